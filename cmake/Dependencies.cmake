@@ -1,0 +1,33 @@
+# Every dependency is a Debian bookworm package. When one is missing, stop with a
+# message that names the package to install, not a CMake stack trace.
+include(FindPkgConfig)
+
+macro(gyrod_require found debian_package what)
+  if(NOT ${found})
+    message(FATAL_ERROR
+      "gyrod needs ${what}: install it with\n"
+      "    apt-get install ${debian_package}\n")
+  endif()
+endmacro()
+
+find_package(Eigen3 3.3 QUIET NO_MODULE)
+gyrod_require(Eigen3_FOUND libeigen3-dev "Eigen 3 (linear algebra)")
+
+find_package(Boost 1.74 QUIET)
+gyrod_require(Boost_FOUND libboost-math-dev "Boost.Math (chi-square and normal distributions)")
+
+find_package(nlohmann_json 3.10 QUIET)
+gyrod_require(nlohmann_json_FOUND nlohmann-json3-dev "nlohmann-json (JSON output)")
+
+find_package(CLI11 2.1 QUIET)
+gyrod_require(CLI11_FOUND libcli11-dev "CLI11 (command-line parsing)")
+
+if(GYROD_BUILD_TESTS)
+  find_package(GTest QUIET)
+  gyrod_require(GTest_FOUND libgtest-dev "GoogleTest (unit tests)")
+endif()
+
+if(GYROD_BUILD_BENCHMARKS)
+  find_package(benchmark QUIET)
+  gyrod_require(benchmark_FOUND libbenchmark-dev "Google Benchmark (benchmarks)")
+endif()

@@ -1,0 +1,1 @@
+#include "tools/recording/recording_csv.hpp"
