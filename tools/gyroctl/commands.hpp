@@ -1,0 +1,21 @@
+#pragma once
+// Each gyroctl subcommand lives in its own file and registers itself here: it adds a
+// CLI11 subcommand to `app` and, when that subcommand is parsed, sets `run` to the
+// function that executes it and returns the process exit status.
+#include <CLI/CLI.hpp>
+#include <functional>
+
+namespace gyrod::gyroctl {
+
+using CommandRunner = std::function<int()>;
+
+// Exit statuses shared by all subcommands.
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitUsage = 2;     // bad input file, bad option value
+inline constexpr int kExitFailure = 1;   // anything else
+
+void addAnalyzeCommand(CLI::App& app, CommandRunner& run);
+void addFilterCommand(CLI::App& app, CommandRunner& run);
+void addImportCommand(CLI::App& app, CommandRunner& run);
+
+}  // namespace gyrod::gyroctl
