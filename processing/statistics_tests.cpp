@@ -77,7 +77,8 @@ ReverseArrangementsTest reverseArrangementsTestOfSequence(std::span<const double
   return t;
 }
 
-ReverseArrangementsTest reverseArrangementsTest(std::span<const double> x, std::size_t segments) {
+ReverseArrangementsTest reverseArrangementsTest(std::span<const double> x, std::size_t segments,
+                                                SegmentStatistic statistic) {
   if (segments < kMinReverseArrangementsSegments)
     throw std::invalid_argument("reverseArrangementsTest: segments must be >= " +
                                 std::to_string(kMinReverseArrangementsSegments) + ", got " +
@@ -88,18 +89,24 @@ ReverseArrangementsTest reverseArrangementsTest(std::span<const double> x, std::
   requireFinite(x, "reverseArrangementsTest");
   // Bendat & Piersol apply the test to the mean-square values of equal-length segments of a
   // record they take as zero-mean. The paper ran it on raw data whose mean (1.367) dwarfs the
-  // fluctuations, where a plain mean square would be almost entirely the constant mean². We
-  // therefore use each segment's mean square about the mean of the whole series: it equals
-  // segment variance + (segment mean − overall mean)², so it reacts to a change of either the
-  // variance or the mean along the record, and it does not depend on the constant offset.
+  // fluctuations, where a plain mean square would be almost entirely the constant mean². The
+  // default therefore uses each segment's mean square about the mean of the whole series: it
+  // equals segment variance + (segment mean − overall mean)², so it does not depend on the
+  // constant offset and reacts to a change of the variance (and of the mean, see the header
+  // for the one shape it misses) along the record.
   const std::size_t len = x.size() / segments;
   const std::size_t used = len * segments;  // trailing remainder (< segments samples) unused
   const double overall_mean = meanOf(x.first(used));
   std::vector<double> v(segments);
   for (std::size_t s = 0; s < segments; ++s) {
-    double ss = 0.0;
-    for (std::size_t i = s * len; i < (s + 1) * len; ++i) ss += (x[i] - overall_mean) * (x[i] - overall_mean);
-    v[s] = ss / static_cast<double>(len);
+    const std::span<const double> seg = x.subspan(s * len, len);
+    if (statistic == SegmentStatistic::Mean) {
+      v[s] = meanOf(seg);
+    } else {
+      double ss = 0.0;
+      for (double xi : seg) ss += (xi - overall_mean) * (xi - overall_mean);
+      v[s] = ss / static_cast<double>(len);
+    }
   }
   return reverseArrangementsTestOfSequence(v);
 }

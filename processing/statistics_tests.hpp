@@ -19,11 +19,22 @@ ZeroMeanTest zeroMeanTest(std::span<const double> x);
 
 // Reverse-arrangements test (Bendat & Piersol, Random Data, §4.5.2): the series is cut
 // into `segments` equal segments (a trailing remainder of size mod segments is not used);
-// each segment gives v_i = mean square of its samples about the mean of the whole series
-// (see the .cpp for why); A counts pairs i<j with v_i > v_j;
-// u = (A − μ_A)/σ_A with μ_A = N(N−1)/4, σ_A² = N(2N+5)(N−1)/72; stationary if |u| < 1.96.
-// Throws for segments < kMinReverseArrangementsSegments or x.size() < segments.
+// each segment gives one value v_i (see SegmentStatistic); A counts pairs i<j with
+// v_i > v_j; u = (A − μ_A)/σ_A with μ_A = N(N−1)/4, σ_A² = N(2N+5)(N−1)/72;
+// stationary if |u| < 1.96.
+// Throws for segments < kMinReverseArrangementsSegments, x.size() < segments or
+// non-finite samples.
 inline constexpr std::size_t kMinReverseArrangementsSegments = 10;
+enum class SegmentStatistic {
+  // Mean square of the segment about the mean of the whole series (the default; see the
+  // .cpp for why): segment variance + (segment mean − overall mean)². Sees a monotone
+  // trend in the variance, and a change of the mean that is not symmetric about the
+  // middle of the record; a pure linear ramp in the mean gives a symmetric U-shaped
+  // profile with A ≈ μ_A, which this statistic cannot see: use Mean for that.
+  MeanSquareAboutMean,
+  // Segment mean: a monotone trend in the mean.
+  Mean,
+};
 struct ReverseArrangementsTest {
   std::size_t segments = 0;
   double arrangements = 0.0;   // A
@@ -32,7 +43,8 @@ struct ReverseArrangementsTest {
   double u = 0.0;
   bool stationary = false;
 };
-ReverseArrangementsTest reverseArrangementsTest(std::span<const double> x, std::size_t segments = 100);
+ReverseArrangementsTest reverseArrangementsTest(std::span<const double> x, std::size_t segments = 100,
+                                                SegmentStatistic statistic = SegmentStatistic::MeanSquareAboutMean);
 
 // The same test applied directly to a sequence of N ≥ kMinReverseArrangementsSegments
 // values (e.g. mean squares computed elsewhere): N = v.size().
