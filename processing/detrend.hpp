@@ -10,10 +10,11 @@ struct LinearTrend {
 };
 
 // Least-squares line x ≈ offset + slope·(i·dt). Numerically stable (centred) form.
+// Throws std::invalid_argument for fewer than 2 samples or dt_s ≤ 0 / non-finite.
 LinearTrend fitLinearTrend(std::span<const double> x, double dt_s);
-// In place: x[i] −= mean. Returns the mean.
+// In place: x[i] −= mean. Returns the mean. Throws for an empty span.
 double removeConstant(std::span<double> x);
-// In place: x[i] −= offset + slope·i·dt. Returns the trend removed.
+// In place: x[i] −= offset + slope·i·dt. Returns the trend removed. Throws as fitLinearTrend.
 LinearTrend removeLinearTrend(std::span<double> x, double dt_s);
 
 }  // namespace gyrod::processing

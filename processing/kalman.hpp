@@ -23,13 +23,18 @@ struct ScalarKalmanParameters {
 
 class ScalarKalmanFilter {
  public:
-  explicit ScalarKalmanFilter(const ScalarKalmanParameters& p);  // throws on q<0, r<0, p0<0, non-finite
+  // Throws std::invalid_argument on non-finite a/q/r/p0/x0, q < 0, r ≤ 0 (R = 0 would be a
+  // perfect measurement, for which P⁻ + R can vanish) or p0 < 0.
+  explicit ScalarKalmanFilter(const ScalarKalmanParameters& p);
   // One measurement in, the updated estimate out. The first call with x0 empty
-  // initialises x̂ = Z and returns it (P = P0).
+  // initialises x̂ = Z and returns it (P = P0, K = 0, innovation 0). With x0 set, every call,
+  // the first included, predicts from the previous estimate and updates.
+  // Throws std::invalid_argument for a non-finite z (state unchanged).
   double update(double z);
+  // Back to the state after construction.
   void reset();
   double gain() const { return k_; }
-  double covariance() const { return p_; }
+  double covariance() const { return p_; }  // P after the last update
   double innovation() const { return innovation_; }  // Z − x̂⁻ of the last update
   const ScalarKalmanParameters& parameters() const { return params_; }
 
@@ -39,25 +44,55 @@ class ScalarKalmanFilter {
   double x_ = 0.0, p_ = 0.0, k_ = 0.0, innovation_ = 0.0;
 };
 
-// Steady-state a-priori covariance P⁻∞ of the scalar filter (positive root of the
-// discrete algebraic Riccati equation) and the gain K∞ = P⁻∞/(P⁻∞ + R).
+// Steady-state a-priori covariance P⁻∞ of the scalar filter: the positive root of the
+// discrete algebraic Riccati equation P⁻ = A²·P⁻R/(P⁻ + R) + Q, i.e. of
+// P⁻² + (R(1 − A²) − Q)·P⁻ − QR = 0; the gain K∞ = P⁻∞/(P⁻∞ + R) and the a-posteriori
+// P∞ = (1 − K∞)·P⁻∞ (the steady error variance of x̂ when the model is right).
+// Throw std::invalid_argument on non-finite input, q < 0 or r ≤ 0.
 double steadyStatePriorCovariance(double a, double q, double r);
 double steadyStateGain(double a, double q, double r);
+double steadyStatePosteriorCovariance(double a, double q, double r);
+
+// The paper's scalar Kalman parameters identified from data (paper §4–5, gyrod's choices):
+//  - A = φ1 and Q = σa² of the AR(1) Yule–Walker fit of the mean-filtered series, as the
+//    paper does (its Table 3 AR(1) column);
+//  - R = the variance of the raw (detrended) sample about the mean-filter output,
+//    var(raw − mean_filtered) with the mean of the difference removed and divisor N. The
+//    paper calls R "the variance of the estimation error of the sample data" and gives no
+//    formula; gyrod reads the mean filter's output as the estimate of the sample data and
+//    raw − estimate as its error.
+//  - P0 = 0 and x̂0 empty (first measurement), as in the paper.
+// phi_std_error is the asymptotic standard error of φ1, √((1 − φ1²)/N).
+// Throws std::invalid_argument if the spans differ in length, have fewer than 2 samples,
+// hold non-finite values, the mean-filtered series has zero variance, or raw equals the
+// mean-filtered series (R would be 0).
+struct KalmanIdentification {
+  ScalarKalmanParameters params;
+  double phi_std_error = 0.0;
+};
+KalmanIdentification identifyKalmanParameters(std::span<const double> raw_detrended,
+                                              std::span<const double> mean_filtered);
 
 // AR(p) in companion form: state s_k = [x_k, x_{k−1}, …, x_{k−p+1}], F = companion(φ),
 // G = e1 (noise enters the first state), H = e1ᵀ. Storage is fixed at construction;
-// update() allocates nothing. Maximum order kMaxArOrder.
+// update() allocates nothing (all matrices have compile-time maximum sizes, so Eigen keeps
+// them and every temporary inline, and products are coefficient-based). Maximum order
+// kMaxArOrder.
 inline constexpr std::size_t kMaxArOrder = 8;
 class ArKalmanFilter {
  public:
   using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxArOrder, kMaxArOrder>;
   using Vector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxArOrder, 1>;
   // phi: φ1..φp (1 ≤ p ≤ kMaxArOrder); q = σa²; r = R; P0 = p0·I; x̂0 = [Z0, Z0, …] by default.
+  // Throws std::invalid_argument on a bad order, non-finite values, q < 0, r ≤ 0 or p0 < 0.
   ArKalmanFilter(std::span<const double> phi, double q, double r, double p0 = 0.0);
+  // As ScalarKalmanFilter::update: the first call initialises x̂ = [Z, …, Z], P = P0 and
+  // returns Z; later calls predict and update. Returns the first state, the estimate of x_k.
   double update(double z);
   void reset();
   std::size_t order() const { return static_cast<std::size_t>(f_.rows()); }
   double gain() const { return k_(0); }  // gain on the first state
+  double covariance() const { return p_(0, 0); }  // a-posteriori variance of the first state
 
  private:
   Matrix f_;

@@ -13,8 +13,11 @@ class GrossErrorMeanFilter {
  public:
   // Throws std::invalid_argument for L = 0 or r ≤ 0 / non-finite.
   GrossErrorMeanFilter(std::size_t window_length, double threshold_dps);
-  // One sample in, one out. Allocates nothing.
+  // One sample in, one out. Allocates nothing; O(L). Throws std::invalid_argument for a
+  // non-finite sample (the filter's state is then unchanged), since one NaN would
+  // otherwise poison the next L outputs.
   double update(double x);
+  // Forget all samples (the window is empty again, as after construction).
   void reset();
   std::size_t windowLength() const { return window_.size(); }
   double threshold() const { return threshold_; }
@@ -31,6 +34,7 @@ class GrossErrorMeanFilter {
 
 // Decimating (block) mode: consecutive non-overlapping blocks of L samples, one output
 // per complete block, same rejection rule. A trailing partial block is dropped.
+// Throws as the constructor above, and for non-finite samples.
 std::vector<double> blockMeanFilter(std::span<const double> x, std::size_t window_length,
                                     double threshold_dps);
 

@@ -1,8 +1,269 @@
+// gyroctl analyze: every table of the paper for each axis of a static recording.
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "processing/axis_analysis.hpp"
+#include "processing/noise_terms.hpp"
 #include "tools/gyroctl/commands.hpp"
+#include "tools/gyroctl/input.hpp"
 
 namespace gyrod::gyroctl {
-void addAnalyzeCommand(CLI::App& app, CommandRunner& run) {
-  auto* sub = app.add_subcommand("analyze", "(being written)");
-  sub->callback([&run] { run = [] { return kExitFailure; }; });
+namespace {
+
+using namespace gyrod::processing;
+using nlohmann::json;
+
+// Fewer samples than this cannot carry the tests (100 reverse-arrangement segments
+// need ≥ 10 samples each to mean anything) nor a useful Allan curve.
+constexpr std::size_t kMinimumSamples = 100;
+
+struct AnalyzeOptions {
+  std::string file;
+  std::optional<double> rate_hz;
+  std::string axis = "all";
+  std::string taus = "octave";
+  bool no_detrend = false;
+  bool json = false;
+  std::size_t mean_window = 20;
+  double mean_threshold_dps = 0.3;
+  std::size_t max_ar_order = 3;
+};
+
+std::vector<double> parseTauList(const std::string& text) {
+  std::vector<double> taus;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    std::size_t used = 0;
+    double v = 0.0;
+    try {
+      v = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size() || !std::isfinite(v) || v <= 0.0)
+      throw std::invalid_argument("--taus: '" + item + "' is not a positive number of seconds (use octave, dense or a list like 1,10,100)");
+    taus.push_back(v);
+  }
+  if (taus.empty()) throw std::invalid_argument("--taus: empty list");
+  return taus;
 }
+
+std::vector<std::size_t> clusterSizesFor(const std::string& spec, double rate_hz, std::size_t n) {
+  if (spec == "octave") return octaveClusterSizes(n);
+  if (spec == "dense") return denseClusterSizes(n);
+  const auto taus = parseTauList(spec);
+  try {
+    return clusterSizesForTaus(taus, 1.0 / rate_hz, n);
+  } catch (const std::invalid_argument& e) {
+    std::ostringstream s;
+    s << "--taus: " << e.what() << " (sample rate " << rate_hz << " Hz)";
+    throw std::invalid_argument(s.str());
+  }
+}
+
+json noiseTermsJson(const NoiseTerms& t) {
+  json j = json::object();
+  for (NoiseTerm term : kAllNoiseTerms) j[std::string(noiseTermKey(term))] = t.get(term);
+  return j;
+}
+
+json allanJson(const std::vector<AllanPoint>& curve) {
+  json a = json::array();
+  for (const auto& p : curve) {
+    json j = {{"tau_s", p.tau_s}, {"m", p.m},
+              {"adev", p.adev},   {"oadev", p.oadev},
+              {"oadev_lo", p.oadev_lo}, {"oadev_hi", p.oadev_hi},
+              {"n", p.oadev_terms}, {"adev_n", p.adev_terms},
+              {"edf", p.edf}, {"noise_alpha", p.noise_alpha}};
+    if (!std::isfinite(p.adev)) j.erase("adev");  // fewer than two clusters: omitted, not null
+    a.push_back(j);
+  }
+  return a;
+}
+
+json axisJson(const AxisAnalysis& a) {
+  json j;
+  j["samples"] = a.samples;
+  j["tests"] = {{"mean", a.zero_mean.mean},
+                {"mean_z", a.zero_mean.z},
+                {"zero_mean", a.zero_mean.zero_mean},
+                {"reverse_arrangements_u", a.reverse_arrangements.u},
+                {"reverse_arrangements_segments", a.reverse_arrangements.segments},
+                {"stationary", a.reverse_arrangements.stationary},
+                {"chi2", a.normality.chi2},
+                {"chi2_dof", a.normality.dof},
+                {"chi2_critical", a.normality.critical},
+                {"chi2_p", a.normality.p_value},
+                {"normal", a.normality.normal}};
+  j["trend_removed"] = {{"offset_dps", a.trend_removed.offset}, {"slope_dps_per_s", a.trend_removed.slope_per_s}};
+  j["allan"] = allanJson(a.allan);
+  j["noise"] = noiseTermsJson(a.noise.value);
+  j["noise_uncertainty"] = noiseTermsJson(a.noise.uncertainty);
+  j["noise_fit_reduced_chi2"] = a.noise.reduced_chi2;
+  j["noise_from_slopes"] = noiseTermsJson(a.noise_from_slopes);
+  json ar = json::array();
+  for (const auto& m : a.ar)
+    ar.push_back({{"order", m.order()}, {"phi", m.phi}, {"phi_std_error", m.phi_std_error},
+                  {"noise_var", m.noise_var}, {"aic", m.aic}, {"bic", m.bic}});
+  j["ar"] = ar;
+  j["ar_order_aic"] = a.ar_order_aic;
+  j["ar_order_bic"] = a.ar_order_bic;
+  j["mean_filter"] = {{"window", a.filter.mean_window}, {"threshold_dps", a.filter.mean_threshold_dps}};
+  j["kalman"] = {{"a", a.filter.kalman.a}, {"q", a.filter.kalman.q}, {"r", a.filter.kalman.r},
+                 {"p0", a.filter.kalman.p0}, {"steady_state_gain", a.steady_state_gain}};
+  j["variance"] = {{"raw", a.variance.raw}, {"mean", a.variance.mean}, {"kalman", a.variance.kalman}};
+  j["peak_ratio"] = a.peak_ratio;
+  j["allan_after_kalman"] = allanJson(a.allan_after_kalman);
+  j["noise_after_kalman"] = noiseTermsJson(a.noise_after_kalman.value);
+  return j;
+}
+
+std::string format(const char* fmt, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, v);
+  return buf;
+}
+
+void printAxisText(std::ostream& o, const std::string& name, const AxisAnalysis& a) {
+  char line[256];
+  o << "\n== " << name << " ==\n";
+  o << "Tests on the raw series (5 % level)\n";
+  std::snprintf(line, sizeof line, "  zero mean     mean = %.6g deg/s, z = %.3f  -> %s\n", a.zero_mean.mean, a.zero_mean.z,
+                a.zero_mean.zero_mean ? "zero mean" : "non-zero mean");
+  o << line;
+  std::snprintf(line, sizeof line, "  stationarity  reverse arrangements over %zu segments: u = %.4f (|u| < 1.96)  -> %s\n",
+                a.reverse_arrangements.segments, a.reverse_arrangements.u,
+                a.reverse_arrangements.stationary ? "stationary" : "not stationary");
+  o << line;
+  std::snprintf(line, sizeof line, "  normality     chi2 = %.3f, dof = %zu, critical %.3f, p = %.3g  -> %s\n", a.normality.chi2,
+                a.normality.dof, a.normality.critical, a.normality.p_value, a.normality.normal ? "normal" : "not normal");
+  o << line;
+  if (a.trend_removed.offset != 0.0 || a.trend_removed.slope_per_s != 0.0) {
+    std::snprintf(line, sizeof line, "Removed: constant %.6g deg/s and trend %.6g deg/s per s\n", a.trend_removed.offset,
+                  a.trend_removed.slope_per_s);
+    o << line;
+  }
+
+  o << "\nAllan deviation (deg/s; overlapping with 68.3 % chi2 interval)\n";
+  o << "      tau [s]        m         adev        oadev     oadev_lo     oadev_hi    terms  alpha\n";
+  for (const auto& p : a.allan) {
+    std::snprintf(line, sizeof line, "  %11.4f %8zu %12.5g %12.5g %12.5g %12.5g %8zu %6d\n", p.tau_s, p.m, p.adev, p.oadev,
+                  p.oadev_lo, p.oadev_hi, p.oadev_terms, p.noise_alpha);
+    o << line;
+  }
+
+  o << "\nTable 2: noise terms (weighted fit +- 1 sigma | slope-line reading)\n";
+  for (NoiseTerm t : kAllNoiseTerms) {
+    std::snprintf(line, sizeof line, "  %-36s %12.5g +- %-11.3g | %12.5g\n", std::string(noiseTermLabel(t)).c_str(),
+                  a.noise.value.get(t), a.noise.uncertainty.get(t), a.noise_from_slopes.get(t));
+    o << line;
+  }
+
+  o << "\nTable 3: AR models of the mean-filtered series (Yule-Walker)\n";
+  o << "              ";
+  for (const auto& m : a.ar) o << "       AR(" << m.order() << ")";
+  o << '\n';
+  for (std::size_t k = 0; k < a.ar.size(); ++k) {
+    std::snprintf(line, sizeof line, "  phi%-9zu", k + 1);
+    o << line;
+    for (const auto& m : a.ar) o << format(" %12.4f", k < m.phi.size() ? m.phi[k] : 0.0);
+    o << '\n';
+  }
+  o << "  noise var   ";
+  for (const auto& m : a.ar) o << format(" %12.5g", m.noise_var);
+  o << "\n  AIC         ";
+  for (const auto& m : a.ar) o << format(" %12.2f", m.aic);
+  o << "\n  BIC         ";
+  for (const auto& m : a.ar) o << format(" %12.2f", m.bic);
+  o << "\n  lowest AIC: AR(" << a.ar_order_aic << "), lowest BIC: AR(" << a.ar_order_bic << ")\n";
+
+  std::snprintf(line, sizeof line,
+                "\nKalman on AR(1): A = %.5g, Q = %.5g, R = %.5g, P0 = %.3g, steady-state gain %.4f\n",
+                a.filter.kalman.a, a.filter.kalman.q, a.filter.kalman.r, a.filter.kalman.p0, a.steady_state_gain);
+  o << line;
+  std::snprintf(line, sizeof line, "Variance (deg/s)^2: raw %.5g, mean filter %.5g, Kalman %.5g (%.1f %% of raw)\n",
+                a.variance.raw, a.variance.mean, a.variance.kalman,
+                a.variance.raw > 0 ? 100.0 * a.variance.kalman / a.variance.raw : 0.0);
+  o << line;
+  std::snprintf(line, sizeof line, "Peak after Kalman: %.1f %% of before\n", 100.0 * a.peak_ratio);
+  o << line;
+
+  o << "\nTable 4: noise terms before and after Kalman\n";
+  for (NoiseTerm t : kAllNoiseTerms) {
+    const double before = a.noise.value.get(t), after = a.noise_after_kalman.value.get(t);
+    std::snprintf(line, sizeof line, "  %-36s %12.5g %12.5g", std::string(noiseTermLabel(t)).c_str(), before, after);
+    o << line;
+    if (before > 0.0) o << format("  %+7.1f %%", 100.0 * (after - before) / before);
+    o << '\n';
+  }
+}
+
+int runAnalyze(const AnalyzeOptions& opt) {
+  LoadedInput in = loadInput(opt.file, opt.rate_hz, opt.axis);
+  const auto& rec = in.recording;
+  if (rec.size() < kMinimumSamples) {
+    std::ostringstream s;
+    s << opt.file << ": " << rec.size() << " samples are too few to analyse (need at least " << kMinimumSamples << ")";
+    throw recording::RecordingError(s.str());
+  }
+  AnalysisOptions options;
+  options.rate_hz = in.rate_hz;
+  options.detrend = !opt.no_detrend;
+  options.cluster_sizes = clusterSizesFor(opt.taus, in.rate_hz, rec.size());
+  options.mean_window = opt.mean_window;
+  options.mean_threshold_dps = opt.mean_threshold_dps;
+  options.max_ar_order = opt.max_ar_order;
+
+  json doc;
+  doc["file"] = opt.file;
+  doc["rate_hz"] = in.rate_hz;
+  doc["samples"] = rec.size();
+  doc["detrended"] = options.detrend;
+  doc["axes"] = json::object();
+  if (!opt.json) {
+    std::printf("gyroctl analyze %s: %zu samples at %g Hz (%s), %.1f s%s\n", opt.file.c_str(), rec.size(), in.rate_hz,
+                in.rate_source.c_str(), rec.size() / in.rate_hz,
+                options.detrend ? ", constant and linear trend removed" : ", no detrending");
+  }
+  for (std::size_t idx : in.axis_indices) {
+    const AxisAnalysis a = analyzeAxis(rec.axes[idx], options);
+    if (opt.json)
+      doc["axes"][rec.axis_names[idx]] = axisJson(a);
+    else
+      printAxisText(std::cout, rec.axis_names[idx], a);
+  }
+  if (opt.json) std::cout << doc.dump(1) << '\n';
+  return kExitOk;
+}
+
+}  // namespace
+
+void addAnalyzeCommand(CLI::App& app, CommandRunner& run) {
+  auto opt = std::make_shared<AnalyzeOptions>();
+  auto* sub = app.add_subcommand("analyze", "The paper's tables for a static recording: tests, Allan deviation, "
+                                            "noise terms, AR/AIC, Kalman, terms after Kalman");
+  sub->add_option("FILE", opt->file, "CSV with header t,gx,gy,gz,temp (any subset), or one column of bare numbers")
+      ->required();
+  sub->add_option("--rate", opt->rate_hz, "sample rate [Hz] (default: from t, else 50)");
+  sub->add_option("--axis", opt->axis, "gx, gy, gz or all")->default_val("all");
+  sub->add_option("--taus", opt->taus, "octave, dense, or a list of tau in seconds (e.g. 1,10,100)")
+      ->default_val("octave");
+  sub->add_flag("--no-detrend", opt->no_detrend, "keep the constant and the linear trend");
+  sub->add_flag("--json", opt->json, "one JSON document on stdout");
+  sub->add_option("--mean-window", opt->mean_window, "mean filter window L [samples]")
+      ->default_val(20)->check(CLI::Range(std::size_t{1}, std::size_t{100000}));
+  sub->add_option("--mean-threshold", opt->mean_threshold_dps, "gross-error threshold r [deg/s]")
+      ->default_val(0.3)->check(CLI::PositiveNumber);
+  sub->add_option("--max-ar-order", opt->max_ar_order, "highest AR order for Table 3")
+      ->default_val(3)->check(CLI::Range(std::size_t{1}, std::size_t{8}));
+  sub->callback([&run, opt] { run = [opt] { return runAnalyze(*opt); }; });
+}
+
 }  // namespace gyrod::gyroctl

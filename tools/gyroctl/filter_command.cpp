@@ -1,8 +1,112 @@
+// gyroctl filter: the daemon's per-sample chain, offline: (detrend) → mean filter → Kalman.
+#include <charconv>
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include "processing/detrend.hpp"
+#include "processing/filter_chain.hpp"
 #include "tools/gyroctl/commands.hpp"
+#include "tools/gyroctl/input.hpp"
 
 namespace gyrod::gyroctl {
-void addFilterCommand(CLI::App& app, CommandRunner& run) {
-  auto* sub = app.add_subcommand("filter", "(being written)");
-  sub->callback([&run] { run = [] { return kExitFailure; }; });
+namespace {
+
+using namespace gyrod::processing;
+
+struct FilterOptions {
+  std::string file;
+  std::string output;
+  std::optional<double> rate_hz;
+  std::size_t mean_window = 20;
+  double mean_threshold_dps = 0.3;
+  std::optional<double> ar_phi, kalman_q, kalman_r;
+  bool no_detrend = false;
+};
+
+// 17 significant digits: every double survives the text round trip exactly.
+void appendNumber(std::string& out, double v) {
+  char buf[32];
+  const int n = std::snprintf(buf, sizeof buf, "%.17g", v);
+  out.append(buf, static_cast<std::size_t>(n));
 }
+
+int runFilter(const FilterOptions& opt) {
+  if (opt.kalman_q && !(*opt.kalman_q >= 0.0)) throw std::invalid_argument("--kalman-q must be >= 0");
+  if (opt.kalman_r && !(*opt.kalman_r >= 0.0)) throw std::invalid_argument("--kalman-r must be >= 0");
+  if (opt.ar_phi && !std::isfinite(*opt.ar_phi)) throw std::invalid_argument("--ar-phi must be a finite number");
+  LoadedInput in = loadInput(opt.file, opt.rate_hz, "all");
+  const auto& rec = in.recording;
+  const std::size_t n = rec.size();
+  const double dt = 1.0 / in.rate_hz;
+
+  std::vector<std::vector<double>> chain_input;
+  std::vector<FilterChainParameters> params;
+  for (std::size_t axis = 0; axis < rec.axes.size(); ++axis) {
+    std::vector<double> x = rec.axes[axis];
+    if (!opt.no_detrend) removeLinearTrend(x, dt);
+    try {
+      params.push_back(identifyFilterChain(x, opt.mean_window, opt.mean_threshold_dps,
+                                           KalmanOverrides{opt.ar_phi, opt.kalman_q, opt.kalman_r}));
+    } catch (const std::invalid_argument& e) {
+      throw recording::RecordingError(opt.file + ": column '" + rec.axis_names[axis] +
+                                      "': cannot identify the filter: " + e.what());
+    }
+    chain_input.push_back(std::move(x));
+  }
+
+  std::string out;
+  out.reserve(n * (1 + 3 * rec.axes.size()) * 24 + 64);
+  out += "t";
+  for (const auto& name : rec.axis_names) out += "," + name + "," + name + "_mean," + name + "_kalman";
+  out += '\n';
+  std::vector<AxisFilterChain> chains;
+  for (const auto& p : params) chains.emplace_back(p);
+  for (std::size_t i = 0; i < n; ++i) {
+    appendNumber(out, rec.t.empty() ? static_cast<double>(i) * dt : rec.t[i]);
+    for (std::size_t axis = 0; axis < chains.size(); ++axis) {
+      const double x = chain_input[axis][i];
+      const FilteredRate f = chains[axis].update(x);
+      out += ',';
+      appendNumber(out, x);
+      out += ',';
+      appendNumber(out, f.mean_dps);
+      out += ',';
+      appendNumber(out, f.kalman_dps);
+    }
+    out += '\n';
+  }
+  writeFileAtomically(opt.output, out);
+
+  for (std::size_t axis = 0; axis < params.size(); ++axis) {
+    const auto& k = params[axis].kalman;
+    std::fprintf(stderr, "%s: L = %zu, r = %g deg/s, A = %.6g, Q = %.6g, R = %.6g%s\n", rec.axis_names[axis].c_str(),
+                 params[axis].mean_window, params[axis].mean_threshold_dps, k.a, k.q, k.r,
+                 opt.ar_phi || opt.kalman_q || opt.kalman_r ? " (some given on the command line)" : " (identified from the file)");
+  }
+  std::fprintf(stderr, "wrote %zu samples to %s\n", n, opt.output.c_str());
+  return kExitOk;
+}
+
+}  // namespace
+
+void addFilterCommand(CLI::App& app, CommandRunner& run) {
+  auto opt = std::make_shared<FilterOptions>();
+  auto* sub = app.add_subcommand("filter", "Run the daemon's per-sample chain offline: (detrend) -> mean filter -> Kalman");
+  sub->add_option("FILE", opt->file, "recording CSV (as for analyze)")->required();
+  sub->add_option("-o,--output", opt->output, "output CSV: t, then gx,gx_mean,gx_kalman per axis")->required();
+  sub->add_option("--rate", opt->rate_hz, "sample rate [Hz] (default: from t, else 50)");
+  sub->add_option("--mean-window", opt->mean_window, "mean filter window L [samples]")
+      ->default_val(20)->check(CLI::Range(std::size_t{1}, std::size_t{100000}));
+  sub->add_option("--mean-threshold", opt->mean_threshold_dps, "gross-error threshold r [deg/s]")
+      ->default_val(0.3)->check(CLI::PositiveNumber);
+  sub->add_option("--ar-phi", opt->ar_phi, "Kalman A = phi1 (default: AR(1) fit of the mean-filtered series)");
+  sub->add_option("--kalman-q", opt->kalman_q, "Kalman Q [(deg/s)^2] (default: AR(1) noise variance)");
+  sub->add_option("--kalman-r", opt->kalman_r, "Kalman R [(deg/s)^2] (default: var(x - mean-filtered x))");
+  sub->add_flag("--no-detrend", opt->no_detrend, "feed the raw input to the mean filter");
+  sub->callback([&run, opt] { run = [opt] { return runFilter(*opt); }; });
+}
+
 }  // namespace gyrod::gyroctl

@@ -20,6 +20,7 @@ struct Recording {
   std::vector<std::string> axis_names;   // "gx", "gy", "gz" in file order (or "x" for bare numbers)
   std::vector<std::vector<double>> axes; // one vector per axis_names entry
   std::vector<double> temp;              // empty when absent
+  std::vector<std::size_t> line_numbers; // file line of each sample, for error messages
   std::size_t size() const { return axes.empty() ? 0 : axes.front().size(); }
   const std::vector<double>* axis(const std::string& name) const;
 };
@@ -28,7 +29,7 @@ struct Recording {
 Recording readRecordingCsv(const std::string& path);
 
 // Sample rate implied by t: 1 / median spacing. Throws RecordingError if t is not
-// strictly increasing (naming the line).
+// strictly increasing (naming file and line).
 double sampleRateFromTimes(const Recording& r);
 
 }  // namespace gyrod::recording

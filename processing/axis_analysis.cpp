@@ -1,0 +1,75 @@
+#include "processing/axis_analysis.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace gyrod::processing {
+
+double varianceAboutMean(std::span<const double> x) {
+  if (x.empty()) return 0.0;
+  long double mean = 0.0L;
+  for (double v : x) mean += v;
+  mean /= static_cast<long double>(x.size());
+  long double ss = 0.0L;
+  for (double v : x) ss += (v - mean) * (v - mean);
+  return static_cast<double>(ss / static_cast<long double>(x.size()));
+}
+
+double peakDeviationFromMean(std::span<const double> x) {
+  if (x.empty()) return 0.0;
+  long double mean = 0.0L;
+  for (double v : x) mean += v;
+  mean /= static_cast<long double>(x.size());
+  double peak = 0.0;
+  for (double v : x) peak = std::max(peak, std::abs(static_cast<double>(v - mean)));
+  return peak;
+}
+
+AxisAnalysis analyzeAxis(std::span<const double> rate_dps, const AnalysisOptions& options) {
+  if (!(options.rate_hz > 0.0) || !std::isfinite(options.rate_hz))
+    throw std::invalid_argument("analyzeAxis: rate must be a positive number of Hz");
+  const double tau0 = 1.0 / options.rate_hz;
+  AxisAnalysis a;
+  a.samples = rate_dps.size();
+
+  // 1. Tests on the raw series, before any preprocessing (paper §3.2.1).
+  a.zero_mean = zeroMeanTest(rate_dps);
+  a.reverse_arrangements = reverseArrangementsTest(rate_dps, options.reverse_arrangements_segments);
+  a.normality = chiSquareNormalityTest(rate_dps);
+
+  // 2. Preprocessing (§3.2.2).
+  std::vector<double> x(rate_dps.begin(), rate_dps.end());
+  if (options.detrend) a.trend_removed = removeLinearTrend(x, tau0);
+
+  // 3. Allan deviation and noise terms (§3.2.3, Table 2).
+  std::vector<std::size_t> ms = options.cluster_sizes.empty() ? octaveClusterSizes(x.size()) : options.cluster_sizes;
+  a.allan = allanDeviationTable(x, tau0, ms);
+  a.noise = fitNoiseTerms(a.allan);
+  a.noise_from_slopes = readNoiseTermsFromSlopes(a.allan);
+
+  // 4–6. Mean filter, AR models of its output, Kalman on AR(1) (§4–5).
+  a.filter = identifyFilterChain(x, options.mean_window, options.mean_threshold_dps, options.kalman_overrides);
+  AxisFilterChain chain(a.filter);
+  std::vector<double> mean_filtered(x.size()), kalman_filtered(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const FilteredRate f = chain.update(x[i]);
+    mean_filtered[i] = f.mean_dps;
+    kalman_filtered[i] = f.kalman_dps;
+  }
+  a.ar = yuleWalker(mean_filtered, options.max_ar_order);
+  a.ar_order_aic = orderByAic(a.ar);
+  a.ar_order_bic = orderByBic(a.ar);
+  a.steady_state_gain = steadyStateGain(a.filter.kalman.a, a.filter.kalman.q, a.filter.kalman.r);
+
+  a.variance = {varianceAboutMean(x), varianceAboutMean(mean_filtered), varianceAboutMean(kalman_filtered)};
+  const double peak_raw = peakDeviationFromMean(x);
+  a.peak_ratio = peak_raw > 0.0 ? peakDeviationFromMean(kalman_filtered) / peak_raw : 0.0;
+
+  // Table 4: the same Allan analysis on the Kalman output.
+  a.allan_after_kalman = allanDeviationTable(kalman_filtered, tau0, ms);
+  a.noise_after_kalman = fitNoiseTerms(a.allan_after_kalman);
+  return a;
+}
+
+}  // namespace gyrod::processing

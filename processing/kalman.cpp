@@ -1,0 +1,182 @@
+#include "processing/kalman.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "processing/ar_model.hpp"
+
+namespace gyrod::processing {
+
+namespace {
+
+void requireFinite(double v, const char* who, const char* name) {
+  if (!std::isfinite(v)) throw std::invalid_argument(std::string(who) + ": " + name + " is not finite");
+}
+
+void validateNoise(const char* who, double q, double r, double p0) {
+  requireFinite(q, who, "q");
+  requireFinite(r, who, "r");
+  requireFinite(p0, who, "p0");
+  if (q < 0.0) throw std::invalid_argument(std::string(who) + ": q must be >= 0, got " + std::to_string(q));
+  if (!(r > 0.0)) throw std::invalid_argument(std::string(who) + ": r must be > 0, got " + std::to_string(r));
+  if (p0 < 0.0) throw std::invalid_argument(std::string(who) + ": p0 must be >= 0, got " + std::to_string(p0));
+}
+
+}  // namespace
+
+ScalarKalmanFilter::ScalarKalmanFilter(const ScalarKalmanParameters& p) : params_(p) {
+  requireFinite(p.a, "ScalarKalmanFilter", "a");
+  validateNoise("ScalarKalmanFilter", p.q, p.r, p.p0);
+  if (p.x0) requireFinite(*p.x0, "ScalarKalmanFilter", "x0");
+  reset();
+}
+
+void ScalarKalmanFilter::reset() {
+  initialised_ = params_.x0.has_value();
+  x_ = params_.x0.value_or(0.0);
+  p_ = params_.p0;
+  k_ = 0.0;
+  innovation_ = 0.0;
+}
+
+double ScalarKalmanFilter::update(double z) {
+  if (!std::isfinite(z)) throw std::invalid_argument("ScalarKalmanFilter::update: measurement is not finite");
+  if (!initialised_) {
+    // Paper: x̂0 = Z0, P0 as given; nothing to predict from yet.
+    initialised_ = true;
+    x_ = z;
+    p_ = params_.p0;
+    k_ = 0.0;
+    innovation_ = 0.0;
+    return x_;
+  }
+  const double a = params_.a;
+  const double x_prior = a * x_;                       // paper eq. 12
+  const double p_prior = a * p_ * a + params_.q;       // eq. 15 (B = 1)
+  k_ = p_prior / (p_prior + params_.r);                // eq. 14 (H = 1); r > 0 keeps it defined
+  innovation_ = z - x_prior;
+  x_ = x_prior + k_ * innovation_;                     // eq. 13
+  p_ = (1.0 - k_) * p_prior;                           // eq. 16
+  return x_;
+}
+
+double steadyStatePriorCovariance(double a, double q, double r) {
+  requireFinite(a, "steadyStatePriorCovariance", "a");
+  validateNoise("steadyStatePriorCovariance", q, r, 0.0);
+  // M² + b·M − QR = 0 with b = R(1 − A²) − Q. The roots have product −QR ≤ 0; take the
+  // larger (the positive one for Q > 0), written to avoid cancellation for either sign of b.
+  const double b = r * (1.0 - a * a) - q;
+  const double disc = std::sqrt(b * b + 4.0 * q * r);
+  return b > 0.0 ? 2.0 * q * r / (b + disc) : (disc - b) / 2.0;
+}
+
+double steadyStateGain(double a, double q, double r) {
+  const double m = steadyStatePriorCovariance(a, q, r);
+  return m / (m + r);
+}
+
+double steadyStatePosteriorCovariance(double a, double q, double r) {
+  const double m = steadyStatePriorCovariance(a, q, r);
+  // (1 − K)·M with K = M/(M + R), i.e. M·R/(M + R).
+  return m * r / (m + r);
+}
+
+KalmanIdentification identifyKalmanParameters(std::span<const double> raw_detrended,
+                                              std::span<const double> mean_filtered) {
+  if (raw_detrended.size() != mean_filtered.size())
+    throw std::invalid_argument("identifyKalmanParameters: raw_detrended has " +
+                                std::to_string(raw_detrended.size()) + " samples but mean_filtered has " +
+                                std::to_string(mean_filtered.size()));
+  if (mean_filtered.size() < 2)
+    throw std::invalid_argument("identifyKalmanParameters: need at least 2 samples, got " +
+                                std::to_string(mean_filtered.size()));
+  // A, Q: the AR(1) Yule–Walker fit of the mean-filtered series (throws on non-finite
+  // values or zero variance).
+  const std::vector<ArModel> ar1 = yuleWalker(mean_filtered, 1);
+
+  // R: variance of the error raw − mean_filtered (mean removed, divisor N).
+  const double n = static_cast<double>(raw_detrended.size());
+  double mean = 0.0;
+  for (std::size_t i = 0; i < raw_detrended.size(); ++i) {
+    if (!std::isfinite(raw_detrended[i]))
+      throw std::invalid_argument("identifyKalmanParameters: raw sample " + std::to_string(i) + " is not finite");
+    mean += raw_detrended[i] - mean_filtered[i];
+  }
+  mean /= n;
+  double ss = 0.0;
+  for (std::size_t i = 0; i < raw_detrended.size(); ++i) {
+    const double d = raw_detrended[i] - mean_filtered[i] - mean;
+    ss += d * d;
+  }
+  const double r = ss / n;
+  if (!(r > 0.0))
+    throw std::invalid_argument(
+        "identifyKalmanParameters: raw and mean-filtered series differ only by a constant, so R would be 0");
+
+  KalmanIdentification id;
+  id.params.a = ar1[0].phi[0];
+  id.params.q = ar1[0].noise_var;
+  id.params.r = r;
+  id.params.p0 = 0.0;
+  id.phi_std_error = ar1[0].phi_std_error[0];
+  return id;
+}
+
+ArKalmanFilter::ArKalmanFilter(std::span<const double> phi, double q, double r, double p0)
+    : q_(q), r_(r), p0_(p0) {
+  if (phi.empty() || phi.size() > kMaxArOrder)
+    throw std::invalid_argument("ArKalmanFilter: AR order must be in [1, " + std::to_string(kMaxArOrder) +
+                                "], got " + std::to_string(phi.size()));
+  for (double v : phi) requireFinite(v, "ArKalmanFilter", "a coefficient phi");
+  validateNoise("ArKalmanFilter", q, r, p0);
+  const auto p = static_cast<Eigen::Index>(phi.size());
+  // Companion matrix: first row φ1..φp, ones on the subdiagonal (x_{k−i} shifts down).
+  f_.setZero(p, p);
+  for (Eigen::Index j = 0; j < p; ++j) f_(0, j) = phi[static_cast<std::size_t>(j)];
+  for (Eigen::Index i = 1; i < p; ++i) f_(i, i - 1) = 1.0;
+  x_.setZero(p);
+  k_.setZero(p);
+  tmp_.setZero(p);
+  p_.setZero(p, p);
+  ptmp_.setZero(p, p);
+  reset();
+}
+
+void ArKalmanFilter::reset() {
+  initialised_ = false;
+  x_.setZero();
+  k_.setZero();
+  p_.setIdentity();
+  p_ *= p0_;
+}
+
+double ArKalmanFilter::update(double z) {
+  if (!std::isfinite(z)) throw std::invalid_argument("ArKalmanFilter::update: measurement is not finite");
+  if (!initialised_) {
+    initialised_ = true;
+    x_.setConstant(z);
+    p_.setIdentity();
+    p_ *= p0_;
+    k_.setZero();
+    return z;
+  }
+  // Predict: x̂⁻ = F·x̂, P⁻ = F·P·Fᵀ + G·Q·Gᵀ (Q enters P⁻(0,0) only).
+  tmp_.noalias() = f_.lazyProduct(x_);
+  ptmp_.noalias() = f_.lazyProduct(p_);
+  p_.noalias() = ptmp_.lazyProduct(f_.transpose());
+  p_(0, 0) += q_;
+  // Update with H = e1ᵀ: S = P⁻(0,0) + R, K = P⁻(:,0)/S, P = (I − K·H)·P⁻ = P⁻ − K·P⁻(0,:).
+  const double s = p_(0, 0) + r_;
+  k_ = p_.col(0) / s;
+  const double innovation = z - tmp_(0);
+  x_ = tmp_ + k_ * innovation;
+  ptmp_.noalias() = k_.lazyProduct(p_.row(0));
+  p_ -= ptmp_;
+  // Keep P exactly symmetric against rounding drift over long runs.
+  ptmp_ = p_.transpose();
+  p_ = 0.5 * (p_ + ptmp_);
+  return x_(0);
+}
+
+}  // namespace gyrod::processing

@@ -1,0 +1,153 @@
+// Every bad input to gyroctl's offline commands: one line naming file, line and cause,
+// exit status 2, no crash, and no existing output destroyed.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "tools/run_command.hpp"
+
+using gyrod::test::runGyroctl;
+using gyrod::test::ScratchDir;
+
+namespace {
+
+std::string whiteNoiseCsv(std::size_t n, double rate_hz, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, 0.1);
+  std::string s = "t,gx,gy\n";
+  char buf[96];
+  for (std::size_t i = 0; i < n; ++i) {
+    std::snprintf(buf, sizeof buf, "%.17g,%.17g,%.17g\n", static_cast<double>(i) / rate_hz, noise(rng), noise(rng));
+    s += buf;
+  }
+  return s;
+}
+
+void expectOneLineError(const gyrod::test::CommandResult& r, const std::string& must_contain) {
+  EXPECT_EQ(r.exit_status, 2) << r.err;
+  EXPECT_NE(r.err.find(must_contain), std::string::npos) << "stderr was: " << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "stderr was: " << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
+}  // namespace
+
+TEST(GyroctlErrors, MissingFile) {
+  ScratchDir d;
+  const auto missing = (d.path() / "nope.csv").string();
+  expectOneLineError(runGyroctl("analyze " + missing, d.path()), missing + ": cannot open: No such file or directory");
+}
+
+TEST(GyroctlErrors, EmptyFile) {
+  ScratchDir d;
+  const auto f = d.write("empty.csv", "");
+  expectOneLineError(runGyroctl("analyze " + f.string(), d.path()), f.string() + ": empty file");
+}
+
+TEST(GyroctlErrors, HeaderWithoutSamples) {
+  ScratchDir d;
+  const auto f = d.write("h.csv", "t,gx\n");
+  expectOneLineError(runGyroctl("analyze " + f.string(), d.path()), f.string() + ":1: no samples after the header");
+}
+
+TEST(GyroctlErrors, TextWhereANumberShouldBeNamesTheLine) {
+  ScratchDir d;
+  const auto f = d.write("t.csv", "t,gx\n0,0.1\n0.02,abc\n0.04,0.2\n");
+  expectOneLineError(runGyroctl("analyze " + f.string(), d.path()), f.string() + ":3: column 'gx': 'abc' is not a number");
+}
+
+TEST(GyroctlErrors, NaNAndInfAreRejectedWithTheirLine) {
+  ScratchDir d;
+  const auto nan_file = d.write("nan.csv", "t,gx\n0,0.1\n0.02,0.2\n0.04,nan\n");
+  expectOneLineError(runGyroctl("analyze " + nan_file.string(), d.path()),
+                     nan_file.string() + ":4: column 'gx': non-finite value 'nan'");
+  const auto inf_file = d.write("inf.csv", "t,gx\n0,-inf\n");
+  expectOneLineError(runGyroctl("filter " + inf_file.string() + " -o " + (d.path() / "o.csv").string(), d.path()),
+                     inf_file.string() + ":2: column 'gx': non-finite value '-inf'");
+  const auto huge_file = d.write("huge.csv", "gx\n1e999\n");
+  expectOneLineError(runGyroctl("analyze " + huge_file.string(), d.path()), ":2: column 'gx': non-finite value '1e999'");
+}
+
+TEST(GyroctlErrors, MissingColumn) {
+  ScratchDir d;
+  const auto f = d.write("w.csv", whiteNoiseCsv(500, 50.0, 1));
+  expectOneLineError(runGyroctl("analyze " + f.string() + " --axis gz", d.path()),
+                     f.string() + ": no column 'gz' (the file has gx,gy)");
+  const auto no_gyro = d.write("ng.csv", "t,temp\n0,25\n");
+  expectOneLineError(runGyroctl("analyze " + no_gyro.string(), d.path()), ":1: no gyro column");
+}
+
+TEST(GyroctlErrors, UnknownAndDuplicateColumns) {
+  ScratchDir d;
+  const auto f = d.write("u.csv", "t,gx,ax\n0,1,2\n");
+  expectOneLineError(runGyroctl("analyze " + f.string(), d.path()), ":1: unknown column 'ax'");
+  const auto g = d.write("dup.csv", "t,gx,gx\n0,1,2\n");
+  expectOneLineError(runGyroctl("analyze " + g.string(), d.path()), ":1: column 'gx' appears twice");
+}
+
+TEST(GyroctlErrors, WrongFieldCount) {
+  ScratchDir d;
+  const auto f = d.write("f.csv", "t,gx,gy\n0,1,2\n0.02,1\n");
+  expectOneLineError(runGyroctl("analyze " + f.string(), d.path()), f.string() + ":3: expected 3 fields, found 2");
+}
+
+TEST(GyroctlErrors, RateThatDisagreesWithT) {
+  ScratchDir d;
+  const auto f = d.write("w.csv", whiteNoiseCsv(500, 50.0, 2));
+  expectOneLineError(runGyroctl("analyze " + f.string() + " --rate 100", d.path()),
+                     f.string() + ": --rate 100 Hz disagrees with column 't'");
+}
+
+TEST(GyroctlErrors, TimeGoingBackwardsNamesTheLine) {
+  ScratchDir d;
+  const auto f = d.write("b.csv", "t,gx\n0,1\n0.02,1\n0.01,1\n");
+  expectOneLineError(runGyroctl("analyze " + f.string(), d.path()), f.string() + ":4: column 't' is not strictly increasing");
+}
+
+TEST(GyroctlErrors, TooFewSamples) {
+  ScratchDir d;
+  const auto f = d.write("s.csv", whiteNoiseCsv(20, 50.0, 3));
+  expectOneLineError(runGyroctl("analyze " + f.string(), d.path()), "20 samples are too few");
+}
+
+TEST(GyroctlErrors, TauThatIsNotAWholeNumberOfSamples) {
+  ScratchDir d;
+  const auto f = d.write("w.csv", whiteNoiseCsv(2000, 50.0, 4));
+  const auto r = runGyroctl("analyze " + f.string() + " --taus 0.1,0.03", d.path());
+  expectOneLineError(r, "--taus");
+  EXPECT_NE(r.err.find("0.03"), std::string::npos) << r.err;
+  expectOneLineError(runGyroctl("analyze " + f.string() + " --taus 1,x", d.path()), "--taus: 'x' is not a positive number");
+}
+
+TEST(GyroctlErrors, BadOptionValuesExitTwo) {
+  ScratchDir d;
+  const auto f = d.write("w.csv", whiteNoiseCsv(500, 50.0, 5));
+  EXPECT_EQ(runGyroctl("analyze " + f.string() + " --mean-window 0", d.path()).exit_status, 2);
+  EXPECT_EQ(runGyroctl("analyze " + f.string() + " --rate -3", d.path()).exit_status, 2);
+  EXPECT_EQ(runGyroctl("analyze " + f.string() + " --bogus", d.path()).exit_status, 2);
+  EXPECT_EQ(runGyroctl("frobnicate", d.path()).exit_status, 2);
+  EXPECT_EQ(runGyroctl("filter " + f.string() + " -o " + (d.path() / "o.csv").string() + " --kalman-r -1", d.path())
+                .exit_status,
+            2);
+}
+
+TEST(GyroctlErrors, FailedFilterLeavesAnExistingOutputUntouched) {
+  ScratchDir d;
+  const auto out = d.write("out.csv", "precious\n");
+  const auto bad = d.write("bad.csv", "t,gx\n0,1\n0.02,oops\n");
+  const auto r = runGyroctl("filter " + bad.string() + " -o " + out.string(), d.path());
+  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_EQ(gyrod::test::readWholeFile(out), "precious\n");
+}
+
+TEST(GyroctlErrors, ImportOfAForeignFileThatIsNotImucal) {
+  ScratchDir d;
+  const auto f = d.write("x.csv", "hello,world\n1,2\n");
+  expectOneLineError(runGyroctl("import " + f.string() + " -o " + (d.path() / "o.csv").string(), d.path()),
+                     f.string() + ":1: not an imucal recording");
+  const auto g = d.write("y.csv", "Fs,100\nLogging Type,1\nax,ay,az,gx,gy,gz\n1,2,3,4,5,6\n1,2,3,4,x,6\n");
+  expectOneLineError(runGyroctl("import " + g.string() + " -o " + (d.path() / "o.csv").string(), d.path()),
+                     g.string() + ":5: column 'gy': 'x' is not an integer count");
+}
