@@ -1,6 +1,7 @@
 #include "processing/noise_simulator.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -12,19 +13,28 @@ namespace {
 
 constexpr std::array<const char*, kSimulatedAxes> kAxisNames = {"x", "y", "z"};
 
+// Numbers in messages as the user would write them (std::to_string prints 300.000000).
+std::string formatNumber(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
 std::string axisPrefix(std::size_t axis) { return std::string("axis ") + kAxisNames[axis] + ": "; }
 
 void requireFinite(double v, const std::string& what) {
-  if (!std::isfinite(v)) throw std::invalid_argument(what + " must be finite, got " + std::to_string(v));
+  if (!std::isfinite(v)) throw std::invalid_argument(what + " must be finite, got " + formatNumber(v));
 }
 void requireNonNegative(double v, const std::string& what) {
   if (!std::isfinite(v) || v < 0.0)
-    throw std::invalid_argument(what + " must be finite and >= 0, got " + std::to_string(v));
+    throw std::invalid_argument(what + " must be finite and >= 0, got " + formatNumber(v));
 }
 void requirePositive(double v, const std::string& what) {
   if (!std::isfinite(v) || !(v > 0.0))
-    throw std::invalid_argument(what + " must be finite and > 0, got " + std::to_string(v));
+    throw std::invalid_argument(what + " must be finite and > 0, got " + formatNumber(v));
 }
+
+}  // namespace
 
 // 1 + SMPLRT_DIV for an output rate with the DLPF on: the chip's output rate is
 // internal/(1 + SMPLRT_DIV) with SMPLRT_DIV an 8-bit register (register map §4.2).
@@ -35,11 +45,13 @@ std::size_t sampleRateDivisor(int dlpf_cfg, double rate_hz) {
   const double divisor = std::round(ratio);
   if (divisor < 1.0 || divisor > 256.0 || std::fabs(ratio - divisor) > 1e-9 * ratio)
     throw std::invalid_argument(
-        "rate_hz " + std::to_string(rate_hz) + " is not possible with DLPF_CFG " + std::to_string(dlpf_cfg) +
-        ": the output rate is the internal rate " + std::to_string(dlpf.internal_rate_hz) +
+        "rate_hz " + formatNumber(rate_hz) + " is not possible with DLPF_CFG " + std::to_string(dlpf_cfg) +
+        ": the output rate is the internal rate " + formatNumber(dlpf.internal_rate_hz) +
         " Hz divided by an integer 1..256 (rate = internal/(1+SMPLRT_DIV))");
   return static_cast<std::size_t>(divisor);
 }
+
+namespace {
 
 // Step-down (inverse Levinson–Durbin) recursion: from φ = φ^(p) to the coefficients
 // φ^(j) of every lower order and the reflection coefficients k_j = φ^(j)_j. The AR
@@ -55,7 +67,7 @@ std::vector<std::vector<double>> arStepDown(const std::vector<double>& phi, cons
     const double k = cur[j - 1];
     if (!(std::fabs(k) < 1.0))
       throw std::invalid_argument(what + "ar.phi is not stationary (reflection coefficient " +
-                                  std::to_string(j) + " is " + std::to_string(k) +
+                                  std::to_string(j) + " is " + formatNumber(k) +
                                   ", must be in (-1, 1)): all roots of 1 - sum phi_i z^i must lie outside the unit circle");
     if (j == 1) break;
     std::vector<double>& lower = orders[j - 2];
@@ -66,15 +78,15 @@ std::vector<std::vector<double>> arStepDown(const std::vector<double>& phi, cons
   return orders;
 }
 
-void validateAr(const ArComponent& ar, const std::string& prefix) {
+}  // namespace
+
+void validateArComponent(const ArComponent& ar, const std::string& prefix) {
   requireNonNegative(ar.noise_var, prefix + "ar.noise_var");
   if (ar.phi.size() > 64)
     throw std::invalid_argument(prefix + "ar.phi has " + std::to_string(ar.phi.size()) + " coefficients (at most 64)");
   for (std::size_t i = 0; i < ar.phi.size(); ++i) requireFinite(ar.phi[i], prefix + "ar.phi[" + std::to_string(i) + "]");
   arStepDown(ar.phi, prefix);
 }
-
-}  // namespace
 
 void validateSimulationModel(const SimulationModel& model) {
   requirePositive(model.rate_hz, "rate_hz");
@@ -85,7 +97,7 @@ void validateSimulationModel(const SimulationModel& model) {
     const std::string prefix = axisPrefix(a);
     for (NoiseTerm t : kAllNoiseTerms) requireNonNegative(axis.terms.get(t), prefix + std::string(noiseTermKey(t)));
     requireFinite(axis.bias_dps, prefix + "bias_dps");
-    validateAr(axis.ar, prefix);
+    validateArComponent(axis.ar, prefix);
   }
   const TemperatureModel& temp = model.temperature;
   requireFinite(temp.start_c, "temperature.start_c");
@@ -150,8 +162,8 @@ NoiseSimulator::NoiseSimulator(const SimulationModel& model, double duration_s, 
   requirePositive(duration_s, "duration_s");
   const double samples = std::floor(duration_s * model_.rate_hz + 1e-9);
   if (samples < 1.0)
-    throw std::invalid_argument("duration_s " + std::to_string(duration_s) + " at rate_hz " +
-                                std::to_string(model_.rate_hz) + " gives no sample");
+    throw std::invalid_argument("duration_s " + formatNumber(duration_s) + " at rate_hz " +
+                                formatNumber(model_.rate_hz) + " gives no sample");
   sample_count_ = static_cast<std::size_t>(samples);
 
   if (model_.dlpf_cfg) {

@@ -14,6 +14,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "processing/noise_terms.hpp"
@@ -48,7 +49,7 @@ struct TemperatureModel {
 struct SimulationModel {
   std::array<AxisNoiseModel, kSimulatedAxes> axes;
   TemperatureModel temperature;
-  double rate_hz = 100.0;        // output rate
+  double rate_hz = 50.0;         // output rate (default: the paper's 50 Hz)
   std::optional<int> dlpf_cfg;   // DLPF_CFG 0..6; none = no DLPF, generated at rate_hz
   std::optional<int> fs_sel;     // FS_SEL 0..3; none = no quantisation or saturation
   // "Pure" mode (both none) shows the Allan terms alone, for testing them.
@@ -60,6 +61,11 @@ struct SimulationModel {
 // that is not internal/(1+SMPLRT_DIV) for an integer SMPLRT_DIV in 0..255 when the DLPF
 // is on, DLPF_CFG/FS_SEL out of range, a bad temperature model.
 void validateSimulationModel(const SimulationModel& model);
+// The parts of it, for readers that want to point at the offending line: 1 + SMPLRT_DIV
+// for an output rate with the DLPF on (throws as above), and the AR component alone
+// (finite φ, σa² ≥ 0, stationary; messages start with `what`).
+std::size_t sampleRateDivisor(int dlpf_cfg, double rate_hz);
+void validateArComponent(const ArComponent& ar, const std::string& what = "");
 
 // ---- bias instability (flicker) as a bank of Gauss–Markov processes ----------------
 // One first-order Gauss–Markov process x' = −x/T + w, stationary variance `variance`,
