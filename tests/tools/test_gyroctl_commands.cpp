@@ -232,3 +232,28 @@ TEST(GyroctlImport, ConvertsTheRealImucalRecordingExactly) {
   ASSERT_EQ(a.exit_status, 0) << a.err;
   EXPECT_NEAR(json::parse(a.out)["rate_hz"].get<double>(), 100.0, 1e-9);
 }
+
+// analyse → model → simulate: the model file carries the fitted terms and the bias, and
+// `gyroctl simulate --model` accepts it.
+TEST(GyroctlAnalyze, WriteModelRoundTripsThroughSimulate) {
+  ScratchDir d;
+  const auto sim = d.path() / "sim.csv";
+  const auto model = d.path() / "model.toml";
+  ASSERT_EQ(runGyroctl("simulate --arw 0.5 --bias-instability 30 --duration 1200 --seed 7 -o " + sim.string(), d.path())
+                .exit_status,
+            0);
+  const auto a = runGyroctl("analyze " + sim.string() + " --json --write-model " + model.string(), d.path());
+  ASSERT_EQ(a.exit_status, 0) << a.err;
+  const json doc = json::parse(a.out);
+  const std::string text = readWholeFile(model);
+  for (const char* table : {"[x]", "[y]", "[z]"}) EXPECT_NE(text.find(table), std::string::npos) << table;
+  // The file's x-axis ARW is the analysis' value (17 significant digits in the file).
+  const double n_fit = doc["axes"]["gx"]["noise"]["arw_deg_per_sqrt_h"].get<double>();
+  EXPECT_NEAR(n_fit, 0.5, 0.05);
+  const auto pos = text.find("arw_deg_per_sqrt_h", text.find("[x]"));
+  ASSERT_NE(pos, std::string::npos);
+  EXPECT_NEAR(std::stod(text.substr(text.find('=', pos) + 1)), n_fit, 1e-12 * n_fit);
+  const auto sim2 = d.path() / "sim2.csv";
+  const auto r = runGyroctl("simulate --model " + model.string() + " --duration 600 --seed 8 -o " + sim2.string(), d.path());
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+}

@@ -12,6 +12,7 @@
 #include "processing/noise_terms.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
+#include "tools/recording/model_toml.hpp"
 
 namespace gyrod::gyroctl {
 namespace {
@@ -33,6 +34,7 @@ struct AnalyzeOptions {
   std::size_t mean_window = 20;
   double mean_threshold_dps = 0.3;
   std::size_t max_ar_order = 3;
+  std::string write_model;
 };
 
 std::vector<double> parseTauList(const std::string& text) {
@@ -205,6 +207,14 @@ void printAxisText(std::ostream& o, const std::string& name, const AxisAnalysis&
   }
 }
 
+// Model axis (x, y, z) for a recording column: gx → x, ..., a bare-number file's x → x.
+std::optional<std::size_t> modelAxisFor(const std::string& column) {
+  if (column == "gx" || column == "x") return 0;
+  if (column == "gy") return 1;
+  if (column == "gz") return 2;
+  return std::nullopt;
+}
+
 int runAnalyze(const AnalyzeOptions& opt) {
   LoadedInput in = loadInput(opt.file, opt.rate_hz, opt.axis);
   const auto& rec = in.recording;
@@ -232,12 +242,31 @@ int runAnalyze(const AnalyzeOptions& opt) {
                 in.rate_source.c_str(), rec.size() / in.rate_hz,
                 options.detrend ? ", constant and linear trend removed" : ", no detrending");
   }
+  SimulationModel model;
+  model.rate_hz = in.rate_hz;
+  if (!rec.temp.empty()) {
+    const double temp_mean = [&] {
+      long double s = 0.0L;
+      for (double v : rec.temp) s += v;
+      return static_cast<double>(s / static_cast<long double>(rec.temp.size()));
+    }();
+    model.temperature.start_c = model.temperature.final_c = temp_mean;
+    model.temperature.noise_std_c = std::sqrt(varianceAboutMean(rec.temp));
+  }
   for (std::size_t idx : in.axis_indices) {
     const AxisAnalysis a = analyzeAxis(rec.axes[idx], options);
+    if (const auto slot = modelAxisFor(rec.axis_names[idx])) {
+      model.axes[*slot].terms = a.noise.value;
+      model.axes[*slot].bias_dps = a.zero_mean.mean;
+    }
     if (opt.json)
       doc["axes"][rec.axis_names[idx]] = axisJson(a);
     else
       printAxisText(std::cout, rec.axis_names[idx], a);
+  }
+  if (!opt.write_model.empty()) {
+    writeFileAtomically(opt.write_model, recording::modelToToml(model));
+    if (!opt.json) std::printf("\nModel written to %s\n", opt.write_model.c_str());
   }
   if (opt.json) std::cout << doc.dump(1) << '\n';
   return kExitOk;
@@ -263,6 +292,8 @@ void addAnalyzeCommand(CLI::App& app, CommandRunner& run) {
       ->default_val(0.3)->check(CLI::PositiveNumber);
   sub->add_option("--max-ar-order", opt->max_ar_order, "highest AR order for Table 3")
       ->default_val(3)->check(CLI::Range(std::size_t{1}, std::size_t{8}));
+  sub->add_option("--write-model", opt->write_model,
+                  "write the fitted model (noise terms and bias per axis) as TOML for gyroctl simulate --model");
   sub->callback([&run, opt] { run = [opt] { return runAnalyze(*opt); }; });
 }
 
