@@ -180,8 +180,14 @@ std::optional<std::int64_t> MockMpu6050::nextSampleTimeNs() const {
   return tickTimeNs(tick_index_ + remaining - 1);
 }
 
-std::int64_t MockMpu6050::nextActivityNs() const {
-  return std::min(sampling_ ? next_tick_ns_ : kNever, next_event_ns_);
+std::int64_t MockMpu6050::nextPossibleEdgeNs() const {
+  // Only a sample tick with an interrupt enabled, or a scheduled event (pulse end, reset
+  // done, a fault), can move the INT line.
+  std::int64_t next = next_event_ns_;
+  if (sampling_ && (regs_[R(Register::INT_ENABLE)] & (reg::DATA_RDY_EN | reg::FIFO_OFLOW_EN))) {
+    next = std::min(next, *nextSampleTimeNs());
+  }
+  return next;
 }
 
 void MockMpu6050::recomputeNextEvent() {
@@ -591,8 +597,9 @@ int MockMpu6050::writeByte(std::uint8_t reg, std::uint8_t value) {
 }
 
 int MockMpu6050::readWordBigEndian(std::uint8_t reg, std::uint16_t& value) {
+  // A word read is its own transfer type (SMBus read word), not limited by the burst length.
   std::array<std::uint8_t, 2> b{};
-  const int status = readBlock(reg, b);
+  const int status = readBurst(reg, b);
   if (status == 0) value = static_cast<std::uint16_t>((b[0] << 8) | b[1]);
   return status;
 }
@@ -602,6 +609,10 @@ int MockMpu6050::readBlock(std::uint8_t reg, std::span<std::uint8_t> out) {
     ++counters_.transfers;
     return -EINVAL;  // the adapter refuses before anything reaches the wire
   }
+  return readBurst(reg, out);
+}
+
+int MockMpu6050::readBurst(std::uint8_t reg, std::span<std::uint8_t> out) {
   bool deferred = false;
   const int status = beginTransfer(deferred);
   if (status != 0 && !deferred) return finishTransfer(status);
@@ -762,12 +773,12 @@ void MockMpu6050::DataReadyLine::lineMoved(std::int64_t t_ns, bool rising) {
 
 void MockMpu6050::DataReadyLine::updateReadiness(bool force) {
   // A timerfd stands in for the GPIO event fd: no thread is needed, and in real-time mode
-  // it wakes the loop exactly when the chip next has something to do.
+  // it wakes the loop when the chip can next move the INT line.
   std::int64_t at = 0;  // disarmed
   if (count_ > 0) {
     at = 1;  // an absolute time long past: expires at once
   } else if (owner_.clock_.isRealTime()) {
-    const std::int64_t next = owner_.nextActivityNs();
+    const std::int64_t next = owner_.nextPossibleEdgeNs();
     if (next != kNever) at = std::max<std::int64_t>(next, 1);
   }
   if (at == armed_at_ns_ && !force) return;

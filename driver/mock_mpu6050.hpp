@@ -110,8 +110,8 @@ class MockMpu6050 final : public I2cBus {
     std::uint64_t edgesDropped() const override { return dropped_; }
 
     void lineMoved(std::int64_t t_ns, bool rising);
-    // Arms the timerfd: now if an edge is queued; in real-time mode, at the chip's next
-    // activity; otherwise disarmed.
+    // Arms the timerfd: now if an edge is queued; in real-time mode, at the next time the
+    // chip could move the line; otherwise disarmed.
     void updateReadiness(bool force = false);
 
    private:
@@ -147,7 +147,7 @@ class MockMpu6050 final : public I2cBus {
   void internalTick(std::int64_t t_ns);
   void sampleTick(std::int64_t t_ns);
   std::int64_t tickTimeNs(std::int64_t k) const;
-  std::int64_t nextActivityNs() const;
+  std::int64_t nextPossibleEdgeNs() const;
 
   // Power and configuration.
   void resetChip();  // registers to reset values, FIFO empty, asleep, line inactive
@@ -176,6 +176,7 @@ class MockMpu6050 final : public I2cBus {
 
   // Transfers.
   int beginTransfer(bool& deferred_error);
+  int readBurst(std::uint8_t reg, std::span<std::uint8_t> out);
   int finishTransfer(int result);
 
   // Random numbers (seeded): splitmix64 and Box–Muller.

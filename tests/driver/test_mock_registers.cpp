@@ -218,5 +218,32 @@ TEST(MockMpu6050Registers, BadConfigurationIsRejected) {
   EXPECT_THROW(clock.advanceNs(-1), std::invalid_argument);
 }
 
+
+TEST(MockMpu6050Registers, WordReadsAreNotLimitedByTheBurstLength) {
+  ConstantSource source({0, 0, 0});
+  MockMpu6050Config config = Rig::quietConfig();
+  config.max_burst_length = 1;  // an adapter with byte and word transfers only
+  Rig rig(source, config);
+  std::uint16_t w = 0;
+  EXPECT_EQ(rig.mock.readWordBigEndian(A(Register::PWR_MGMT_1), w), 0);
+  EXPECT_EQ(w, 0x4000);  // PWR_MGMT_1 = 0x40, PWR_MGMT_2 = 0x00
+  std::array<std::uint8_t, 2> two{};
+  EXPECT_EQ(rig.mock.readBlock(A(Register::PWR_MGMT_1), two), -EINVAL);
+}
+
+TEST(MockMpu6050Registers, BurstAcrossIntStatusAndOutputsClearsTheStatusOnce) {
+  // A common driver pattern: one 15-byte burst from INT_STATUS through GYRO_ZOUT_L.
+  ConstantSource source({-10.0, 0.0, 0.0});
+  Rig rig(source);
+  write(rig.mock, Register::INT_ENABLE, mpu6050::DATA_RDY_EN);
+  rig.wake(7, 0);
+  rig.advance(kNsPerMillisecond);
+  std::array<std::uint8_t, 15> b{};
+  ASSERT_EQ(rig.mock.readBlock(A(Register::INT_STATUS), b), 0);
+  EXPECT_EQ(b[0], mpu6050::DATA_RDY_INT);
+  EXPECT_EQ(be16(b[9], b[10]), -1310);  // GYRO_XOUT at offset 0x43 − 0x3A = 9
+  EXPECT_EQ(read(rig.mock, Register::INT_STATUS), 0x00);
+}
+
 }  // namespace
 }  // namespace gyrod::driver::test
