@@ -22,6 +22,9 @@ gyrod_require(nlohmann_json_FOUND nlohmann-json3-dev "nlohmann-json (JSON output
 find_package(CLI11 2.1 QUIET)
 gyrod_require(CLI11_FOUND libcli11-dev "CLI11 (command-line parsing)")
 
+find_package(tomlplusplus 3 QUIET)
+gyrod_require(tomlplusplus_FOUND libtomlplusplus-dev "toml++ (simulation model files)")
+
 if(GYROD_BUILD_TESTS)
   find_package(GTest QUIET)
   gyrod_require(GTest_FOUND libgtest-dev "GoogleTest (unit tests)")

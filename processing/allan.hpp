@@ -4,6 +4,9 @@
 // M rate samples integrate to M+1 phase points (x₀ = 0); the overlapping estimator at
 // averaging factor m uses M − 2m + 1 second differences; the non-overlapping one uses
 // ⌊M/m⌋ cluster means and ⌊M/m⌋ − 1 differences (paper eqs. 1–2).
+// Both are computed from the integrated phase of the mean-removed series (the variance is
+// blind to a constant), kept as a double-double running sum, in O(M) per m.
+// Non-finite rate samples are rejected with std::invalid_argument; m = 0 likewise.
 #include <cstddef>
 #include <span>
 #include <string>
@@ -26,17 +29,27 @@ std::vector<std::size_t> clusterSizesForTaus(std::span<const double> taus_s, dou
 double allanVariance(std::span<const double> rate, std::size_t m);
 // Overlapping Allan variance at averaging factor m. NaN if M − 2m + 1 < 1.
 double overlappingAllanVariance(std::span<const double> rate, std::size_t m);
+// The same for several m, integrating the phase once (NaN where M − 2m + 1 < 1).
+std::vector<double> overlappingAllanVariances(std::span<const double> rate, std::span<const std::size_t> ms);
+
+// Fewer averaged points than this and the lag-1 method is not trusted (Riley & Greenhall).
+inline constexpr std::size_t kMinAveragedPointsForNoiseId = 30;
 
 // Noise type per NIST SP 1065 power-law exponent α of the rate PSD S(f) ∝ f^α:
 // 2 white PM, 1 flicker PM, 0 white FM, −1 flicker FM, −2 random-walk FM. For a gyro:
 // quantization ≈ white PM (α=2), ARW = white FM (0), bias instability = flicker FM
 // (−1), RRW = random-walk FM (−2); a rate ramp is treated as random-walk FM.
 // Identified by the lag-1 autocorrelation method (Riley & Greenhall 2004) on the series
-// averaged over m; returns α rounded to an integer in [−2, 2].
+// averaged over m (mean removed, not detrended, d ≤ 2); returns α rounded to an integer in
+// [−2, 2]. When ⌊M/m⌋ < kMinAveragedPointsForNoiseId the method is applied at the longest
+// m that still has enough points (m = ⌊M/30⌋); for M < 30 the local slope μ of the
+// overlapping Allan variance gives α = −μ − 1 (clamped to [−2, 1]). Needs M ≥ 3.
 int identifyPowerLawNoise(std::span<const double> rate, std::size_t m);
 
 // Equivalent degrees of freedom of the overlapping Allan variance (NIST SP 1065 §5.2.x,
-// simple approximations by noise type). N = number of *phase* points = M + 1.
+// simple approximations by noise type, Table 5). N = number of *phase* points = M + 1.
+// Requires N ≥ 2m + 1 and α ∈ [−2, 2] (else std::invalid_argument). Approximations meant
+// for N ≫ m; the RW FM one is singular at N = 3, where 1 is returned.
 double overlappingAllanEdf(int alpha, std::size_t phase_points, std::size_t m);
 
 struct AllanPoint {
@@ -47,16 +60,18 @@ struct AllanPoint {
   double oadev = 0.0;           // overlapping
   std::size_t oadev_terms = 0;  // M − 2m + 1
   int noise_alpha = 0;          // identified power-law exponent at this τ
-  double edf = 0.0;             // equivalent degrees of freedom of oadev
-  double oadev_lo = 0.0;        // χ² confidence interval of oadev
-  double oadev_hi = 0.0;
+  double edf = 0.0;             // equivalent degrees of freedom of oadev (NaN when oadev is)
+  double oadev_lo = 0.0;        // χ² confidence interval of oadev (NaN when oadev is):
+  double oadev_hi = 0.0;        // σ̂·√(edf/χ²_{(1±c)/2}(edf)), NIST SP 1065 eq. 45
 };
 
 struct AllanOptions {
   double confidence = 0.683;  // two-sided, "1 σ" as is usual for Allan plots
 };
 
-// Both estimators, noise identification, edf and χ² bounds, for each m in `ms`.
+// Both estimators, noise identification, edf and χ² bounds, for each m in `ms` (any order;
+// m too long for an estimator gives NaN there). Throws std::invalid_argument for tau0 ≤ 0,
+// confidence outside (0, 1), m = 0, fewer than 3 samples or a non-finite sample.
 std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double tau0_s,
                                             std::span<const std::size_t> ms,
                                             const AllanOptions& options = {});

@@ -17,5 +17,6 @@ inline constexpr int kExitFailure = 1;   // anything else
 void addAnalyzeCommand(CLI::App& app, CommandRunner& run);
 void addFilterCommand(CLI::App& app, CommandRunner& run);
 void addImportCommand(CLI::App& app, CommandRunner& run);
+void addSimulateCommand(CLI::App& app, CommandRunner& run);
 
 }  // namespace gyrod::gyroctl

@@ -1,0 +1,406 @@
+#include "processing/allan.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "processing/distributions.hpp"
+
+namespace gyrod::processing {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::string formatNumber(double v) {
+  std::ostringstream os;
+  os << std::setprecision(12) << v;
+  return os.str();
+}
+
+void requireClusterSize(std::size_t m, const char* where) {
+  if (m == 0) throw std::invalid_argument(std::string(where) + ": averaging factor m must be >= 1 (got 0)");
+}
+
+// Mean of the series by Neumaier-compensated summation; throws on a non-finite sample
+// so that no estimator ever silently turns a NaN reading into a number.
+double compensatedMean(std::span<const double> rate, const char* where) {
+  double sum = 0.0;
+  double compensation = 0.0;
+  for (std::size_t i = 0; i < rate.size(); ++i) {
+    const double v = rate[i];
+    if (!std::isfinite(v)) {
+      throw std::invalid_argument(std::string(where) + ": rate[" + std::to_string(i) +
+                                  "] is not finite (" + formatNumber(v) + ")");
+    }
+    const double t = sum + v;
+    compensation += std::abs(sum) >= std::abs(v) ? (sum - t) + v : (v - t) + sum;
+    sum = t;
+  }
+  return rate.empty() ? 0.0 : (sum + compensation) / static_cast<double>(rate.size());
+}
+
+// Sum of squares accumulated in blocks: four interleaved partial sums inside a block
+// (independent chains the compiler can vectorise), block totals added with Neumaier
+// compensation, so the rounding error grows with the block length, not with M.
+class SumOfSquares {
+ public:
+  void add(double block_total) {
+    const double t = sum_ + block_total;
+    compensation_ += std::abs(sum_) >= std::abs(block_total) ? (sum_ - t) + block_total
+                                                             : (block_total - t) + sum_;
+    sum_ = t;
+  }
+  double total() const { return sum_ + compensation_; }
+
+ private:
+  double sum_ = 0.0;
+  double compensation_ = 0.0;
+};
+
+constexpr std::size_t kSumBlock = 4096;
+
+// The phase (integrated rate, NIST SP 1065 x_k with x₀ = 0 and τ0 = 1 sample) of the
+// mean-removed series, held as an unevaluated double-double sum hi[k] + lo[k]. Removing
+// the mean keeps |x| small (Allan variance is blind to a constant rate); the double-double
+// running sum keeps the integration error at ~ε² of |x| even when x grows quadratically
+// (a rate ramp), so second differences keep full double accuracy.
+class IntegratedPhase {
+ public:
+  explicit IntegratedPhase(std::span<const double> rate, const char* where)
+      : rate_count_(rate.size()), mean_(compensatedMean(rate, where)), hi_(rate.size() + 1), lo_(rate.size() + 1) {
+    const double mean = mean_;
+    double s_hi = 0.0;
+    double s_lo = 0.0;
+    hi_[0] = 0.0;
+    lo_[0] = 0.0;
+    for (std::size_t i = 0; i < rate.size(); ++i) {
+      const double v = rate[i] - mean;
+      // TwoSum(s_hi, v): exact h + e.
+      const double h = s_hi + v;
+      const double bv = h - s_hi;
+      const double e = (s_hi - (h - bv)) + (v - bv);
+      const double l = s_lo + e;
+      // FastTwoSum renormalisation (|h| ≥ |l|).
+      s_hi = h + l;
+      s_lo = l - (s_hi - h);
+      hi_[i + 1] = s_hi;
+      lo_[i + 1] = s_lo;
+    }
+  }
+
+  std::size_t rateCount() const { return rate_count_; }
+  double mean() const { return mean_; }
+
+  // x_{i+2m} − 2·x_{i+m} + x_i = m·(ȳ over [i+m, i+2m) − ȳ over [i, i+m)). The hi
+  // parts are differenced first (each difference is a window sum, small), then the lo
+  // corrections are added.
+  double secondDifference(std::size_t i, std::size_t m) const {
+    const double* h = hi_.data();
+    const double* l = lo_.data();
+    return ((h[i + 2 * m] - h[i + m]) - (h[i + m] - h[i])) + ((l[i + 2 * m] - l[i + m]) - (l[i + m] - l[i]));
+  }
+
+  // Σ over `count` second differences starting at 0, 0+stride, ... of their squares.
+  double sumSquaredSecondDifferences(std::size_t m, std::size_t stride, std::size_t count) const {
+    SumOfSquares total;
+    std::size_t k = 0;
+    while (k < count) {
+      const std::size_t block_end = std::min(count, k + kSumBlock);
+      double p0 = 0.0, p1 = 0.0, p2 = 0.0, p3 = 0.0;
+      for (; k + 4 <= block_end; k += 4) {
+        const double d0 = secondDifference((k + 0) * stride, m);
+        const double d1 = secondDifference((k + 1) * stride, m);
+        const double d2 = secondDifference((k + 2) * stride, m);
+        const double d3 = secondDifference((k + 3) * stride, m);
+        p0 += d0 * d0;
+        p1 += d1 * d1;
+        p2 += d2 * d2;
+        p3 += d3 * d3;
+      }
+      for (; k < block_end; ++k) {
+        const double d = secondDifference(k * stride, m);
+        p0 += d * d;
+      }
+      total.add((p0 + p1) + (p2 + p3));
+    }
+    return total.total();
+  }
+
+  // Non-overlapping: K = ⌊M/m⌋ cluster means, K − 1 differences (paper eq. 2).
+  double allanVariance(std::size_t m) const {
+    const std::size_t clusters = rate_count_ / m;
+    if (clusters < 2) return kNaN;
+    const double md = static_cast<double>(m);
+    return sumSquaredSecondDifferences(m, m, clusters - 1) / (2.0 * md * md * static_cast<double>(clusters - 1));
+  }
+
+  // Overlapping: N − 2m = M − 2m + 1 second differences of N = M + 1 phase points
+  // (NIST SP 1065 eq. 11), σ² = Σ (x_{i+2m} − 2x_{i+m} + x_i)² / (2 m² (N − 2m)).
+  double overlappingAllanVariance(std::size_t m) const {
+    if (2 * m > rate_count_) return kNaN;
+    const std::size_t terms = rate_count_ - 2 * m + 1;
+    const double md = static_cast<double>(m);
+    return sumSquaredSecondDifferences(m, 1, terms) / (2.0 * md * md * static_cast<double>(terms));
+  }
+
+ private:
+  std::size_t rate_count_;
+  double mean_;
+  std::vector<double> hi_;
+  std::vector<double> lo_;
+};
+
+// Lag-1 autocorrelation r1 = Σ (z_i − z̄)(z_{i+1} − z̄) / Σ (z_i − z̄)² and the spread
+// Σ (z_i − z̄)² it was normalised by.
+struct Lag1 {
+  double r1 = 0.0;
+  double sum_sq = 0.0;
+};
+
+Lag1 lag1Autocorrelation(std::span<const double> z) {
+  double mean = 0.0;
+  for (double v : z) mean += v;
+  mean /= static_cast<double>(z.size());
+  double num = 0.0;
+  double den = 0.0;
+  for (std::size_t i = 0; i < z.size(); ++i) {
+    const double a = z[i] - mean;
+    den += a * a;
+    if (i + 1 < z.size()) num += a * (z[i + 1] - mean);
+  }
+  return {den > 0.0 ? num / den : 0.0, den};
+}
+
+int clampAlpha(double alpha) {
+  return static_cast<int>(std::clamp(std::round(alpha), -2.0, 2.0));
+}
+
+// Riley & Greenhall (2004), lag-1 ACF method for frequency data, dmax = 2: average the
+// rate over m (non-overlapping), then difference d times until ρ = r1/(1 + r1) < 0.25;
+// α = −2(ρ + d). The series is only mean-removed, not detrended: a rate ramp is a term of
+// interest here and is classed with random-walk FM (α = −2).
+// A level that is numerically constant (spread ≤ 1e-10 of the undifferenced spread:
+// rounding only, e.g. the first difference of a pure ramp) has no correlation to measure;
+// it is taken as ρ = 0, i.e. the series is a polynomial of degree d − 1, α = −2d (clamped).
+int lag1NoiseId(std::span<const double> rate, std::size_t m, double mean) {
+  const std::size_t n = rate.size() / m;
+  std::vector<double> z(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    double s = 0.0;
+    for (std::size_t i = k * m; i < (k + 1) * m; ++i) s += rate[i] - mean;
+    z[k] = s / static_cast<double>(m);
+  }
+  constexpr int kMaxDifferences = 2;
+  std::size_t len = n;
+  double level0_spread = -1.0;
+  for (int d = 0;; ++d) {
+    const Lag1 acf = lag1Autocorrelation(std::span<const double>(z.data(), len));
+    const double spread = std::sqrt(acf.sum_sq / static_cast<double>(len));
+    if (level0_spread < 0.0) level0_spread = spread;
+    if (spread <= 1e-10 * level0_spread) return clampAlpha(-2.0 * d);
+    const double rho = acf.r1 / (1.0 + acf.r1);
+    if (rho < 0.25 || d >= kMaxDifferences) return clampAlpha(-2.0 * (rho + d));
+    for (std::size_t i = 0; i + 1 < len; ++i) z[i] = z[i + 1] - z[i];
+    --len;
+  }
+}
+
+// Noise identification at m for a series of ≥ 3 finite samples with the given mean.
+// `phase` is needed only for series shorter than kMinAveragedPointsForNoiseId.
+int identifyWithMean(std::span<const double> rate, std::size_t m, double mean, const IntegratedPhase* phase) {
+  const std::size_t count = rate.size();
+  if (count / m >= kMinAveragedPointsForNoiseId) return lag1NoiseId(rate, m, mean);
+  // Too few averaged points at this m: use the longest averaging that still has enough
+  // (the nearest τ below), assuming the noise type does not change beyond it.
+  if (count >= kMinAveragedPointsForNoiseId) return lag1NoiseId(rate, count / kMinAveragedPointsForNoiseId, mean);
+  // Very short series: the local log-log slope μ of the overlapping Allan variance,
+  // σ² ∝ τ^μ with μ = −α − 1 for α ≤ 1. μ = −2 cannot tell white from flicker PM
+  // (both give μ ≈ −2); it is reported as flicker PM (α = 1), which has the smaller edf.
+  const std::size_t m_max = count / 2;  // ≥ 1 since count ≥ 3
+  const std::size_t m_a = std::min(m, m_max);
+  const std::size_t m_b = (m_a + 1 <= m_max) ? m_a + 1 : m_a - 1;
+  if (m_b == 0) {
+    throw std::invalid_argument("identifyPowerLawNoise: series too short for a slope (" +
+                                std::to_string(count) + " samples)");
+  }
+  const double va = phase->overlappingAllanVariance(m_a);
+  const double vb = phase->overlappingAllanVariance(m_b);
+  if (!(va > 0.0 && vb > 0.0)) return 0;  // constant series: σ² = 0, nothing to identify
+  const double mu = std::log(vb / va) / std::log(static_cast<double>(m_b) / static_cast<double>(m_a));
+  return static_cast<int>(std::clamp(std::round(-mu - 1.0), -2.0, 1.0));
+}
+
+}  // namespace
+
+// ---- cluster sizes -----------------------------------------------------------------
+
+std::vector<std::size_t> octaveClusterSizes(std::size_t sample_count) {
+  std::vector<std::size_t> ms;
+  for (std::size_t m = 1; m <= sample_count / 2; m *= 2) ms.push_back(m);
+  return ms;
+}
+
+std::vector<std::size_t> denseClusterSizes(std::size_t sample_count, std::size_t per_decade) {
+  if (per_decade == 0) throw std::invalid_argument("denseClusterSizes: per_decade must be >= 1 (got 0)");
+  std::vector<std::size_t> ms;
+  const std::size_t m_max = sample_count / 2;
+  for (std::size_t k = 0;; ++k) {
+    const double exact = std::pow(10.0, static_cast<double>(k) / static_cast<double>(per_decade));
+    const auto m = static_cast<std::size_t>(std::llround(exact));
+    if (m > m_max || exact > static_cast<double>(m_max) + 0.5) break;
+    if (ms.empty() || m != ms.back()) ms.push_back(m);
+  }
+  return ms;
+}
+
+std::vector<std::size_t> clusterSizesForTaus(std::span<const double> taus_s, double tau0_s,
+                                             std::size_t sample_count) {
+  if (!(std::isfinite(tau0_s) && tau0_s > 0.0)) {
+    throw std::invalid_argument("clusterSizesForTaus: tau0 must be a finite positive time in s (got " +
+                                formatNumber(tau0_s) + ")");
+  }
+  std::vector<std::size_t> ms;
+  ms.reserve(taus_s.size());
+  for (double tau : taus_s) {
+    if (!(std::isfinite(tau) && tau > 0.0)) {
+      throw std::invalid_argument("clusterSizesForTaus: tau = " + formatNumber(tau) +
+                                  " s is not a finite positive time");
+    }
+    const double samples = tau / tau0_s;
+    const double whole = std::round(samples);
+    if (whole < 1.0 || std::abs(samples - whole) > 1e-9 * samples) {
+      throw std::invalid_argument("clusterSizesForTaus: tau = " + formatNumber(tau) +
+                                  " s is not a whole number of samples (tau0 = " + formatNumber(tau0_s) +
+                                  " s gives " + formatNumber(samples) + " samples)");
+    }
+    if (whole > static_cast<double>(sample_count / 2)) {
+      throw std::invalid_argument("clusterSizesForTaus: tau = " + formatNumber(tau) + " s (m = " +
+                                  formatNumber(whole) + " samples) is too long for " +
+                                  std::to_string(sample_count) +
+                                  " samples: the overlapping estimator needs 2*m <= sample count");
+    }
+    ms.push_back(static_cast<std::size_t>(whole));
+  }
+  return ms;
+}
+
+// ---- estimators ----------------------------------------------------------------------
+
+double allanVariance(std::span<const double> rate, std::size_t m) {
+  requireClusterSize(m, "allanVariance");
+  if (rate.size() / m < 2) {
+    compensatedMean(rate, "allanVariance");  // still reject non-finite input
+    return kNaN;
+  }
+  return IntegratedPhase(rate, "allanVariance").allanVariance(m);
+}
+
+double overlappingAllanVariance(std::span<const double> rate, std::size_t m) {
+  requireClusterSize(m, "overlappingAllanVariance");
+  if (2 * m > rate.size()) {
+    compensatedMean(rate, "overlappingAllanVariance");
+    return kNaN;
+  }
+  return IntegratedPhase(rate, "overlappingAllanVariance").overlappingAllanVariance(m);
+}
+
+std::vector<double> overlappingAllanVariances(std::span<const double> rate, std::span<const std::size_t> ms) {
+  for (std::size_t m : ms) requireClusterSize(m, "overlappingAllanVariances");
+  const IntegratedPhase phase(rate, "overlappingAllanVariances");
+  std::vector<double> variances;
+  variances.reserve(ms.size());
+  for (std::size_t m : ms) variances.push_back(phase.overlappingAllanVariance(m));
+  return variances;
+}
+
+int identifyPowerLawNoise(std::span<const double> rate, std::size_t m) {
+  requireClusterSize(m, "identifyPowerLawNoise");
+  if (rate.size() < 3) {
+    throw std::invalid_argument("identifyPowerLawNoise: need at least 3 samples (got " +
+                                std::to_string(rate.size()) + ")");
+  }
+  const double mean = compensatedMean(rate, "identifyPowerLawNoise");
+  if (rate.size() >= kMinAveragedPointsForNoiseId) return identifyWithMean(rate, m, mean, nullptr);
+  const IntegratedPhase phase(rate, "identifyPowerLawNoise");
+  return identifyWithMean(rate, m, mean, &phase);
+}
+
+double overlappingAllanEdf(int alpha, std::size_t phase_points, std::size_t m) {
+  requireClusterSize(m, "overlappingAllanEdf");
+  if (phase_points < 2 * m + 1) {
+    throw std::invalid_argument("overlappingAllanEdf: need phase_points >= 2m + 1 (N = " +
+                                std::to_string(phase_points) + ", m = " + std::to_string(m) + ")");
+  }
+  const double N = static_cast<double>(phase_points);
+  const double md = static_cast<double>(m);
+  switch (alpha) {
+    case 2:  // white PM
+      return (N + 1.0) * (N - 2.0 * md) / (2.0 * (N - md));
+    case 1:  // flicker PM
+      return std::exp(std::sqrt(std::log((N - 1.0) / (2.0 * md)) * std::log((2.0 * md + 1.0) * (N - 1.0) / 4.0)));
+    case 0:  // white FM
+      return (3.0 * (N - 1.0) / (2.0 * md) - 2.0 * (N - 2.0) / N) * (4.0 * md * md / (4.0 * md * md + 5.0));
+    case -1:  // flicker FM
+      return m == 1 ? 2.0 * (N - 2.0) / (2.3 * N - 4.9) : 5.0 * N * N / (4.0 * md * (N + 3.0 * md));
+    case -2: {  // random-walk FM; singular at N = 3 (one second difference): one degree of freedom
+      if (phase_points == 3) return 1.0;
+      const double n1 = N - 1.0;
+      return (N - 2.0) / md * (n1 * n1 - 3.0 * md * n1 + 4.0 * md * md) / ((N - 3.0) * (N - 3.0));
+    }
+    default:
+      throw std::invalid_argument("overlappingAllanEdf: alpha must be an integer in [-2, 2] (got " +
+                                  std::to_string(alpha) + ")");
+  }
+}
+
+std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double tau0_s,
+                                            std::span<const std::size_t> ms, const AllanOptions& options) {
+  if (!(std::isfinite(tau0_s) && tau0_s > 0.0)) {
+    throw std::invalid_argument("allanDeviationTable: tau0 must be a finite positive time in s (got " +
+                                formatNumber(tau0_s) + ")");
+  }
+  if (!(options.confidence > 0.0 && options.confidence < 1.0)) {
+    throw std::invalid_argument("allanDeviationTable: confidence must be in (0, 1) (got " +
+                                formatNumber(options.confidence) + ")");
+  }
+  if (rate.size() < 3) {
+    throw std::invalid_argument("allanDeviationTable: need at least 3 rate samples (got " +
+                                std::to_string(rate.size()) + ")");
+  }
+  for (std::size_t m : ms) requireClusterSize(m, "allanDeviationTable");
+
+  const IntegratedPhase phase(rate, "allanDeviationTable");
+  const std::size_t count = rate.size();
+  const double p_upper = 0.5 * (1.0 + options.confidence);
+  const double p_lower = 0.5 * (1.0 - options.confidence);
+
+  std::vector<AllanPoint> table;
+  table.reserve(ms.size());
+  for (std::size_t m : ms) {
+    AllanPoint p;
+    p.m = m;
+    p.tau_s = static_cast<double>(m) * tau0_s;
+    p.adev = std::sqrt(phase.allanVariance(m));
+    p.adev_terms = count / m >= 1 ? count / m - 1 : 0;
+    p.oadev = std::sqrt(phase.overlappingAllanVariance(m));
+    p.oadev_terms = 2 * m <= count ? count - 2 * m + 1 : 0;
+    p.noise_alpha = identifyWithMean(rate, m, phase.mean(), &phase);
+    if (p.oadev_terms >= 1) {
+      p.edf = overlappingAllanEdf(p.noise_alpha, count + 1, m);
+      // NIST SP 1065 eq. 45: σ²·edf/σ̂² ~ χ²(edf).
+      p.oadev_lo = p.oadev * std::sqrt(p.edf / chiSquareQuantile(p_upper, p.edf));
+      p.oadev_hi = p.oadev * std::sqrt(p.edf / chiSquareQuantile(p_lower, p.edf));
+    } else {
+      p.edf = kNaN;
+      p.oadev_lo = kNaN;
+      p.oadev_hi = kNaN;
+    }
+    table.push_back(p);
+  }
+  return table;
+}
+
+}  // namespace gyrod::processing

@@ -1,0 +1,169 @@
+#pragma once
+// A streaming simulator of the MPU6050 gyro at rest: three axes of rate (°/s) and the
+// die temperature (°C), from a model made of the paper's five Allan terms (IEEE 952, in
+// paper units, via processing/noise_terms.hpp), a constant bias and an optional AR(p)
+// component per axis, a warm-up temperature curve, and the sensor's own behaviour (the
+// DLPF at the internal rate, decimation by SMPLRT_DIV, 16-bit quantisation at FS_SEL).
+// Method per term and the evidence that each is right: docs/simulator.md.
+//
+// Streaming: one sample per call, nothing proportional to the recording length is kept;
+// no allocation per sample. Reproducible: the same model, duration and seed give the
+// same bits on every IEEE-754 machine (own PRNG and elementary functions, compiled
+// without FMA contraction; see processing/portable_random.hpp).
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "processing/noise_terms.hpp"
+#include "processing/portable_random.hpp"
+#include "processing/sensor_model.hpp"
+
+namespace gyrod::processing {
+
+inline constexpr std::size_t kSimulatedAxes = 3;  // x, y, z
+
+// x_k = φ1·x_{k−1} + … + φp·x_{k−p} + a_k, a ~ N(0, σa²), at the output rate (paper
+// eq. 5), started in its stationary distribution. Empty φ with σa² > 0 is white noise.
+struct ArComponent {
+  std::vector<double> phi;
+  double noise_var = 0.0;  // σa² in (°/s)²
+};
+
+struct AxisNoiseModel {
+  NoiseTerms terms;     // paper units (µrad, °/√h, °/h, °/h^1.5, °/h²), each ≥ 0
+  double bias_dps = 0.0;
+  ArComponent ar;
+};
+
+// T(t) = final + (start − final)·e^{−t/time_constant} + white noise of std noise_std.
+struct TemperatureModel {
+  double start_c = 25.0;
+  double final_c = 25.0;
+  double time_constant_s = 600.0;
+  double noise_std_c = 0.0;
+};
+
+struct SimulationModel {
+  std::array<AxisNoiseModel, kSimulatedAxes> axes;
+  TemperatureModel temperature;
+  double rate_hz = 50.0;         // output rate (default: the paper's 50 Hz)
+  std::optional<int> dlpf_cfg;   // DLPF_CFG 0..6; none = no DLPF, generated at rate_hz
+  std::optional<int> fs_sel;     // FS_SEL 0..3; none = no quantisation or saturation
+  // "Pure" mode (both none) shows the Allan terms alone, for testing them.
+  bool pure() const { return !dlpf_cfg && !fs_sel; }
+};
+
+// Throws std::invalid_argument naming the parameter (and axis) and its value when the
+// model cannot be simulated: negative or non-finite terms, a non-stationary AR φ, a rate
+// that is not internal/(1+SMPLRT_DIV) for an integer SMPLRT_DIV in 0..255 when the DLPF
+// is on, DLPF_CFG/FS_SEL out of range, a bad temperature model.
+void validateSimulationModel(const SimulationModel& model);
+// The parts of it, for readers that want to point at the offending line: 1 + SMPLRT_DIV
+// for an output rate with the DLPF on (throws as above), and the AR component alone
+// (finite φ, σa² ≥ 0, stationary; messages start with `what`).
+std::size_t sampleRateDivisor(int dlpf_cfg, double rate_hz);
+void validateArComponent(const ArComponent& ar, const std::string& what = "");
+
+// ---- bias instability (flicker) as a bank of Gauss–Markov processes ----------------
+// One first-order Gauss–Markov process x' = −x/T + w, stationary variance `variance`,
+// simulated exactly at step τ0: x_k = e^{−τ0/T}·x_{k−1} + √(variance·(1 − e^{−2τ0/T}))·n_k.
+struct GaussMarkovComponent {
+  double correlation_time_s = 0.0;
+  double variance = 0.0;  // (°/s)²
+};
+
+// The bank whose summed Allan variance is flat at `flat_allan_variance` (= (0.6643·B)²
+// in (°/s)², from allanVarianceCoefficient) for τ from τ0 to duration/2: correlation
+// times T_i = 1.2·τ0·10^{i/2} up to the first ≥ 5·duration, equal variances
+// flat·ln10/(2·ln2·2) (a 1/f spectrum sampled twice per decade), the two end ones
+// raised by √10/(√10 − 1) to stand in for the processes beyond the ends.
+// Empty when flat_allan_variance is 0. Throws std::invalid_argument on bad input.
+std::vector<GaussMarkovComponent> flickerGaussMarkovBank(double flat_allan_variance, double tau0_s,
+                                                         double duration_s);
+
+// White rate noise of two-sided density N at the internal rate, through the DLPF and
+// decimated to rate_hz, is white at low frequency with density N·F where
+// F² = Σ_{k=0}^{D−1} |H(k·rate_hz)|², D = internal/rate (the aliases folded onto f = 0).
+// So the ARW read from long-τ Allan deviation of the output is F·N. Same validation of
+// cfg and rate as the simulator.
+double aliasedWhiteNoiseFactor(int dlpf_cfg, double rate_hz);
+
+struct SimulatedSample {
+  double t_s = 0.0;                                // from 0
+  std::array<double, kSimulatedAxes> rate_dps{};  // °/s
+  double temperature_c = 0.0;
+};
+
+class NoiseSimulator {
+ public:
+  // duration_s fixes the flicker bank's supported τ range (up to duration/2) and
+  // sampleCount(); the stream itself may be read further. Throws std::invalid_argument
+  // (see validateSimulationModel; duration must be finite and ≥ one sample).
+  NoiseSimulator(const SimulationModel& model, double duration_s, std::uint64_t seed);
+
+  // The next output sample at rate_hz: analog rate at the internal rate → DLPF (if on;
+  // started in steady state at the first value) → every D-th sample (t = n/rate_hz,
+  // n = 0, 1, …) → + output-rate terms (Q, AR) → quantised to 1/sensitivity °/s and
+  // saturated (if FS_SEL is set; temperature then also to 1/340 °C).
+  SimulatedSample next();
+
+  // For the mock device, which applies the DLPF, decimation and quantisation itself:
+  // the analog rate at the internal rate (bias + ARW + bias instability + RRW + ramp)
+  // and temperature, one internal sample per call (t = i/internal rate), and the terms
+  // defined at the output rate (quantisation noise Q, AR), one output sample per call.
+  // next() is exactly these two composed as described above; use either next() or
+  // these two on one instance, not both.
+  SimulatedSample nextAnalog();
+  std::array<double, kSimulatedAxes> nextOutputRateNoise();
+
+  double outputRateHz() const { return model_.rate_hz; }
+  double internalRateHz() const { return internal_rate_hz_; }
+  std::size_t decimation() const { return decimation_; }  // 1 + SMPLRT_DIV
+  std::size_t sampleCount() const { return sample_count_; }  // ⌊duration·rate⌋
+  const SimulationModel& model() const { return model_; }
+  // The flicker bank in use (same for all axes up to their level; empty if B = 0).
+  const std::vector<GaussMarkovComponent>& flickerBank(std::size_t axis) const;
+
+ private:
+  struct GaussMarkovState {
+    double decay = 0.0;           // e^{−τ0/T}
+    double innovation_std = 0.0;  // √(variance·(1 − decay²))
+    double value = 0.0;
+  };
+  struct AxisState {
+    double bias_dps = 0.0;
+    double arw_std = 0.0;        // per internal sample
+    double rrw_step_std = 0.0;   // per internal sample
+    double rrw_value = 0.0;
+    double ramp_dps_per_s = 0.0; // signed
+    std::vector<GaussMarkovComponent> flicker_bank;
+    std::vector<GaussMarkovState> flicker;
+    double q_angle_std_deg = 0.0;  // white angle noise, per output sample
+    double q_previous_angle_deg = 0.0;
+    std::vector<double> ar_phi;
+    double ar_innovation_std = 0.0;
+    std::vector<double> ar_history;  // ring buffer of the last p values
+    std::size_t ar_newest = 0;
+    NormalGenerator arw_noise, rrw_noise, flicker_noise, q_noise, ar_noise;
+    explicit AxisState(SplitMix64& seeder);
+  };
+
+  void initAr(AxisState& axis, const ArComponent& ar);
+
+  SimulationModel model_;
+  SplitMix64 seeder_;  // expands the seed into one xoshiro stream per term and axis
+  NormalGenerator temperature_noise_;
+  double internal_rate_hz_ = 0.0;
+  std::size_t decimation_ = 1;
+  std::size_t sample_count_ = 0;
+  std::optional<double> lsb_per_dps_;
+  std::vector<AxisState> axes_;
+  std::vector<DigitalLowPassFilter> dlpf_;
+  std::uint64_t analog_index_ = 0;
+  std::uint64_t output_index_ = 0;
+};
+
+}  // namespace gyrod::processing

@@ -1,0 +1,130 @@
+// gyroctl simulate: a recording of the simulated gyro at rest (docs/simulator.md), as the
+// CSV that analyze/filter read: t,gx,gy,gz,temp.
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include "processing/noise_simulator.hpp"
+#include "tools/gyroctl/commands.hpp"
+#include "tools/recording/model_toml.hpp"
+
+namespace gyrod::gyroctl {
+namespace {
+
+using namespace gyrod::processing;
+
+struct SimulateOptions {
+  std::string model_file;
+  std::optional<double> quantization, arw, bias_instability, rrw, rate_ramp;
+  double duration_s = 0.0;
+  std::optional<double> rate_hz;
+  std::uint64_t seed = 1;
+  std::optional<int> dlpf, fs_sel;
+  std::string output;
+};
+
+// Writes through a temporary file in the same folder and a rename, streaming: the
+// recording is never held in memory, and an existing OUT is replaced only by a complete one.
+class AtomicOutput {
+ public:
+  explicit AtomicOutput(const std::string& path) : path_(path), temp_(path + ".tmp-gyroctl") {
+    file_ = std::fopen(temp_.c_str(), "wb");
+    if (!file_) throw std::runtime_error(temp_ + ": cannot create: " + std::strerror(errno));
+  }
+  ~AtomicOutput() {
+    if (file_) {
+      std::fclose(file_);
+      std::remove(temp_.c_str());
+    }
+  }
+  AtomicOutput(const AtomicOutput&) = delete;
+  AtomicOutput& operator=(const AtomicOutput&) = delete;
+  std::FILE* get() { return file_; }
+  void commit() {
+    const bool write_failed = std::ferror(file_) != 0;
+    const bool close_failed = std::fclose(file_) != 0;
+    file_ = nullptr;
+    if (write_failed || close_failed) {
+      std::remove(temp_.c_str());
+      throw std::runtime_error(path_ + ": write failed");
+    }
+    std::error_code ec;
+    std::filesystem::rename(temp_, path_, ec);
+    if (ec) {
+      std::remove(temp_.c_str());
+      throw std::runtime_error(path_ + ": cannot replace: " + ec.message());
+    }
+  }
+
+ private:
+  std::string path_, temp_;
+  std::FILE* file_ = nullptr;
+};
+
+int runSimulate(const SimulateOptions& opt) {
+  SimulationModel model;
+  if (!opt.model_file.empty()) {
+    model = recording::readModelToml(opt.model_file);
+  } else {
+    // Terms from the command line, the same on all three axes.
+    for (AxisNoiseModel& axis : model.axes) {
+      axis.terms.quantization_urad = opt.quantization.value_or(0.0);
+      axis.terms.arw_deg_per_sqrt_h = opt.arw.value_or(0.0);
+      axis.terms.bias_instability_deg_per_h = opt.bias_instability.value_or(0.0);
+      axis.terms.rrw_deg_per_h_sqrt_h = opt.rrw.value_or(0.0);
+      axis.terms.rate_ramp_deg_per_h2 = opt.rate_ramp.value_or(0.0);
+    }
+  }
+  // Command-line sensor options override the file's.
+  if (opt.rate_hz) model.rate_hz = *opt.rate_hz;
+  if (opt.dlpf) model.dlpf_cfg = *opt.dlpf;
+  if (opt.fs_sel) model.fs_sel = *opt.fs_sel;
+
+  NoiseSimulator sim(model, opt.duration_s, opt.seed);  // validates; std::invalid_argument → exit 2
+  AtomicOutput out(opt.output);
+  std::FILE* f = out.get();
+  std::fputs("t,gx,gy,gz,temp\n", f);
+  const std::size_t n = sim.sampleCount();
+  for (std::size_t i = 0; i < n; ++i) {
+    const SimulatedSample s = sim.next();
+    // 17 significant digits: every double survives the text round trip exactly.
+    std::fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g\n", s.t_s, s.rate_dps[0], s.rate_dps[1], s.rate_dps[2],
+                 s.temperature_c);
+  }
+  out.commit();
+  std::fprintf(stderr, "wrote %zu samples at %g Hz (%s%s, seed %llu) to %s\n", n, model.rate_hz,
+               model.dlpf_cfg ? ("DLPF_CFG " + std::to_string(*model.dlpf_cfg)).c_str() : "no DLPF",
+               model.fs_sel ? (", FS_SEL " + std::to_string(*model.fs_sel)).c_str() : ", not quantised",
+               static_cast<unsigned long long>(opt.seed), opt.output.c_str());
+  return kExitOk;
+}
+
+}  // namespace
+
+void addSimulateCommand(CLI::App& app, CommandRunner& run) {
+  auto opt = std::make_shared<SimulateOptions>();
+  auto* sub = app.add_subcommand(
+      "simulate", "Write a simulated MPU6050 recording at rest (t,gx,gy,gz,temp) from a noise model");
+  auto* model = sub->add_option("--model", opt->model_file, "model file (TOML, see docs/simulator.md)");
+  auto* terms = sub->add_option_group("terms", "noise terms on all three axes (instead of --model)");
+  auto* q = terms->add_option("--quantization", opt->quantization, "quantization noise Q [urad]");
+  auto* n = terms->add_option("--arw", opt->arw, "angle random walk N [deg/sqrt(h)]");
+  auto* b = terms->add_option("--bias-instability", opt->bias_instability, "bias instability B [deg/h]");
+  auto* k = terms->add_option("--rrw", opt->rrw, "rate random walk K [deg/h^1.5]");
+  auto* r = terms->add_option("--rate-ramp", opt->rate_ramp, "rate ramp R [deg/h^2]");
+  for (CLI::Option* o : {q, n, b, k, r}) o->excludes(model);
+  sub->add_option("--duration", opt->duration_s, "length [s]")->required()->check(CLI::PositiveNumber);
+  sub->add_option("--rate", opt->rate_hz, "output rate [Hz] (default: the model file's, else 50)");
+  sub->add_option("--seed", opt->seed, "random seed (same seed, same file on every machine)")->default_val(1);
+  sub->add_option("--dlpf", opt->dlpf, "DLPF_CFG 0..6 (default: the model file's, else no DLPF)");
+  sub->add_option("--fs-sel", opt->fs_sel, "FS_SEL 0..3: quantise and saturate (default: the model file's, else not)");
+  sub->add_option("-o,--output", opt->output, "output CSV")->required();
+  sub->callback([&run, opt] { run = [opt] { return runSimulate(*opt); }; });
+}
+
+}  // namespace gyrod::gyroctl

@@ -1,0 +1,237 @@
+#include "tools/recording/model_toml.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <stdexcept>
+#include <toml++/toml.h>
+
+namespace gyrod::recording {
+namespace {
+
+using processing::SimulationModel;
+
+std::string formatNumber(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+class ModelReader {
+ public:
+  explicit ModelReader(std::string source) : source_(std::move(source)) {}
+
+  [[noreturn]] void fail(const toml::source_region& where, const std::string& cause) const {
+    throw RecordingError(source_ + ":" + std::to_string(where.begin.line) + ": " + cause);
+  }
+
+  double number(const toml::node& node, const toml::key& key, const std::string& where) const {
+    if (!node.is_number()) fail(key.source(), where + std::string(key.str()) + " must be a number, got " + typeName(node));
+    const double v = *node.value<double>();
+    if (!std::isfinite(v)) fail(key.source(), where + std::string(key.str()) + " must be finite, got " + formatNumber(v));
+    return v;
+  }
+  double nonNegative(const toml::node& node, const toml::key& key, const std::string& where) const {
+    const double v = number(node, key, where);
+    if (v < 0.0) fail(key.source(), where + std::string(key.str()) + " must be >= 0, got " + formatNumber(v));
+    return v;
+  }
+  double positive(const toml::node& node, const toml::key& key, const std::string& where) const {
+    const double v = number(node, key, where);
+    if (!(v > 0.0)) fail(key.source(), where + std::string(key.str()) + " must be > 0, got " + formatNumber(v));
+    return v;
+  }
+  int integerIn(const toml::node& node, const toml::key& key, int lo, int hi) const {
+    if (!node.is_integer()) fail(key.source(), std::string(key.str()) + " must be an integer, got " + typeName(node));
+    const std::int64_t v = *node.value<std::int64_t>();
+    if (v < lo || v > hi)
+      fail(key.source(), std::string(key.str()) + " must be " + std::to_string(lo) + ".." + std::to_string(hi) +
+                             ", got " + formatNumber(v));
+    return static_cast<int>(v);
+  }
+  const toml::table& table(const toml::node& node, const toml::key& key) const {
+    if (!node.is_table()) fail(key.source(), std::string(key.str()) + " must be a table ([" + std::string(key.str()) + "]), got " + typeName(node));
+    return *node.as_table();
+  }
+
+  static std::string typeName(const toml::node& node) {
+    switch (node.type()) {
+      case toml::node_type::string: return "a string";
+      case toml::node_type::integer: return "an integer";
+      case toml::node_type::floating_point: return "a float";
+      case toml::node_type::boolean: return "a boolean";
+      case toml::node_type::array: return "an array";
+      case toml::node_type::table: return "a table";
+      default: return "a date/time";
+    }
+  }
+
+  SimulationModel read(const toml::table& root) const {
+    SimulationModel model;
+    const toml::key* rate_key = nullptr;
+    for (auto&& [key, node] : root) {
+      const std::string k(key.str());
+      if (k == "rate_hz") {
+        model.rate_hz = positive(node, key, "");
+        rate_key = &key;
+      } else if (k == "dlpf") {
+        model.dlpf_cfg = integerIn(node, key, 0, 6);
+      } else if (k == "fs_sel") {
+        model.fs_sel = integerIn(node, key, 0, 3);
+      } else if (k == "temperature") {
+        readTemperature(table(node, key), model.temperature);
+      } else if (k == "x" || k == "y" || k == "z") {
+        readAxis(table(node, key), k, model.axes[static_cast<std::size_t>(k[0] - 'x')]);
+      } else {
+        fail(key.source(), "unknown key '" + k + "' (expected rate_hz, dlpf, fs_sel, [temperature], [x], [y], [z])");
+      }
+    }
+    if (model.dlpf_cfg) {
+      try {
+        processing::sampleRateDivisor(*model.dlpf_cfg, model.rate_hz);
+      } catch (const std::invalid_argument& e) {
+        if (rate_key) fail(rate_key->source(), e.what());
+        throw RecordingError(source_ + ": " + e.what() + " (rate_hz not given: default 50)");
+      }
+    }
+    return model;
+  }
+
+  void readTemperature(const toml::table& t, processing::TemperatureModel& temp) const {
+    for (auto&& [key, node] : t) {
+      const std::string k(key.str());
+      if (k == "start_c") temp.start_c = number(node, key, "temperature.");
+      else if (k == "final_c") temp.final_c = number(node, key, "temperature.");
+      else if (k == "time_constant_s") temp.time_constant_s = positive(node, key, "temperature.");
+      else if (k == "noise_std_c") temp.noise_std_c = nonNegative(node, key, "temperature.");
+      else fail(key.source(), "unknown key '" + k + "' in [temperature] (expected start_c, final_c, time_constant_s, noise_std_c)");
+    }
+  }
+
+  void readAxis(const toml::table& t, const std::string& axis, processing::AxisNoiseModel& out) const {
+    const std::string where = axis + ".";
+    for (auto&& [key, node] : t) {
+      const std::string k(key.str());
+      bool is_term = false;
+      for (processing::NoiseTerm term : processing::kAllNoiseTerms) {
+        if (k == processing::noiseTermKey(term)) {
+          out.terms.set(term, nonNegative(node, key, where));
+          is_term = true;
+        }
+      }
+      if (is_term) continue;
+      if (k == "bias_dps") {
+        out.bias_dps = number(node, key, where);
+      } else if (k == "ar") {
+        readAr(table(node, key), axis, out.ar);
+      } else {
+        fail(key.source(), "unknown key '" + k + "' in [" + axis +
+                               "] (expected the five noise-term keys of noise_terms.hpp, bias_dps, [" + axis + ".ar])");
+      }
+    }
+  }
+
+  void readAr(const toml::table& t, const std::string& axis, processing::ArComponent& ar) const {
+    const std::string where = axis + ".ar.";
+    const toml::key* phi_key = nullptr;
+    for (auto&& [key, node] : t) {
+      const std::string k(key.str());
+      if (k == "phi") {
+        phi_key = &key;
+        if (!node.is_array()) fail(key.source(), where + "phi must be an array of numbers, got " + typeName(node));
+        ar.phi.clear();
+        for (const toml::node& element : *node.as_array()) {
+          if (!element.is_number()) fail(key.source(), where + "phi must contain numbers only, found " + typeName(element));
+          ar.phi.push_back(*element.value<double>());
+        }
+      } else if (k == "noise_var") {
+        ar.noise_var = nonNegative(node, key, where);
+      } else {
+        fail(key.source(), "unknown key '" + k + "' in [" + axis + ".ar] (expected phi, noise_var)");
+      }
+    }
+    try {
+      processing::validateArComponent(ar, axis + ".");
+    } catch (const std::invalid_argument& e) {
+      if (phi_key) fail(phi_key->source(), e.what());
+      throw RecordingError(source_ + ": " + e.what());
+    }
+  }
+
+ private:
+  std::string source_;
+};
+
+void appendKeyValue(std::string& out, const std::string& key, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  std::string text(buf);
+  if (text.find_first_of(".eE") == std::string::npos) text += ".0";  // a TOML float
+  out += key + " = " + text + "\n";
+}
+
+}  // namespace
+
+processing::SimulationModel parseModelToml(std::string_view text, const std::string& source_name) {
+  toml::table root;
+  try {
+    root = toml::parse(text, source_name);
+  } catch (const toml::parse_error& e) {
+    throw RecordingError(source_name + ":" + std::to_string(e.source().begin.line) + ": " + std::string(e.description()));
+  }
+  const SimulationModel model = ModelReader(source_name).read(root);
+  try {
+    processing::validateSimulationModel(model);  // anything not already tied to a line
+  } catch (const std::invalid_argument& e) {
+    throw RecordingError(source_name + ": " + e.what());
+  }
+  return model;
+}
+
+processing::SimulationModel readModelToml(const std::string& path) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) throw RecordingError(path + ": cannot open: " + std::strerror(errno));
+  std::string text;
+  char buf[65536];
+  std::size_t n = 0;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
+  const bool failed = std::ferror(f);
+  std::fclose(f);
+  if (failed) throw RecordingError(path + ": cannot read");
+  return parseModelToml(text, path);
+}
+
+std::string modelToToml(const processing::SimulationModel& model) {
+  std::string out = "# gyrod simulation model (docs/simulator.md)\n";
+  appendKeyValue(out, "rate_hz", model.rate_hz);
+  if (model.dlpf_cfg) out += "dlpf = " + std::to_string(*model.dlpf_cfg) + "\n";
+  if (model.fs_sel) out += "fs_sel = " + std::to_string(*model.fs_sel) + "\n";
+  out += "\n[temperature]\n";
+  appendKeyValue(out, "start_c", model.temperature.start_c);
+  appendKeyValue(out, "final_c", model.temperature.final_c);
+  appendKeyValue(out, "time_constant_s", model.temperature.time_constant_s);
+  appendKeyValue(out, "noise_std_c", model.temperature.noise_std_c);
+  const char* names[] = {"x", "y", "z"};
+  for (std::size_t a = 0; a < processing::kSimulatedAxes; ++a) {
+    const processing::AxisNoiseModel& axis = model.axes[a];
+    out += std::string("\n[") + names[a] + "]\n";
+    for (processing::NoiseTerm t : processing::kAllNoiseTerms)
+      appendKeyValue(out, std::string(processing::noiseTermKey(t)), axis.terms.get(t));
+    appendKeyValue(out, "bias_dps", axis.bias_dps);
+    if (!axis.ar.phi.empty() || axis.ar.noise_var != 0.0) {
+      out += std::string("\n[") + names[a] + ".ar]\nphi = [";
+      for (std::size_t i = 0; i < axis.ar.phi.size(); ++i) {
+        char buf[64];
+        std::snprintf(buf, sizeof buf, "%s%.17g", i ? ", " : "", axis.ar.phi[i]);
+        out += buf;
+      }
+      out += "]\n";
+      appendKeyValue(out, "noise_var", axis.ar.noise_var);
+    }
+  }
+  return out;
+}
+
+}  // namespace gyrod::recording
