@@ -19,6 +19,10 @@ namespace reg = mpu6050;
 
 constexpr std::uint8_t R(Register r) { return mpu6050::address(r); }
 
+// The register map's temperature constants and processing's sensor model must agree.
+static_assert(mpu6050::kTemperatureLsbPerDegC == processing::kTemperatureLsbPerDegC);
+static_assert(mpu6050::kTemperatureOffsetDegC == processing::kTemperatureOffsetDegC);
+
 // Registers the host may write on an MPU-6050 (RM §3 p.6–8, R/W entries). Writes elsewhere
 // (outputs, INT_STATUS, FIFO_COUNT, WHO_AM_I, unknown addresses) are ignored by the chip.
 constexpr bool isWritable(std::uint8_t r) {

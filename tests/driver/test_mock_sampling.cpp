@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include "driver/mock_signal_source.hpp"
+#include "processing/sensor_model.hpp"
 #include "tests/driver/mock_rig.hpp"
 
 namespace gyrod::driver::test {
@@ -95,6 +96,12 @@ INSTANTIATE_TEST_SUITE_P(FullScaleRanges, GyroScaling,
                                            ScaleCase{0, 250.0, 32750},
                                            ScaleCase{0, 300.0, 32767},    // 39300 saturates
                                            ScaleCase{3, 2500.0, 32767}));  // 41000 saturates
+
+TEST(MockMpu6050Sampling, RegisterMapSensitivitiesAgreeWithTheSensorModel) {
+  for (int fs = 0; fs < 4; ++fs) {
+    EXPECT_EQ(m::kGyroLsbPerDps[fs], processing::gyroSensitivityLsbPerDps(fs)) << "FS_SEL " << fs;
+  }
+}
 
 TEST(MockMpu6050Sampling, TemperatureEncodingFollowsTheRegisterMapFormula) {
   // TEMP_OUT = round((T − 36.53) · 340), worked out by hand for each T.
