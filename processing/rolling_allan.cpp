@@ -167,10 +167,15 @@ double RollingOverlappingAllan::secondDifference(std::size_t back, std::size_t m
   const PhasePoint& x2 = ring_[slotBack(back)];          // x_{j+2m}
   const PhasePoint& x1 = ring_[slotBack(back + m)];      // x_{j+m}
   const PhasePoint& x0 = ring_[slotBack(back + 2 * m)];  // x_j
-  const DoubleDouble later = difference(x2.hi, x2.lo, x1.hi, x1.lo);
-  const DoubleDouble earlier = difference(x1.hi, x1.lo, x0.hi, x0.lo);
-  const DoubleDouble d = difference(later.hi, later.lo, earlier.hi, earlier.lo);
-  return d.hi;  // already hi = fl(hi + lo)
+  // The hi parts are differenced exactly (TwoSum); what is left is d = A + c with
+  // A = later.hi − earlier.hi, rounded once (error ≤ 2⁻⁵³·|A|, and A ≈ d, or A is exact by
+  // Sterbenz when the window sums nearly cancel), and c of order 2⁻⁵³·|x_{j+2m} − x_{j+m}|
+  // from the low parts. So d carries ~2 roundings of its own size plus ~2⁻¹⁰⁴·|x|, however
+  // large the phase or the window sums are.
+  const DoubleDouble later = twoSum(x2.hi, -x1.hi);
+  const DoubleDouble earlier = twoSum(x1.hi, -x0.hi);
+  const double low_parts = (later.lo - earlier.lo) + ((x2.lo - x1.lo) - (x1.lo - x0.lo));
+  return (later.hi - earlier.hi) + low_parts;
 }
 
 void RollingOverlappingAllan::push(double rate) {
