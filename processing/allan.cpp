@@ -356,6 +356,21 @@ double overlappingAllanEdf(int alpha, std::size_t phase_points, std::size_t m) {
   }
 }
 
+DeviationInterval allanDeviationConfidenceInterval(double deviation, double edf, double confidence) {
+  if (!(confidence > 0.0 && confidence < 1.0)) {
+    throw std::invalid_argument("allanDeviationConfidenceInterval: confidence must be in (0, 1) (got " +
+                                formatNumber(confidence) + ")");
+  }
+  if (std::isnan(deviation)) return {kNaN, kNaN};
+  if (!(std::isfinite(edf) && edf > 0.0)) {
+    throw std::invalid_argument("allanDeviationConfidenceInterval: edf must be finite and > 0 (got " +
+                                formatNumber(edf) + ")");
+  }
+  // NIST SP 1065 eq. 45: σ²·edf/σ̂² ~ χ²(edf).
+  return {deviation * std::sqrt(edf / chiSquareQuantile(0.5 * (1.0 + confidence), edf)),
+          deviation * std::sqrt(edf / chiSquareQuantile(0.5 * (1.0 - confidence), edf))};
+}
+
 std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double tau0_s,
                                             std::span<const std::size_t> ms, const AllanOptions& options) {
   if (!(std::isfinite(tau0_s) && tau0_s > 0.0)) {
@@ -374,8 +389,6 @@ std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double
 
   const IntegratedPhase phase(rate, "allanDeviationTable");
   const std::size_t count = rate.size();
-  const double p_upper = 0.5 * (1.0 + options.confidence);
-  const double p_lower = 0.5 * (1.0 - options.confidence);
 
   std::vector<AllanPoint> table;
   table.reserve(ms.size());
@@ -390,9 +403,9 @@ std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double
     p.noise_alpha = identifyWithMean(rate, m, phase.mean(), &phase);
     if (p.oadev_terms >= 1) {
       p.edf = overlappingAllanEdf(p.noise_alpha, count + 1, m);
-      // NIST SP 1065 eq. 45: σ²·edf/σ̂² ~ χ²(edf).
-      p.oadev_lo = p.oadev * std::sqrt(p.edf / chiSquareQuantile(p_upper, p.edf));
-      p.oadev_hi = p.oadev * std::sqrt(p.edf / chiSquareQuantile(p_lower, p.edf));
+      const DeviationInterval interval = allanDeviationConfidenceInterval(p.oadev, p.edf, options.confidence);
+      p.oadev_lo = interval.lo;
+      p.oadev_hi = interval.hi;
     } else {
       p.edf = kNaN;
       p.oadev_lo = kNaN;

@@ -65,6 +65,16 @@ struct AllanPoint {
   double oadev_hi = 0.0;        // σ̂·√(edf/χ²_{(1±c)/2}(edf)), NIST SP 1065 eq. 45
 };
 
+// χ² confidence interval of a deviation estimate σ̂ with `edf` equivalent degrees of freedom
+// at two-sided confidence c (NIST SP 1065 eq. 45: σ²·edf/σ̂² ~ χ²(edf)):
+// [σ̂·√(edf/χ²_{(1+c)/2}(edf)), σ̂·√(edf/χ²_{(1−c)/2}(edf))]. NaN σ̂ gives NaN bounds.
+// Throws std::invalid_argument for c outside (0, 1) or edf not finite and > 0 (σ̂ finite).
+struct DeviationInterval {
+  double lo = 0.0;
+  double hi = 0.0;
+};
+DeviationInterval allanDeviationConfidenceInterval(double deviation, double edf, double confidence);
+
 struct AllanOptions {
   double confidence = 0.683;  // two-sided, "1 σ" as is usual for Allan plots
 };
