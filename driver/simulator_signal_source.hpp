@@ -1,0 +1,33 @@
+#pragma once
+// The noise simulator (processing/noise_simulator.hpp) as what the mock MPU-6050 "feels":
+// one analog sample per internal gyro tick (bias, ARW, bias instability, RRW, ramp and
+// the temperature curve). The mock applies the DLPF, decimation and quantisation itself.
+//
+// Not included: the two terms the simulator defines at the *output* rate — angle
+// quantization noise Q and the AR(p) component — because the mock's output rate is set by
+// the driver through SMPLRT_DIV at run time, not by the model. A model that relies on
+// them is simulated faithfully only by `gyroctl simulate`.
+#include <cstdint>
+#include <memory>
+
+#include "driver/mock_signal_source.hpp"
+#include "processing/noise_simulator.hpp"
+
+namespace gyrod::driver {
+
+class SimulatorSignalSource final : public SignalSource {
+ public:
+  // `dlpf_cfg` selects the internal rate the chip will tick at (8 kHz for 0 and 7, else
+  // 1 kHz); it must match CONFIG.DLPF_CFG as the driver will set it. `horizon_s` is the
+  // longest run the flicker (bias-instability) model is built for. Throws
+  // std::invalid_argument for a model the simulator rejects.
+  SimulatorSignalSource(const processing::SimulationModel& model, int dlpf_cfg, std::uint64_t seed,
+                        double horizon_s = 7.0 * 24 * 3600);
+  double expectedTickRateHz() const override { return simulator_->internalRateHz(); }
+  AnalogSample nextTick(double t_s) override;
+
+ private:
+  std::unique_ptr<processing::NoiseSimulator> simulator_;
+};
+
+}  // namespace gyrod::driver

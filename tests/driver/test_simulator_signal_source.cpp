@@ -1,0 +1,50 @@
+// The noise simulator as the mock chip's input: what comes out of the chip's output
+// registers carries the model's bias and angle random walk (with the DLPF's aliasing
+// factor the simulator documents), quantised at FS_SEL 0.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "driver/simulator_signal_source.hpp"
+#include "mock_rig.hpp"
+#include "processing/allan.hpp"
+
+using namespace gyrod::driver;
+using namespace gyrod::driver::test;
+using gyrod::processing::SimulationModel;
+
+TEST(SimulatorSignalSource, ChipOutputCarriesTheModelsBiasAndArw) {
+  SimulationModel model;
+  model.axes[0].terms.arw_deg_per_sqrt_h = 0.9;
+  model.axes[0].bias_dps = 1.25;
+  model.axes[1].bias_dps = -0.5;
+  SimulatorSignalSource source(model, 4, 42, 3600.0);
+  EXPECT_DOUBLE_EQ(source.expectedTickRateHz(), 1000.0);
+  Rig rig(source);
+  std::vector<double> x, y;
+  rig.mock.setSampleObserver([&](const SampleRecord& s) {
+    x.push_back(s.gyro[0] / 131.0);
+    y.push_back(s.gyro[1] / 131.0);
+  });
+  rig.wake(4, 19);  // DLPF_CFG 4, 1 kHz / 20 = 50 Hz
+  rig.advance(600 * kNsPerSecond);
+  ASSERT_NEAR(static_cast<double>(x.size()), 30000.0, 2.0);
+  EXPECT_EQ(rig.mock.counters().source_rate_mismatch_ticks, 0u);
+
+  double mean_x = 0.0, mean_y = 0.0;
+  for (double v : x) mean_x += v;
+  for (double v : y) mean_y += v;
+  mean_x /= static_cast<double>(x.size());
+  mean_y /= static_cast<double>(y.size());
+  // N = 0.9 °/√h → 0.015 °/√s; σ of a 600 s mean = N/√600 ≈ 6e-4 °/s.
+  EXPECT_NEAR(mean_x, 1.25, 5 * 0.015 / std::sqrt(600.0));
+  EXPECT_NEAR(mean_y, -0.5, 1.0 / 131.0);  // y has no noise: the bias, quantised
+
+  // ARW at τ = 1 s: σ(τ) = F·N/√τ with F the decimation aliasing factor (docs/simulator.md).
+  const double factor = gyrod::processing::aliasedWhiteNoiseFactor(4, 50.0);
+  const double expected = factor * 0.015;
+  const double measured = std::sqrt(gyrod::processing::overlappingAllanVariance(x, 50));
+  // ~600 independent 1 s intervals: the relative standard error of σ is about 1/√(2·600/1.5).
+  EXPECT_NEAR(measured, expected, 5 * expected / std::sqrt(800.0));
+}
