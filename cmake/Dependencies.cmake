@@ -34,3 +34,9 @@ if(GYROD_BUILD_BENCHMARKS)
   find_package(benchmark QUIET)
   gyrod_require(benchmark_FOUND libbenchmark-dev "Google Benchmark (benchmarks)")
 endif()
+
+find_package(tomlplusplus 3 QUIET)
+gyrod_require(tomlplusplus_FOUND libtomlplusplus-dev "toml++ (configuration file)")
+
+find_package(spdlog QUIET)
+gyrod_require(spdlog_FOUND libspdlog-dev "spdlog (logging)")

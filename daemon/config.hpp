@@ -1,0 +1,189 @@
+#pragma once
+// gyrod's configuration: one TOML file (config/gyrod.toml documents every key and its
+// default) plus a few command-line flags on top. Every problem is a ConfigError whose
+// message is one line naming the file, the line and the key; the daemon prints it and
+// exits with EX_CONFIG (78). A key the loader does not know is an error, never ignored.
+#include <spdlog/common.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace gyrod::daemon {
+
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// sysexits.h EX_CONFIG: "something was found in an unconfigured or misconfigured state".
+inline constexpr int kExitConfigError = 78;
+inline constexpr int exitCodeForConfigError() { return kExitConfigError; }
+// sysexits.h EX_USAGE: the command line itself is wrong (unknown flag, bad flag value).
+inline constexpr int kExitUsageError = 64;
+
+inline constexpr std::string_view kDefaultConfigPath = "/etc/gyrod/gyrod.toml";
+
+enum class DeviceBackend { I2c, Mock };
+enum class BiasSource { Estimate, Model, Config };
+enum class MockSource { Simulator, Replay };
+
+struct DeviceConfig {
+  DeviceBackend backend = DeviceBackend::I2c;
+  std::string bus = "/dev/i2c-1";  // resolved: `bus = 1` and `bus = "1"` both give /dev/i2c-1
+  int address = 0x68;              // 0x68 (AD0 low) or 0x69 (AD0 high)
+  double rate_hz = 50.0;           // internal rate / (1 + SMPLRT_DIV), checked to be reachable
+  int dlpf = 4;                    // DLPF_CFG 0..6; 4 = 20 Hz gyro bandwidth (the paper's)
+  int full_scale_dps = 250;        // FS_SEL: 250, 500, 1000 or 2000 °/s
+  bool operator==(const DeviceConfig&) const = default;
+};
+
+struct GpioConfig {
+  std::string chip;         // "gpiochip0", "/dev/gpiochip0", ...; empty = no data-ready line (FIFO polling)
+  std::optional<int> line;  // line offset on the chip; required when chip is set
+  bool operator==(const GpioConfig&) const = default;
+};
+
+struct BiasConfig {
+  BiasSource source = BiasSource::Estimate;
+  double still_seconds = 10.0;             // length of the still period averaged at start (estimate)
+  std::vector<double> values{0.0, 0.0, 0.0};  // x, y, z in °/s (source = config)
+  bool operator==(const BiasConfig&) const = default;
+};
+
+struct KalmanOverrideConfig {
+  std::optional<double> a, q, r;  // A = φ1, Q = σa², R; empty = from the model / identification
+  bool operator==(const KalmanOverrideConfig&) const = default;
+};
+
+struct FilterConfig {
+  std::size_t mean_window = 20;     // L (paper: 20)
+  double mean_threshold_dps = 0.3;  // r (paper: 0.3 °/s)
+  std::string model;                // model file from `gyroctl analyze --write-model`; empty = none
+  KalmanOverrideConfig kalman;
+  bool operator==(const FilterConfig&) const = default;
+};
+
+struct AllanConfig {
+  double window_s = 3600.0;        // rolling window of the statistics
+  double refit_interval_s = 10.0;  // how often the noise terms are refitted
+  std::vector<double> taus_s;      // empty = octave spacing (τ0·2^k); else explicit τ in s
+  bool octave() const { return taus_s.empty(); }
+  bool operator==(const AllanConfig&) const = default;
+};
+
+struct SocketConfig {
+  std::string path = "/run/gyrod/gyrod.sock";
+  unsigned mode = 0660;             // permission bits of the socket file
+  std::string group;                // group of the socket file; empty = the daemon's group
+  std::size_t client_buffer_kib = 256;  // per-client output queue before dropping
+  bool operator==(const SocketConfig&) const = default;
+};
+
+struct RecordConfig {
+  std::string path;                // base file name, e.g. /var/lib/gyrod/gyro.csv; empty = off
+  double rotate_mb = 64.0;         // start a new file past this size (10^6 bytes); 0 = never
+  double rotate_minutes = 0.0;     // start a new file after this long; 0 = never
+  double flush_interval_s = 1.0;   // how often buffered lines are written (bounds crash loss)
+  bool fsync_each_flush = false;   // also fdatasync() at every flush (power-loss safety, SD wear)
+  std::size_t keep = 10;           // recording files kept (oldest deleted); 0 = keep all
+  bool enabled() const { return !path.empty(); }
+  bool operator==(const RecordConfig&) const = default;
+};
+
+struct LogConfig {
+  spdlog::level::level_enum level = spdlog::level::info;
+  bool operator==(const LogConfig&) const = default;
+};
+
+// Mock device faults (all optional). Times are seconds since the mock device started.
+struct MockErrorBurst {
+  double at_s = 0.0;
+  std::uint32_t count = 1;  // consecutive failing transfers
+  bool operator==(const MockErrorBurst&) const = default;
+};
+struct MockVanish {
+  double at_s = 0.0;
+  double duration_s = 0.0;
+  bool power_lost = false;  // also loses power: comes back in its power-on state
+  bool operator==(const MockVanish&) const = default;
+};
+struct MockFaults {
+  double transfer_error_fraction = 0.0;  // each transfer fails with this probability
+  std::vector<MockErrorBurst> error_bursts;
+  std::vector<MockVanish> vanish;
+  std::vector<double> silent_reset_at_s;   // brown-out: registers reset, no bus error
+  std::vector<double> fifo_overflow_at_s;  // FIFO forced to overflow
+  std::optional<int> who_am_i;             // WHO_AM_I answer instead of 0x68 (clones)
+  std::vector<double> stuck_data_ready_at_s;
+  std::optional<double> stuck_data_ready_duration_s;  // empty = stuck until the end
+  bool operator==(const MockFaults&) const = default;
+};
+
+struct MockConfig {
+  MockSource source = MockSource::Simulator;
+  std::string replay_file;  // recording CSV (t,gx,gy,gz,temp) when source = replay
+  std::uint64_t seed = 1;
+  double speed = 1.0;       // 1 = real time; 10 = ten times faster
+  MockFaults faults;
+  bool operator==(const MockConfig&) const = default;
+};
+
+struct GyrodConfig {
+  DeviceConfig device;
+  GpioConfig gpio;
+  BiasConfig bias;
+  FilterConfig filter;
+  AllanConfig allan;
+  SocketConfig socket;
+  RecordConfig record;
+  LogConfig log;
+  MockConfig mock;
+  bool operator==(const GyrodConfig&) const = default;
+};
+
+// Parses and validates TOML text; `source_name` is the file name used in messages.
+// Keys absent from the text keep their defaults. Throws ConfigError.
+GyrodConfig parseConfig(std::string_view toml_text, const std::string& source_name);
+// Reads the file and parses it. Throws ConfigError ("FILE: cannot open: ...") if unreadable.
+GyrodConfig loadConfigFile(const std::string& path);
+
+// Names as written in the file.
+std::string_view toString(DeviceBackend b);
+std::string_view toString(BiasSource s);
+std::string_view toString(MockSource s);
+
+// The I2C device node for a `bus` value: a bus number N (≥ 0) → /dev/i2c-N, a path
+// starting with '/' → itself. Throws ConfigError for anything else.
+std::string i2cDevicePath(std::string_view bus);
+
+// Values a flag may set, on top of the file. Each is validated as the same key would be.
+struct CommandLineOverrides {
+  std::optional<DeviceBackend> backend;
+  std::optional<std::string> socket_path;
+  std::optional<std::string> record_path;
+  std::optional<double> mock_speed;
+  std::optional<spdlog::level::level_enum> log_level;
+};
+// Throws ConfigError naming the flag for a value out of range.
+void applyOverrides(GyrodConfig& config, const CommandLineOverrides& overrides);
+
+struct GyrodCommandLine {
+  GyrodConfig config;
+  std::string config_file;        // the file loaded; empty = compiled-in defaults
+  std::optional<int> exit_code;   // set: exit now (0 after --help/--version, 64 for bad usage)
+  std::string message;            // print before exiting: stdout if exit_code == 0, else stderr
+};
+
+// gyrod's command line:  gyrod [--config FILE] [--backend mock|i2c] [--socket PATH]
+//   [--record PATH] [--mock-speed X] [--log-level L] [--help] [--version]
+// Loads --config FILE, or else default_config_path when that file exists, or else the
+// compiled-in defaults, then applies the flags. Throws ConfigError for a bad config file.
+GyrodCommandLine parseGyrodCommandLine(int argc, const char* const* argv,
+                                       const std::string& default_config_path = std::string(kDefaultConfigPath));
+
+}  // namespace gyrod::daemon

@@ -1,0 +1,455 @@
+#include "daemon/recorder.hpp"
+
+#include <fcntl.h>
+#include <spdlog/spdlog.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+
+namespace gyrod::daemon {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr std::string_view kHeader = "t,gx,gy,gz,temp\n";
+constexpr std::size_t kMaxHeaderBytes = 2048;  // < any page size: the header is written in one write()
+
+std::int64_t steadyNowNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+// Appends the shortest decimal form that reads back as the same double.
+char* putNumber(char* p, char* end, double v) { return std::to_chars(p, end, v).ptr; }
+
+char* putText(char* p, std::string_view s) {
+  std::memcpy(p, s.data(), s.size());
+  return p + s.size();
+}
+
+char* putUnsigned(char* p, char* end, std::uint64_t v) { return std::to_chars(p, end, v).ptr; }
+
+std::string utcStamp(std::int64_t unix_seconds, const char* format) {
+  const std::time_t t = static_cast<std::time_t>(unix_seconds);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  const auto n = std::strftime(buf, sizeof buf, format, &tm);
+  return std::string(buf, n);
+}
+
+std::int64_t unixNow() {
+  return std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+bool allDigits(std::string_view s) {
+  return std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
+}
+
+}  // namespace
+
+std::string recordingFileName(std::string_view stem, std::string_view extension, std::int64_t unix_seconds,
+                              std::uint64_t index) {
+  char idx[32];
+  std::snprintf(idx, sizeof idx, "%06llu", static_cast<unsigned long long>(index));
+  return std::string(stem) + "-" + utcStamp(unix_seconds, "%Y%m%dT%H%M%SZ") + "-" + idx + std::string(extension);
+}
+
+bool isRecordingFileName(std::string_view name, std::string_view stem, std::string_view extension) {
+  // stem "-" YYYYmmdd "T" HHMMSS "Z-" index(≥ 6 digits) extension
+  if (name.size() < stem.size() + 1 + 16 + 1 + 6 + extension.size()) return false;
+  if (name.substr(0, stem.size()) != stem || name[stem.size()] != '-') return false;
+  if (name.substr(name.size() - extension.size()) != extension) return false;
+  const auto middle = name.substr(stem.size() + 1, name.size() - stem.size() - 1 - extension.size());
+  return allDigits(middle.substr(0, 8)) && middle[8] == 'T' && allDigits(middle.substr(9, 6)) &&
+         middle.substr(15, 2) == "Z-" && middle.size() >= 17 + 6 && allDigits(middle.substr(17));
+}
+
+RecorderOptions recorderOptions(const RecordConfig& c, double rate_hz) {
+  RecorderOptions o;
+  o.path = c.path;
+  o.rotate_bytes = static_cast<std::uint64_t>(std::llround(c.rotate_mb * 1e6));
+  o.rotate_after_s = c.rotate_minutes * 60.0;
+  o.flush_interval_s = c.flush_interval_s;
+  o.fsync_each_flush = c.fsync_each_flush;
+  o.keep = c.keep;
+  const double wanted = 4.0 * rate_hz * c.flush_interval_s;
+  o.ring_capacity = static_cast<std::size_t>(std::clamp(wanted, 1024.0, static_cast<double>(1u << 18)));
+  return o;
+}
+
+Recorder::Recorder(RecorderOptions options) : options_(std::move(options)), ring_(options_.ring_capacity) {
+  if (options_.path.empty()) throw std::invalid_argument("Recorder: path is empty");
+  if (!(options_.flush_interval_s > 0.0) || !std::isfinite(options_.flush_interval_s))
+    throw std::invalid_argument("Recorder: flush_interval_s must be > 0 (got " + std::to_string(options_.flush_interval_s) + ")");
+  if (!(options_.rotate_after_s >= 0.0)) throw std::invalid_argument("Recorder: rotate_after_s must be ≥ 0");
+  std::size_t header_bytes = kHeader.size() + 128;
+  for (const auto& c : options_.header_comments) {
+    if (c.find('\n') != std::string::npos) throw std::invalid_argument("Recorder: a header comment contains a newline");
+    header_bytes += c.size() + 3;
+  }
+  if (header_bytes > kMaxHeaderBytes)
+    throw std::invalid_argument("Recorder: header comments too long (" + std::to_string(header_bytes) + " bytes, at most " +
+                                std::to_string(kMaxHeaderBytes) + ")");
+
+  const fs::path p(options_.path);
+  directory_ = p.has_parent_path() ? p.parent_path().string() : ".";
+  stem_ = p.stem().string();
+  extension_ = p.extension().string();
+  if (stem_.empty() || stem_ == "." || stem_ == "..")
+    throw std::invalid_argument("Recorder: path '" + options_.path + "' does not name a file");
+  const long page = sysconf(_SC_PAGESIZE);
+  page_size_ = page > 0 ? static_cast<std::size_t>(page) : 4096;
+  pending_.reserve(1 << 16);
+  page_.reserve(page_size_);
+
+  if (!openNextFile({})) {
+    throw RecorderError(options_.path + ": cannot create recording file in " + directory_ + ": " +
+                        std::strerror(errno));
+  }
+  in_error_ = false;
+  writer_ = std::thread([this] { writerLoop(); });
+}
+
+Recorder::~Recorder() { stop(); }
+
+bool Recorder::pushSample(double t_s, double gx_dps, double gy_dps, double gz_dps, double temp_c) noexcept {
+  RecorderRecord r;
+  r.kind = RecorderRecord::Kind::Sample;
+  r.dropped_before = pending_drops_;
+  r.t_s = t_s;
+  r.gx_dps = gx_dps;
+  r.gy_dps = gy_dps;
+  r.gz_dps = gz_dps;
+  r.temp_c = temp_c;
+  if (!ring_.tryPush(r)) {
+    ++pending_drops_;
+    dropped_.store(dropped_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+    return false;
+  }
+  pending_drops_ = 0;
+  pushed_.store(pushed_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  return true;
+}
+
+bool Recorder::pushGap(std::uint64_t seq, double t_s, std::uint32_t count, std::string_view reason) noexcept {
+  RecorderRecord r;
+  r.kind = RecorderRecord::Kind::Gap;
+  r.dropped_before = pending_drops_;
+  r.gap_seq = seq;
+  r.gap_count = count;
+  r.t_s = t_s;
+  const std::size_t n = std::min(reason.size(), sizeof r.gap_reason - 1);
+  for (std::size_t i = 0; i < n; ++i) {
+    const char c = reason[i];
+    const bool plain = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+                       c == '.' || c == '-';
+    r.gap_reason[i] = plain ? c : '_';
+  }
+  r.gap_reason[n] = '\0';
+  if (!ring_.tryPush(r)) {
+    ++pending_drops_;
+    dropped_.store(dropped_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+    return false;
+  }
+  pending_drops_ = 0;
+  pushed_.store(pushed_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  return true;
+}
+
+void Recorder::flush() {
+  std::unique_lock lock(wake_mutex_);
+  if (stopping_) return;
+  const auto ticket = ++flush_requests_;
+  wake_.notify_all();
+  flushed_.wait(lock, [&] { return flushes_done_ >= ticket || stopping_; });
+}
+
+void Recorder::stop() {
+  {
+    std::lock_guard lock(wake_mutex_);
+    if (stopping_) return;
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  flushed_.notify_all();
+  if (writer_.joinable()) writer_.join();
+  // The writer has exited: this thread owns the writer-side state now.
+  flushOnce(true);
+  closeFile();
+}
+
+RecorderStats Recorder::stats() const noexcept {
+  RecorderStats s;
+  s.pushed = pushed_.load(std::memory_order_relaxed);
+  s.dropped = dropped_.load(std::memory_order_relaxed);
+  s.written = written_.load(std::memory_order_acquire);
+  s.lost_to_errors = lost_.load(std::memory_order_relaxed);
+  s.write_errors = write_errors_.load(std::memory_order_relaxed);
+  s.flushes = flushes_.load(std::memory_order_acquire);
+  s.files_opened = files_opened_.load(std::memory_order_relaxed);
+  return s;
+}
+
+std::string Recorder::currentFile() const {
+  std::lock_guard lock(file_mutex_);
+  return current_file_;
+}
+
+std::vector<std::string> Recorder::files() const {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(directory_, ec)) {
+    const auto name = entry.path().filename().string();
+    if (isRecordingFileName(name, stem_, extension_)) names.push_back(name);
+  }
+  std::sort(names.begin(), names.end());
+  std::vector<std::string> paths;
+  for (const auto& n : names) paths.push_back((fs::path(directory_) / n).string());
+  return paths;
+}
+
+void Recorder::writerLoop() {
+  const auto interval = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(options_.flush_interval_s));
+  auto next = std::chrono::steady_clock::now() + interval;
+  std::unique_lock lock(wake_mutex_);
+  while (true) {
+    wake_.wait_until(lock, next, [&] { return stopping_ || flush_requests_ != flushes_done_; });
+    if (stopping_) break;
+    const auto requested = flush_requests_;
+    lock.unlock();
+    flushOnce(false);
+    lock.lock();
+    flushes_done_ = requested;
+    flushed_.notify_all();
+    const auto now = std::chrono::steady_clock::now();
+    if (now >= next) next = now + interval;
+  }
+}
+
+void Recorder::flushOnce(bool final_flush) {
+  if (options_.rotate_after_s > 0.0 && fd_ >= 0 && file_records_ > 0 &&
+      static_cast<double>(steadyNowNs() - file_opened_ns_) >= options_.rotate_after_s * 1e9) {
+    const auto previous = fs::path(currentFile()).filename().string();
+    closeFile();
+    openNextFile(previous);
+  }
+
+  std::array<char, 256> buf{};
+  char* const end = buf.data() + buf.size();
+  RecorderRecord r;
+  const auto dropLine = [&](std::uint64_t count) {
+    char* p = putText(buf.data(), "# DROPPED count=");
+    p = putUnsigned(p, end, count);
+    p = putText(p, " reason=ring_full\n");
+    appendLine(std::string_view(buf.data(), static_cast<std::size_t>(p - buf.data())), false);
+    drops_reported_ += count;
+  };
+  while (ring_.tryPop(r)) {
+    if (r.dropped_before > 0) dropLine(r.dropped_before);
+    char* p = buf.data();
+    bool record = true;
+    if (r.kind == RecorderRecord::Kind::Gap) {
+      p = putText(p, "# GAP seq=");
+      p = putUnsigned(p, end, r.gap_seq);
+      p = putText(p, " t=");
+      p = putNumber(p, end, r.t_s);
+      p = putText(p, " count=");
+      p = putUnsigned(p, end, r.gap_count);
+      p = putText(p, " reason=");
+      p = putText(p, r.gap_reason[0] ? std::string_view(r.gap_reason) : std::string_view("unknown"));
+    } else {
+      const bool finite = std::isfinite(r.t_s) && std::isfinite(r.gx_dps) && std::isfinite(r.gy_dps) &&
+                          std::isfinite(r.gz_dps) && std::isfinite(r.temp_c);
+      // The reader rejects non-finite values; keep the file readable and say what came.
+      if (!finite) p = putText(p, "# NONFINITE ");
+      for (double v : {r.t_s, r.gx_dps, r.gy_dps, r.gz_dps, r.temp_c}) {
+        if (p != buf.data() && p[-1] != ' ') *p++ = ',';
+        p = putNumber(p, end, v);
+      }
+    }
+    *p++ = '\n';
+    appendLine(std::string_view(buf.data(), static_cast<std::size_t>(p - buf.data())), record);
+  }
+  if (final_flush) {
+    const auto unreported = dropped_.load(std::memory_order_relaxed) - drops_reported_;
+    if (unreported > 0) dropLine(unreported);
+  }
+  writePending();
+  if (options_.fsync_each_flush && fd_ >= 0 && ::fdatasync(fd_) != 0) reportError("fdatasync", errno);
+  flushes_.fetch_add(1, std::memory_order_release);
+}
+
+void Recorder::appendLine(std::string_view line, bool is_record) {
+  pending_.append(line);
+  pending_lines_.push_back({pending_.size(), is_record});
+}
+
+void Recorder::writePending() {
+  std::size_t begin = 0;
+  for (std::size_t i = 0; i < pending_lines_.size(); ++i) {
+    const auto [line_end, record] = pending_lines_[i];
+    const std::string_view line(pending_.data() + begin, line_end - begin);
+    begin = line_end;
+    if (fd_ < 0 && !openNextFile({})) {
+      // No file to write to (e.g. the directory was removed): these lines are lost.
+      for (std::size_t j = i; j < pending_lines_.size(); ++j)
+        if (pending_lines_[j].record) lost_.fetch_add(1, std::memory_order_relaxed);
+      break;
+    }
+    if (options_.rotate_bytes > 0 && file_records_ + page_records_ > 0 &&
+        file_bytes_ + page_.size() + line.size() > options_.rotate_bytes) {
+      emitPage();
+      const auto previous = fs::path(currentFile()).filename().string();
+      closeFile();
+      if (!openNextFile(previous)) {
+        --i;  // retried (and counted as lost) at the top of the loop
+        begin -= line.size();
+        continue;
+      }
+    }
+    // Keep every line inside one page of the file: pad the rest of the page if it does
+    // not fit. Padding is a comment line ("#" and spaces) or, for one byte, an empty line.
+    const std::size_t room = page_size_ - static_cast<std::size_t>((file_bytes_ + page_.size()) % page_size_);
+    if (line.size() > room) {
+      if (room == 1) {
+        page_.push_back('\n');
+      } else {
+        page_.push_back('#');
+        page_.append(room - 2, ' ');
+        page_.push_back('\n');
+      }
+      emitPage();
+    }
+    page_.append(line);
+    if (record) ++page_records_;
+    if ((file_bytes_ + page_.size()) % page_size_ == 0) emitPage();
+  }
+  emitPage();
+  pending_.clear();
+  pending_lines_.clear();
+}
+
+// Writes page_, which lies within one page of the file, in one write() where possible.
+void Recorder::emitPage() {
+  if (page_.empty()) return;
+  if (fd_ < 0) {
+    lost_.fetch_add(page_records_, std::memory_order_relaxed);
+  } else {
+    std::size_t done = 0;
+    while (done < page_.size()) {
+      const ssize_t n = ::write(fd_, page_.data() + done, page_.size() - done);
+      if (n > 0) {
+        done += static_cast<std::size_t>(n);
+        continue;
+      }
+      if (n < 0 && errno == EINTR) continue;
+      const int error_number = n < 0 ? errno : EIO;
+      // Take back a partial page so the file still ends with a whole line.
+      if (done > 0 && ::ftruncate(fd_, static_cast<off_t>(file_bytes_)) == 0) ::lseek(fd_, static_cast<off_t>(file_bytes_), SEEK_SET);
+      reportError("write to " + currentFile(), error_number);
+      lost_.fetch_add(page_records_, std::memory_order_relaxed);
+      page_.clear();
+      page_records_ = 0;
+      return;
+    }
+    file_bytes_ += page_.size();
+    file_records_ += page_records_;
+    written_.fetch_add(page_records_, std::memory_order_release);
+    if (in_error_) {
+      spdlog::info("recorder: writing to {} again", currentFile());
+      in_error_ = false;
+    }
+  }
+  page_.clear();
+  page_records_ = 0;
+}
+
+bool Recorder::openNextFile(const std::string& previous_name) {
+  const auto now = unixNow();
+  int fd = -1;
+  std::string path;
+  for (int attempt = 0; attempt < 1000; ++attempt) {
+    path = (fs::path(directory_) / recordingFileName(stem_, extension_, now, next_index_++)).string();
+    fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0640);
+    if (fd >= 0 || errno != EEXIST) break;
+  }
+  if (fd < 0) {
+    const int e = errno;
+    reportError("create " + path, e);
+    errno = e;
+    return false;
+  }
+  std::string header = "# gyrod recording, opened " + utcStamp(now, "%Y-%m-%dT%H:%M:%SZ") + "\n";
+  if (!previous_name.empty()) header += "# continues " + previous_name + "\n";
+  for (const auto& c : options_.header_comments) header += "# " + c + "\n";
+  header += kHeader;
+  // One write() of less than a page at offset 0: lands whole or not at all.
+  const ssize_t n = ::write(fd, header.data(), header.size());
+  if (n != static_cast<ssize_t>(header.size())) {
+    const int e = n < 0 ? errno : EIO;
+    ::close(fd);
+    ::unlink(path.c_str());
+    reportError("write header to " + path, e);
+    errno = e;
+    return false;
+  }
+  fd_ = fd;
+  file_bytes_ = header.size();
+  file_records_ = 0;
+  file_opened_ns_ = steadyNowNs();
+  {
+    std::lock_guard lock(file_mutex_);
+    current_file_ = path;
+  }
+  files_opened_.fetch_add(1, std::memory_order_relaxed);
+  spdlog::info("recorder: writing {}", path);
+  pruneOldFiles();
+  return true;
+}
+
+void Recorder::closeFile() {
+  if (fd_ < 0) return;
+  emitPage();
+  // Durable at close: a finished file survives a power cut.
+  if (::fdatasync(fd_) != 0) reportError("fdatasync " + currentFile(), errno);
+  if (::close(fd_) != 0) reportError("close " + currentFile(), errno);
+  fd_ = -1;
+}
+
+void Recorder::pruneOldFiles() {
+  if (options_.keep == 0) return;
+  const auto all = files();
+  const auto current = currentFile();
+  std::size_t count = all.size();
+  for (const auto& f : all) {
+    if (count <= options_.keep) break;
+    if (f == current) continue;
+    std::error_code ec;
+    if (fs::remove(f, ec)) {
+      --count;
+      spdlog::debug("recorder: removed old recording {}", f);
+    } else if (ec) {
+      spdlog::warn("recorder: cannot remove old recording {}: {}", f, ec.message());
+    }
+  }
+}
+
+void Recorder::reportError(const std::string& what, int error_number) {
+  write_errors_.fetch_add(1, std::memory_order_relaxed);
+  // One message per episode: a full disk would otherwise log every flush.
+  if (!in_error_) spdlog::error("recorder: {}: {}", what, std::strerror(error_number));
+  in_error_ = true;
+}
+
+}  // namespace gyrod::daemon
