@@ -1,0 +1,188 @@
+#include "daemon/sample_pipeline.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace gyrod::daemon {
+namespace {
+
+using processing::RollingOverlappingAllan;
+
+// identifyFilterChain fits AR(1) on the mean-filtered still period: fewer samples than
+// this give a φ1 too uncertain to run a filter on (standard error ≈ 1/√n ≈ 0.1).
+constexpr std::size_t kMinimumIdentificationSamples = 100;
+
+RollingOverlappingAllan makeAllan(const PipelineSettings& s) {
+  if (s.allan_cluster_sizes.empty()) return RollingOverlappingAllan(s.allan_window_samples);
+  return RollingOverlappingAllan(s.allan_window_samples, s.allan_cluster_sizes);
+}
+
+std::array<RollingOverlappingAllan, kAxes> makeAllanArray(const PipelineSettings& s) {
+  return {makeAllan(s), makeAllan(s), makeAllan(s)};
+}
+
+const PipelineSettings& validated(const PipelineSettings& s) {
+  if (!(s.rate_hz > 0.0) || !std::isfinite(s.rate_hz)) throw std::invalid_argument("pipeline: rate must be > 0 Hz");
+  if (!(s.still_seconds >= 0.0) || !std::isfinite(s.still_seconds))
+    throw std::invalid_argument("pipeline: still period must be >= 0 s");
+  for (double b : s.bias_dps)
+    if (!std::isfinite(b)) throw std::invalid_argument("pipeline: bias values must be finite");
+  return s;
+}
+
+}  // namespace
+
+std::string_view toString(BiasOrigin origin) {
+  switch (origin) {
+    case BiasOrigin::Config: return "config";
+    case BiasOrigin::Model: return "model";
+    case BiasOrigin::Estimate: return "estimate";
+  }
+  return "?";
+}
+
+SamplePipeline::SamplePipeline(const PipelineSettings& settings)
+    : settings_(validated(settings)), allan_raw_(makeAllanArray(settings)), allan_kalman_(makeAllanArray(settings)) {
+  if (settings_.bias_origin != BiasOrigin::Estimate) bias_ = settings_.bias_dps;
+  for (auto& p : params_) {
+    p.mean_window = settings_.mean_window;
+    p.mean_threshold_dps = settings_.mean_threshold_dps;
+  }
+  // Validate the filter settings now rather than at the end of the still period.
+  processing::GrossErrorMeanFilter probe(settings_.mean_window, settings_.mean_threshold_dps);
+  (void)probe;
+  if (needsStillPeriod()) {
+    still_samples_ = static_cast<std::size_t>(std::llround(settings_.still_seconds * settings_.rate_hz));
+    const bool identifying = !(settings_.kalman.a && settings_.kalman.q && settings_.kalman.r);
+    if (identifying && still_samples_ < kMinimumIdentificationSamples) {
+      std::ostringstream msg;
+      msg << "bias.still_seconds = " << settings_.still_seconds << " gives " << still_samples_
+          << " samples at " << settings_.rate_hz << " Hz; identifying the Kalman filter needs at least "
+          << kMinimumIdentificationSamples << " (or give filter.kalman a, q and r)";
+      throw std::invalid_argument(msg.str());
+    }
+    if (still_samples_ == 0) throw std::invalid_argument("bias.still_seconds must give at least one sample to estimate the bias");
+    for (auto& v : still_) v.reserve(still_samples_);
+    phase_ = PipelinePhase::Estimating;
+  } else {
+    for (auto& p : params_) p.kalman = {*settings_.kalman.a, *settings_.kalman.q, *settings_.kalman.r, 0.0, {}};
+    startFilters();
+  }
+}
+
+bool SamplePipeline::needsStillPeriod() const {
+  return settings_.bias_origin == BiasOrigin::Estimate ||
+         !(settings_.kalman.a && settings_.kalman.q && settings_.kalman.r);
+}
+
+double SamplePipeline::stillSecondsNeeded() const {
+  return needsStillPeriod() ? static_cast<double>(still_samples_) / settings_.rate_hz : 0.0;
+}
+
+bool SamplePipeline::kalmanIdentified() const {
+  return !(settings_.kalman.a && settings_.kalman.q && settings_.kalman.r);
+}
+
+void SamplePipeline::startFilters() {
+  chains_.clear();
+  for (std::size_t axis = 0; axis < kAxes; ++axis) chains_.emplace_back(params_[axis]);
+  phase_ = PipelinePhase::Running;
+}
+
+void SamplePipeline::finishEstimation() {
+  for (std::size_t axis = 0; axis < kAxes; ++axis) {
+    auto& x = still_[axis];
+    if (settings_.bias_origin == BiasOrigin::Estimate) {
+      long double sum = 0.0L;
+      for (double v : x) sum += v;
+      bias_[axis] = static_cast<double>(sum / static_cast<long double>(x.size()));
+    }
+    for (double& v : x) v -= bias_[axis];
+    if (kalmanIdentified()) {
+      params_[axis] = processing::identifyFilterChain(x, settings_.mean_window, settings_.mean_threshold_dps,
+                                                      settings_.kalman);
+    } else {
+      params_[axis].kalman = {*settings_.kalman.a, *settings_.kalman.q, *settings_.kalman.r, 0.0, {}};
+    }
+    std::vector<double>().swap(x);  // the still period is over: give the memory back
+  }
+  startFilters();
+}
+
+ProcessedSample SamplePipeline::process(std::uint64_t seq, double t_s, const Vec3& raw_dps, double temp_c) {
+  ProcessedSample out;
+  out.seq = seq;
+  out.t_s = t_s;
+  out.temp_c = temp_c;
+  out.raw = raw_dps;
+  ++processed_;
+  for (std::size_t axis = 0; axis < kAxes; ++axis) allan_raw_[axis].push(raw_dps[axis]);
+  if (phase_ == PipelinePhase::Estimating) {
+    for (std::size_t axis = 0; axis < kAxes; ++axis) still_[axis].push_back(raw_dps[axis]);  // reserved: no allocation
+    if (still_[0].size() >= still_samples_) finishEstimation();
+    return out;
+  }
+  for (std::size_t axis = 0; axis < kAxes; ++axis) {
+    const processing::FilteredRate f = chains_[axis].update(raw_dps[axis] - bias_[axis]);
+    out.mean[axis] = f.mean_dps;
+    out.kalman[axis] = f.kalman_dps;
+    allan_kalman_[axis].push(f.kalman_dps);
+  }
+  out.filtered = true;
+  return out;
+}
+
+void SamplePipeline::discontinuity() {
+  for (auto& c : chains_) c.reset();
+}
+
+void SamplePipeline::reloadFilter(std::size_t mean_window, double mean_threshold_dps,
+                                  const processing::KalmanOverrides& kalman) {
+  processing::GrossErrorMeanFilter probe(mean_window, mean_threshold_dps);  // validates
+  (void)probe;
+  settings_.mean_window = mean_window;
+  settings_.mean_threshold_dps = mean_threshold_dps;
+  if (kalman.a) settings_.kalman.a = kalman.a;
+  if (kalman.q) settings_.kalman.q = kalman.q;
+  if (kalman.r) settings_.kalman.r = kalman.r;
+  for (auto& p : params_) {
+    p.mean_window = mean_window;
+    p.mean_threshold_dps = mean_threshold_dps;
+    if (kalman.a) p.kalman.a = *kalman.a;
+    if (kalman.q) p.kalman.q = *kalman.q;
+    if (kalman.r) p.kalman.r = *kalman.r;
+  }
+  if (phase_ == PipelinePhase::Running) {
+    for (auto& p : params_) processing::ScalarKalmanFilter check(p.kalman);  // validates before replacing
+    startFilters();
+  }
+}
+
+AllanStreams SamplePipeline::allanSnapshot() const {
+  AllanStreams s;
+  s.tau0_s = 1.0 / settings_.rate_hz;
+  s.window_s = static_cast<double>(settings_.allan_window_samples) / settings_.rate_hz;
+  for (std::size_t axis = 0; axis < kAxes; ++axis) {
+    s.raw[axis] = allan_raw_[axis].snapshot(s.tau0_s);
+    s.kalman[axis] = allan_kalman_[axis].snapshot(s.tau0_s);
+  }
+  return s;
+}
+
+void SamplePipeline::refitNoiseTerms() {
+  const double tau0 = 1.0 / settings_.rate_hz;
+  for (std::size_t axis = 0; axis < kAxes; ++axis) {
+    const auto snap = allan_raw_[axis].snapshot(tau0);
+    std::size_t usable = 0;
+    for (const auto& p : snap.window) usable += (p.oadev_terms >= 2 && std::isfinite(p.oadev)) ? 1 : 0;
+    if (usable < 3) continue;  // too early for a fit of five terms to mean anything
+    try {
+      noise_terms_[axis] = processing::fitNoiseTerms(snap.window);
+    } catch (const std::exception&) {
+      noise_terms_[axis].reset();  // e.g. a constant signal: nothing to fit
+    }
+  }
+}
+
+}  // namespace gyrod::daemon

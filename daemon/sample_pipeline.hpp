@@ -1,0 +1,113 @@
+#pragma once
+// What gyrod does with each sample, per axis, in order (issue: "the loop"):
+//   bias removal → mean filter → Kalman (processing/filter_chain.hpp, the same code and
+//   numbers as `gyroctl filter`) → rolling Allan update of the raw and filtered streams.
+// Pure computation: no I/O, no logging, no clock. process() allocates nothing.
+//
+// Where the bias and the Kalman parameters come from (said in STATUS):
+//  - bias: from the config (`bias.source = "config"`), from a model file written by
+//    `gyroctl analyze --write-model` ("model"), or estimated as the mean of the first
+//    `still_seconds` of samples ("estimate");
+//  - A, Q, R: each from the config when given there, else identified over the same still
+//    period, exactly as `gyroctl filter` identifies them from a file (identifyFilterChain).
+// While a still period is needed, samples are published raw only; the filters start on the
+// first sample after it.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "processing/filter_chain.hpp"
+#include "processing/noise_fit.hpp"
+#include "processing/rolling_allan.hpp"
+
+namespace gyrod::daemon {
+
+inline constexpr std::size_t kAxes = 3;
+using Vec3 = std::array<double, kAxes>;
+
+enum class BiasOrigin { Config, Model, Estimate };
+std::string_view toString(BiasOrigin origin);
+
+struct PipelineSettings {
+  double rate_hz = 50.0;
+  BiasOrigin bias_origin = BiasOrigin::Estimate;
+  Vec3 bias_dps{};             // used unless bias_origin == Estimate
+  double still_seconds = 10.0; // estimation period (bias and/or Kalman identification)
+  std::size_t mean_window = 20;
+  double mean_threshold_dps = 0.3;
+  processing::KalmanOverrides kalman;  // given values; the rest are identified
+  std::size_t allan_window_samples = 180000;
+  std::vector<std::size_t> allan_cluster_sizes;  // empty = octave up to half the window
+};
+
+enum class PipelinePhase { Estimating, Running };
+
+struct ProcessedSample {
+  std::uint64_t seq = 0;
+  double t_s = 0.0;
+  double temp_c = 0.0;
+  Vec3 raw{};        // as measured (bias not removed)
+  Vec3 mean{};       // mean filter output on raw − bias
+  Vec3 kalman{};     // Kalman output
+  bool filtered = false;  // false while estimating: mean/kalman not set
+};
+
+struct AllanStreams {
+  double tau0_s = 0.0;
+  double window_s = 0.0;
+  std::array<processing::RollingOverlappingAllan::Snapshot, kAxes> raw, kalman;
+};
+
+class SamplePipeline {
+ public:
+  // Throws std::invalid_argument for settings that cannot work (rate ≤ 0, still period
+  // shorter than needed to identify the filter when something must be identified, ...).
+  explicit SamplePipeline(const PipelineSettings& settings);
+
+  ProcessedSample process(std::uint64_t seq, double t_s, const Vec3& raw_dps, double temp_c);
+
+  // After samples were lost: the filters restart on the next sample (their history is no
+  // longer contiguous). The Allan statistics continue over the delivered samples.
+  void discontinuity();
+
+  // New filter parameters (SIGHUP) without losing the stream: the bias and the identified
+  // values are kept unless the new settings give them; the Allan statistics continue.
+  void reloadFilter(std::size_t mean_window, double mean_threshold_dps, const processing::KalmanOverrides& kalman);
+
+  // Not per sample (allocates): the Allan curves of the window and since start.
+  AllanStreams allanSnapshot() const;
+  // Refit the five noise terms on the window of each raw axis (fitNoiseTerms).
+  void refitNoiseTerms();
+  const std::array<std::optional<processing::NoiseTermFit>, kAxes>& noiseTerms() const { return noise_terms_; }
+
+  PipelinePhase phase() const { return phase_; }
+  const Vec3& bias() const { return bias_; }
+  BiasOrigin biasOrigin() const { return settings_.bias_origin; }
+  // Parameters the filters run with (valid once Running).
+  const std::array<processing::FilterChainParameters, kAxes>& filterParameters() const { return params_; }
+  // Which of A, Q, R were identified from the still period rather than configured.
+  bool kalmanIdentified() const;
+  std::uint64_t samplesProcessed() const { return processed_; }
+  double stillSecondsNeeded() const;
+
+ private:
+  bool needsStillPeriod() const;
+  void finishEstimation();
+  void startFilters();
+
+  PipelineSettings settings_;
+  PipelinePhase phase_ = PipelinePhase::Running;
+  Vec3 bias_{};
+  std::size_t still_samples_ = 0;
+  std::array<std::vector<double>, kAxes> still_;  // reserved once
+  std::array<processing::FilterChainParameters, kAxes> params_{};
+  std::vector<processing::AxisFilterChain> chains_;  // kAxes, built at start and on reload
+  std::array<processing::RollingOverlappingAllan, kAxes> allan_raw_, allan_kalman_;
+  std::array<std::optional<processing::NoiseTermFit>, kAxes> noise_terms_;
+  std::uint64_t processed_ = 0;
+};
+
+}  // namespace gyrod::daemon

@@ -1,0 +1,194 @@
+// The daemon's per-sample pipeline runs exactly the offline chain of `gyroctl filter`
+// (identifyFilterChain + AxisFilterChain) on raw − bias, and its rolling Allan statistics
+// equal the batch computation on the same samples.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "daemon/sample_pipeline.hpp"
+#include "processing/allan.hpp"
+
+using namespace gyrod::daemon;
+using namespace gyrod::processing;
+
+namespace {
+
+struct Stream {
+  std::array<std::vector<double>, kAxes> x;
+};
+
+Stream noisyStream(std::size_t n, unsigned seed, const Vec3& bias) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  Stream s;
+  for (std::size_t axis = 0; axis < kAxes; ++axis) {
+    double walk = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      walk += 0.001 * noise(rng);
+      double v = bias[axis] + walk + noise(rng);
+      if (u(rng) < 0.01) v += 1.5;  // gross errors for the mean filter to reject
+      s.x[axis].push_back(v);
+    }
+  }
+  return s;
+}
+
+PipelineSettings baseSettings() {
+  PipelineSettings p;
+  p.rate_hz = 50.0;
+  p.allan_window_samples = 2048;
+  return p;
+}
+
+}  // namespace
+
+TEST(SamplePipeline, ConfiguredBiasAndKalmanRunTheOfflineChainFromTheFirstSample) {
+  const Vec3 bias{1.5, -0.25, 0.125};
+  const Stream s = noisyStream(3000, 1, bias);
+  PipelineSettings p = baseSettings();
+  p.bias_origin = BiasOrigin::Config;
+  p.bias_dps = bias;
+  p.kalman = {-0.2855, 0.0577, 0.0667};
+  SamplePipeline pipeline(p);
+  EXPECT_EQ(pipeline.phase(), PipelinePhase::Running);
+  EXPECT_FALSE(pipeline.kalmanIdentified());
+
+  std::array<AxisFilterChain, kAxes> reference = {
+      AxisFilterChain({20, 0.3, {-0.2855, 0.0577, 0.0667, 0.0, {}}}),
+      AxisFilterChain({20, 0.3, {-0.2855, 0.0577, 0.0667, 0.0, {}}}),
+      AxisFilterChain({20, 0.3, {-0.2855, 0.0577, 0.0667, 0.0, {}}})};
+  for (std::size_t i = 0; i < 3000; ++i) {
+    const Vec3 raw{s.x[0][i], s.x[1][i], s.x[2][i]};
+    const ProcessedSample out = pipeline.process(i, i / 50.0, raw, 30.0);
+    ASSERT_TRUE(out.filtered);
+    EXPECT_EQ(out.raw, raw);
+    for (std::size_t axis = 0; axis < kAxes; ++axis) {
+      const FilteredRate f = reference[axis].update(raw[axis] - bias[axis]);
+      ASSERT_EQ(out.mean[axis], f.mean_dps) << i;
+      ASSERT_EQ(out.kalman[axis], f.kalman_dps) << i;
+    }
+  }
+}
+
+TEST(SamplePipeline, EstimatesBiasAndIdentifiesKalmanOverTheStillPeriod) {
+  const Vec3 bias{0.75, -1.0, 2.0};
+  const Stream s = noisyStream(2000, 2, bias);
+  PipelineSettings p = baseSettings();
+  p.bias_origin = BiasOrigin::Estimate;
+  p.still_seconds = 10.0;  // 500 samples
+  p.kalman.r = 0.05;       // R given, A and Q identified
+  SamplePipeline pipeline(p);
+  EXPECT_EQ(pipeline.phase(), PipelinePhase::Estimating);
+  for (std::size_t i = 0; i < 500; ++i) {
+    const ProcessedSample out = pipeline.process(i, i / 50.0, {s.x[0][i], s.x[1][i], s.x[2][i]}, 25.0);
+    EXPECT_EQ(out.filtered, false);
+  }
+  ASSERT_EQ(pipeline.phase(), PipelinePhase::Running);
+  for (std::size_t axis = 0; axis < kAxes; ++axis) {
+    std::vector<double> still(s.x[axis].begin(), s.x[axis].begin() + 500);
+    double mean = 0.0;
+    for (double v : still) mean += v;
+    mean /= 500.0;
+    EXPECT_NEAR(pipeline.bias()[axis], mean, 1e-12);
+    for (double& v : still) v -= pipeline.bias()[axis];
+    const FilterChainParameters expected = identifyFilterChain(still, 20, 0.3, {std::nullopt, std::nullopt, 0.05});
+    EXPECT_EQ(pipeline.filterParameters()[axis].kalman.a, expected.kalman.a);
+    EXPECT_EQ(pipeline.filterParameters()[axis].kalman.q, expected.kalman.q);
+    EXPECT_EQ(pipeline.filterParameters()[axis].kalman.r, 0.05);
+  }
+}
+
+TEST(SamplePipeline, FilteredOutputAfterEstimationEqualsTheOfflineChain) {
+  const Vec3 bias{0.5, 0.5, 0.5};
+  const Stream s = noisyStream(1500, 3, bias);
+  PipelineSettings p = baseSettings();
+  p.still_seconds = 4.0;  // 200 samples
+  SamplePipeline pipeline(p);
+  std::vector<ProcessedSample> outs;
+  for (std::size_t i = 0; i < 1500; ++i) outs.push_back(pipeline.process(i, i / 50.0, {s.x[0][i], s.x[1][i], s.x[2][i]}, 25.0));
+  for (std::size_t axis = 0; axis < kAxes; ++axis) {
+    AxisFilterChain reference(pipeline.filterParameters()[axis]);
+    for (std::size_t i = 200; i < 1500; ++i) {
+      ASSERT_TRUE(outs[i].filtered);
+      const FilteredRate f = reference.update(s.x[axis][i] - pipeline.bias()[axis]);
+      ASSERT_EQ(outs[i].kalman[axis], f.kalman_dps) << "axis " << axis << " sample " << i;
+    }
+  }
+}
+
+TEST(SamplePipeline, RollingAllanEqualsBatchOnTheWindow) {
+  const Stream s = noisyStream(5000, 4, {0.1, 0.2, 0.3});
+  PipelineSettings p = baseSettings();
+  p.bias_origin = BiasOrigin::Config;
+  p.kalman = {0.5, 0.01, 0.02};
+  SamplePipeline pipeline(p);
+  std::vector<double> kalman_x;
+  for (std::size_t i = 0; i < 5000; ++i)
+    kalman_x.push_back(pipeline.process(i, i / 50.0, {s.x[0][i], s.x[1][i], s.x[2][i]}, 25.0).kalman[0]);
+  const AllanStreams a = pipeline.allanSnapshot();
+  EXPECT_DOUBLE_EQ(a.window_s, 2048 / 50.0);
+  const std::span<const double> last_raw(s.x[0].data() + 5000 - 2048, 2048);
+  const std::span<const double> last_kalman(kalman_x.data() + 5000 - 2048, 2048);
+  ASSERT_FALSE(a.raw[0].window.empty());
+  for (const AllanPoint& pt : a.raw[0].window)
+    EXPECT_NEAR(pt.oadev, std::sqrt(overlappingAllanVariance(last_raw, pt.m)), 1e-9 * pt.oadev) << pt.m;
+  for (const AllanPoint& pt : a.kalman[0].window)
+    EXPECT_NEAR(pt.oadev, std::sqrt(overlappingAllanVariance(last_kalman, pt.m)), 1e-9 * pt.oadev) << pt.m;
+  for (const AllanPoint& pt : a.raw[1].since_start)
+    EXPECT_NEAR(pt.oadev, std::sqrt(overlappingAllanVariance(s.x[1], pt.m)), 1e-9 * pt.oadev) << pt.m;
+  pipeline.refitNoiseTerms();
+  ASSERT_TRUE(pipeline.noiseTerms()[0].has_value());
+  // The stream is white noise plus 1 % spikes plus a slow walk: its white level σ is
+  // estimated from first differences (var(Δx) = 2σ² for white noise), N = 60·σ·√τ0 °/√h.
+  const std::span<const double> w = last_raw;
+  double sd = 0.0;
+  for (std::size_t i = 1; i < w.size(); ++i) sd += (w[i] - w[i - 1]) * (w[i] - w[i - 1]);
+  const double n_expected = 60.0 * std::sqrt(sd / (w.size() - 1) / 2.0) * std::sqrt(0.02);
+  EXPECT_NEAR(pipeline.noiseTerms()[0]->value.arw_deg_per_sqrt_h, n_expected, 0.15 * n_expected);
+}
+
+TEST(SamplePipeline, DiscontinuityRestartsTheFiltersButNotTheStatistics) {
+  PipelineSettings p = baseSettings();
+  p.bias_origin = BiasOrigin::Config;
+  p.kalman = {0.9, 0.001, 0.1};
+  SamplePipeline pipeline(p);
+  for (int i = 0; i < 100; ++i) pipeline.process(i, i / 50.0, {1.0, 1.0, 1.0}, 25.0);
+  pipeline.discontinuity();
+  const ProcessedSample after = pipeline.process(105, 2.1, {-2.0, 0.0, 0.0}, 25.0);
+  // A fresh chain returns its first input: x̂0 = the first mean-filter output = the sample.
+  EXPECT_EQ(after.kalman[0], -2.0);
+  EXPECT_EQ(after.mean[0], -2.0);
+  EXPECT_EQ(pipeline.samplesProcessed(), 101u);
+}
+
+TEST(SamplePipeline, ReloadKeepsTheStreamAndAppliesNewParameters) {
+  PipelineSettings p = baseSettings();
+  p.bias_origin = BiasOrigin::Config;
+  p.kalman = {0.9, 0.001, 0.1};
+  SamplePipeline pipeline(p);
+  for (int i = 0; i < 50; ++i) pipeline.process(i, i / 50.0, {0.1, 0.2, 0.3}, 25.0);
+  pipeline.reloadFilter(5, 0.5, {0.5, std::nullopt, std::nullopt});
+  EXPECT_EQ(pipeline.filterParameters()[0].mean_window, 5u);
+  EXPECT_EQ(pipeline.filterParameters()[0].kalman.a, 0.5);
+  EXPECT_EQ(pipeline.filterParameters()[0].kalman.q, 0.001);
+  EXPECT_EQ(pipeline.samplesProcessed(), 50u);
+  EXPECT_THROW(pipeline.reloadFilter(0, 0.5, {}), std::invalid_argument);
+  EXPECT_EQ(pipeline.filterParameters()[0].mean_window, 5u);  // a bad reload changes nothing
+}
+
+TEST(SamplePipeline, SettingsThatCannotWorkAreRefused) {
+  PipelineSettings p = baseSettings();
+  p.still_seconds = 1.0;  // 50 samples: too few to identify A and Q
+  EXPECT_THROW(SamplePipeline{p}, std::invalid_argument);
+  p.still_seconds = 1.0;
+  p.kalman = {0.5, 0.01, 0.02};
+  EXPECT_NO_THROW(SamplePipeline{p});  // bias only: 50 samples are enough
+  p.rate_hz = 0.0;
+  EXPECT_THROW(SamplePipeline{p}, std::invalid_argument);
+  p = baseSettings();
+  p.mean_window = 0;
+  EXPECT_THROW(SamplePipeline{p}, std::invalid_argument);
+}
