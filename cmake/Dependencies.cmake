@@ -31,3 +31,9 @@ if(GYROD_BUILD_BENCHMARKS)
   find_package(benchmark QUIET)
   gyrod_require(benchmark_FOUND libbenchmark-dev "Google Benchmark (benchmarks)")
 endif()
+
+find_package(spdlog 1.9 QUIET)
+gyrod_require(spdlog_FOUND libspdlog-dev "spdlog (daemon logging)")
+
+pkg_check_modules(LIBSYSTEMD QUIET IMPORTED_TARGET libsystemd)
+gyrod_require(LIBSYSTEMD_FOUND libsystemd-dev "libsystemd (socket activation, sd_notify)")

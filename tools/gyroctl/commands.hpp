@@ -17,5 +17,7 @@ inline constexpr int kExitFailure = 1;   // anything else
 void addAnalyzeCommand(CLI::App& app, CommandRunner& run);
 void addFilterCommand(CLI::App& app, CommandRunner& run);
 void addImportCommand(CLI::App& app, CommandRunner& run);
+// watch, allan, status: talk to a running gyrod over its socket.
+void addClientCommands(CLI::App& app, CommandRunner& run);
 
 }  // namespace gyrod::gyroctl

@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   addAnalyzeCommand(app, run);
   addFilterCommand(app, run);
   addImportCommand(app, run);
+  addClientCommands(app, run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
