@@ -7,8 +7,9 @@
 // that does not fit means the client has stopped reading for longer than the buffer
 // covers (256 KiB ≈ 1,600 RATE lines ≈ 30 s at 50 Hz): it is disconnected, logged and
 // counted (STATUS: clients_dropped, lines_dropped). No client ever sees a gap because of
-// another client, and a client never receives a torn line: what it gets is a prefix of the
-// stream, whole lines only.
+// another client. A dropped client has received a prefix of its stream; its last line may
+// be incomplete if the kernel had taken part of it (docs/protocol.md: a line without its
+// newline at EOF is to be discarded).
 #include <sys/types.h>
 
 #include <cstdint>

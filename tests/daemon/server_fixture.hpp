@@ -99,14 +99,20 @@ class TestClient {
   }
   const std::string& partial() const { return pending_; }
 
+  // Moves what has arrived into the received lines; false once closed by the server.
+  bool collect() {
+    const bool open = drain();
+    for (auto& l : takeLines()) got_.push_back(std::move(l));
+    return open;
+  }
+  std::size_t received() const { return got_.size(); }
+
   // Pumps `loop` until this client has `n` more lines (or the guard passes).
   std::vector<std::string> readLines(EventLoop& loop, std::size_t n) {
     const auto deadline = std::chrono::steady_clock::now() + kHangGuard;
     while (got_.size() < n && std::chrono::steady_clock::now() < deadline) {
       loop.runOnce(1ms);
-      const bool open = drain();
-      for (auto& l : takeLines()) got_.push_back(std::move(l));
-      if (!open) break;
+      if (!collect()) break;
     }
     const std::size_t k = std::min(n, got_.size());
     std::vector<std::string> out(got_.begin(), got_.begin() + static_cast<std::ptrdiff_t>(k));
@@ -140,6 +146,21 @@ class TestClient {
   std::vector<std::string> got_;
   bool closed_ = false;
 };
+
+// Pumps `loop` and reads all `clients` side by side (as independent processes would)
+// until each has received its count of lines.
+inline void collectConcurrently(EventLoop& loop, const std::vector<TestClient*>& clients, const std::vector<std::size_t>& counts) {
+  const auto deadline = std::chrono::steady_clock::now() + kHangGuard;
+  auto done = [&] {
+    for (std::size_t i = 0; i < clients.size(); ++i)
+      if (clients[i]->received() < counts[i] && !clients[i]->closedByServer()) return false;
+    return true;
+  };
+  while (!done() && std::chrono::steady_clock::now() < deadline) {
+    loop.runOnce(1ms);
+    for (TestClient* c : clients) c->collect();
+  }
+}
 
 // ALLAN/STATUS content with values set by the test.
 struct FakeContent : daemon::ServerContent {
@@ -189,12 +210,18 @@ class ServerFixture : public ::testing::Test {
   }
   // Publishes samples first..first+count−1 from a periodic timer, `per_tick` per expiry,
   // as the daemon's data-ready handler would.
-  void publishFromTimer(std::uint64_t first, std::uint64_t count, std::uint64_t per_tick = 1) {
+  // `after_each(k)` runs after sample k is published.
+  void publishFromTimer(std::uint64_t first, std::uint64_t count, std::uint64_t per_tick = 1,
+                        std::function<void(std::uint64_t)> after_each = {}) {
     auto next = std::make_shared<std::uint64_t>(first);
     const std::uint64_t end = first + count;
     auto id = std::make_shared<EventLoop::SourceId>(0);
-    *id = loop_.addPeriodicTimer(200us, [this, next, end, per_tick, id](std::uint64_t) {
-      for (std::uint64_t i = 0; i < per_tick && *next < end; ++i) server_->publishRate(syntheticSample((*next)++));
+    *id = loop_.addPeriodicTimer(200us, [this, next, end, per_tick, id, after_each](std::uint64_t) {
+      for (std::uint64_t i = 0; i < per_tick && *next < end; ++i) {
+        const std::uint64_t k = (*next)++;
+        server_->publishRate(syntheticSample(k));
+        if (after_each) after_each(k);
+      }
       if (*next == end) loop_.removeSource(*id);
     });
   }
