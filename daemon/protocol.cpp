@@ -8,7 +8,8 @@
 namespace gyrod::daemon {
 namespace {
 
-using nlohmann::json;
+// Insertion-ordered, so that "class" comes first in every line, as in gpsd.
+using json = nlohmann::ordered_json;
 
 // Appends to a fixed buffer; the callers size the buffers for their longest line, so an
 // overflow is a programming error that shows as a truncated (and then asserted) line.

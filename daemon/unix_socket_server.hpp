@@ -5,11 +5,11 @@
 // Backpressure policy (gpsd's weakness to avoid: slow clients silently losing data): each
 // client has a preallocated output buffer of ServerOptions::client_buffer_bytes. A line
 // that does not fit means the client has stopped reading for longer than the buffer
-// covers (256 KiB ≈ 1,600 RATE lines ≈ 30 s at 50 Hz): it is disconnected, logged and
-// counted (STATUS: clients_dropped, lines_dropped). No client ever sees a gap because of
-// another client. A dropped client has received a prefix of its stream; its last line may
-// be incomplete if the kernel had taken part of it (docs/protocol.md: a line without its
-// newline at EOF is to be discarded).
+// covers (256 KiB: 750–1 300 RATE lines of 200–350 bytes, 15–25 s at 50 Hz): it is
+// disconnected, logged and counted (STATUS: clients_dropped, lines_dropped). No client
+// ever sees a gap because of another client. A dropped client has received a prefix of
+// its stream; its last line may be incomplete if the kernel had taken part of it
+// (docs/protocol.md: a line without its newline at EOF is to be discarded).
 #include <sys/types.h>
 
 #include <cstdint>
