@@ -19,7 +19,7 @@
 namespace gyrod::daemon {
 namespace {
 
-constexpr int kListenBacklog = 16;
+constexpr int kListenBacklog = 64;
 constexpr int kMaxAcceptsPerWake = 16;
 constexpr int kMaxReadsPerWake = 8;
 constexpr std::size_t kMinClientBufferBytes = 4096;

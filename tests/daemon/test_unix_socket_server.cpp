@@ -248,9 +248,11 @@ TEST_F(ServerTest, StalledClientIsDroppedWhileTheOthersReceiveEveryLine) {
   auto a = watcher();
   auto stalled = watcher();
   auto b = watcher(2);
-  // Enough lines to fill the kernel's socket buffer (a few hundred KiB) and then the
-  // 8 KiB one of the stalled client.
-  const std::uint64_t n = 4000;
+  // Enough lines to fill the kernel's socket buffer and then the 8 KiB one of the
+  // stalled client. The kernel charges each write with its overhead (~1 KiB), so its
+  // default ~208 KiB holds a few hundred one-line writes; 1500 lines leave a wide margin
+  // (the test checks that the drop happened).
+  const std::uint64_t n = 1500;
   std::optional<std::uint64_t> dropped_at;  // the sample that did not fit
   publishFromTimer(0, n, 40, [&](std::uint64_t k) {
     if (!dropped_at && server_->clientCount() == 2) dropped_at = k;
