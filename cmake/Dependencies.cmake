@@ -36,7 +36,10 @@ if(GYROD_BUILD_BENCHMARKS)
 endif()
 
 find_package(tomlplusplus 3 QUIET)
-gyrod_require(tomlplusplus_FOUND libtomlplusplus-dev "toml++ (configuration file)")
+gyrod_require(tomlplusplus_FOUND libtomlplusplus-dev "toml++ (configuration and model files)")
 
-find_package(spdlog QUIET)
-gyrod_require(spdlog_FOUND libspdlog-dev "spdlog (logging)")
+find_package(spdlog 1.9 QUIET)
+gyrod_require(spdlog_FOUND libspdlog-dev "spdlog (daemon logging)")
+
+pkg_check_modules(LIBSYSTEMD QUIET IMPORTED_TARGET libsystemd)
+gyrod_require(LIBSYSTEMD_FOUND libsystemd-dev "libsystemd (socket activation, sd_notify)")

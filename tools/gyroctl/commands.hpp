@@ -18,5 +18,7 @@ void addAnalyzeCommand(CLI::App& app, CommandRunner& run);
 void addFilterCommand(CLI::App& app, CommandRunner& run);
 void addImportCommand(CLI::App& app, CommandRunner& run);
 void addSimulateCommand(CLI::App& app, CommandRunner& run);
+// watch, allan, status: talk to a running gyrod over its socket.
+void addClientCommands(CLI::App& app, CommandRunner& run);
 
 }  // namespace gyrod::gyroctl

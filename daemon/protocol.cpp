@@ -1,0 +1,285 @@
+#include "daemon/protocol.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <nlohmann/json.hpp>
+
+namespace gyrod::daemon {
+namespace {
+
+// Insertion-ordered, so that "class" comes first in every line, as in gpsd.
+using json = nlohmann::ordered_json;
+
+// Appends to a fixed buffer; the callers size the buffers for their longest line, so an
+// overflow is a programming error that shows as a truncated (and then asserted) line.
+class FixedWriter {
+ public:
+  FixedWriter(char* begin, char* end) noexcept : begin_(begin), p_(begin), end_(end) {}
+  void text(std::string_view s) noexcept {
+    const std::size_t n = std::min(s.size(), static_cast<std::size_t>(end_ - p_));
+    std::memcpy(p_, s.data(), n);
+    p_ += n;
+  }
+  void number(std::uint64_t v) noexcept {
+    const auto r = std::to_chars(p_, end_, v);
+    if (r.ec == std::errc()) p_ = r.ptr;
+  }
+  // Shortest representation that reads back as the same double (never "inf"/"nan": the
+  // callers check finiteness first).
+  void number(double v) noexcept {
+    if (v == 0.0 && std::signbit(v)) {  // "-0" would be read back as the integer 0
+      text("-0.0");
+      return;
+    }
+    const auto r = std::to_chars(p_, end_, v);
+    if (r.ec == std::errc()) p_ = r.ptr;
+  }
+  void triple(std::string_view key, const std::array<double, 3>& v) noexcept {
+    if (!(std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]))) return;
+    text(key);
+    number(v[0]);
+    text(",");
+    number(v[1]);
+    text(",");
+    number(v[2]);
+    text("]");
+  }
+  std::size_t size() const noexcept { return static_cast<std::size_t>(p_ - begin_); }
+
+ private:
+  char* begin_;
+  char* p_;
+  char* end_;
+};
+
+bool isReasonToken(std::string_view s) {
+  if (s.empty() || s.size() > kMaxGapReasonBytes) return false;
+  for (const char c : s) {
+    if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_')) return false;
+  }
+  return true;
+}
+
+std::string jsonLine(const json& j) { return j.dump() + '\n'; }
+
+void putIfFinite(json& j, const char* key, const std::optional<double>& v) {
+  if (v && std::isfinite(*v)) j[key] = *v;
+}
+
+const char* jsonTypeName(const json& j) { return j.type_name(); }
+
+}  // namespace
+
+std::size_t formatRateLine(const RateSample& s, std::span<char, kMaxRateLineBytes> out) noexcept {
+  // One byte is kept back for the newline, so it is always there.
+  FixedWriter w(out.data(), out.data() + out.size() - 1);
+  w.text(R"({"class":"RATE","seq":)");
+  w.number(s.seq);
+  if (std::isfinite(s.t_s)) {
+    w.text(R"(,"t":)");
+    w.number(s.t_s);
+  }
+  if (std::isfinite(s.temp_c)) {
+    w.text(R"(,"temp":)");
+    w.number(s.temp_c);
+  }
+  w.triple(R"(,"raw":[)", s.raw_dps);
+  w.triple(R"(,"mean":[)", s.mean_dps);
+  w.triple(R"(,"kalman":[)", s.kalman_dps);
+  w.text("}");
+  const std::size_t n = w.size();
+  out[n] = '\n';
+  return n + 1;
+}
+
+std::size_t formatGapLine(const GapEvent& gap, std::span<char, kMaxGapLineBytes> out) {
+  if (gap.count == 0) throw std::invalid_argument("GAP: count must be >= 1 (a gap of 0 samples is no gap)");
+  if (!isReasonToken(gap.reason))
+    throw std::invalid_argument("GAP: reason '" + std::string(gap.reason) + "' is not a token of 1.." +
+                                std::to_string(kMaxGapReasonBytes) + " characters [a-z0-9_]");
+  FixedWriter w(out.data(), out.data() + out.size() - 1);
+  w.text(R"({"class":"GAP","seq":)");
+  w.number(gap.first_missing_seq);
+  w.text(R"(,"count":)");
+  w.number(gap.count);
+  w.text(R"(,"reason":")");
+  w.text(gap.reason);
+  w.text("\"}");
+  const std::size_t n = w.size();
+  out[n] = '\n';
+  return n + 1;
+}
+
+std::string versionLine(std::string_view release) {
+  return jsonLine({{"class", "VERSION"}, {"release", release}, {"proto_major", kProtocolMajor}, {"proto_minor", kProtocolMinor}});
+}
+
+std::string watchLine(bool enable, std::uint32_t decimate) {
+  return jsonLine({{"class", "WATCH"}, {"enable", enable}, {"decimate", decimate}});
+}
+
+std::string_view errorCodeName(ErrorCode code) {
+  switch (code) {
+    case ErrorCode::NotJson: return "not_json";
+    case ErrorCode::NotObject: return "not_object";
+    case ErrorCode::MissingField: return "missing_field";
+    case ErrorCode::BadType: return "bad_type";
+    case ErrorCode::UnknownCommand: return "unknown_cmd";
+    case ErrorCode::UnknownField: return "unknown_field";
+    case ErrorCode::OutOfRange: return "out_of_range";
+    case ErrorCode::LineTooLong: return "line_too_long";
+    case ErrorCode::TooManyClients: return "too_many_clients";
+    case ErrorCode::Internal: return "internal";
+  }
+  return "internal";
+}
+
+std::string errorLine(ErrorCode code, std::string_view message) {
+  // The message may quote client bytes that are not UTF-8: replace them, never throw.
+  return json({{"class", "ERROR"}, {"code", errorCodeName(code)}, {"message", message}})
+             .dump(-1, ' ', false, json::error_handler_t::replace) + '\n';
+}
+
+std::string allanLine(const AllanReport& r) {
+  const std::size_t n = r.tau_s.size();
+  for (std::size_t a = 0; a < 3; ++a)
+    for (std::size_t s = 0; s < 3; ++s) {
+      const auto& c = r.curves[a][s].adev_dps;
+      if (!c.empty() && c.size() != n)
+        throw std::invalid_argument("ALLAN: curve " + std::string(kAxisNames[a]) + "/" + std::string(kStreamNames[s]) + " has " +
+                                    std::to_string(c.size()) + " values for " + std::to_string(n) + " taus");
+    }
+  // Keep τ only where every computed curve has a value.
+  std::vector<std::size_t> keep;
+  for (std::size_t i = 0; i < n; ++i) {
+    bool ok = std::isfinite(r.tau_s[i]);
+    for (const auto& axis : r.curves)
+      for (const auto& curve : axis)
+        if (!curve.adev_dps.empty() && !std::isfinite(curve.adev_dps[i])) ok = false;
+    if (ok) keep.push_back(i);
+  }
+  json j = {{"class", "ALLAN"}, {"samples", r.samples}};
+  if (std::isfinite(r.window_s)) j["window"] = r.window_s;
+  if (std::isfinite(r.tau0_s) && r.tau0_s > 0.0) j["tau0"] = r.tau0_s;
+  json taus = json::array();
+  for (const std::size_t i : keep) taus.push_back(r.tau_s[i]);
+  j["tau"] = std::move(taus);
+  json adev = json::object();
+  json noise = json::object();
+  for (std::size_t a = 0; a < 3; ++a) {
+    json axis_adev = json::object();
+    json axis_noise = json::object();
+    for (std::size_t s = 0; s < 3; ++s) {
+      const AllanCurve& c = r.curves[a][s];
+      const std::string stream(kStreamNames[s]);
+      if (!c.adev_dps.empty()) {
+        json values = json::array();
+        for (const std::size_t i : keep) values.push_back(c.adev_dps[i]);
+        axis_adev[stream] = std::move(values);
+      }
+      if (c.noise) {
+        json terms = json::object();
+        for (const auto t : processing::kAllNoiseTerms) {
+          const double v = c.noise->get(t);
+          if (std::isfinite(v)) terms[std::string(processing::noiseTermKey(t))] = v;
+        }
+        if (!terms.empty()) axis_noise[stream] = std::move(terms);
+      }
+    }
+    if (!axis_adev.empty()) adev[std::string(kAxisNames[a])] = std::move(axis_adev);
+    if (!axis_noise.empty()) noise[std::string(kAxisNames[a])] = std::move(axis_noise);
+  }
+  j["adev"] = std::move(adev);
+  if (!noise.empty()) j["noise"] = std::move(noise);
+  return jsonLine(j);
+}
+
+std::string statusLine(const StatusReport& d, const ServerStatus& s) {
+  json j = {{"class", "STATUS"},
+            {"uptime", d.uptime_s},
+            {"samples", d.samples},
+            {"gaps", d.gaps},
+            {"missing", d.missing_samples},
+            {"bus_errors", d.bus_errors},
+            {"resets", d.resets},
+            {"device_state", d.device_state}};
+  if (!std::isfinite(d.uptime_s)) j.erase("uptime");
+  if (d.device) j["device"] = *d.device;
+  putIfFinite(j, "rate", d.rate_hz);
+  putIfFinite(j, "nominal_rate", d.nominal_rate_hz);
+  putIfFinite(j, "temp", d.temp_c);
+  if (d.bias_source) j["bias_source"] = *d.bias_source;
+  if (d.recording) j["recording"] = *d.recording;
+  j["clients"] = s.clients;
+  j["clients_total"] = s.clients_total;
+  j["clients_dropped"] = s.clients_dropped;
+  j["lines_dropped"] = s.lines_dropped;
+  j["client_buffer"] = s.client_buffer_bytes;
+  json list = json::array();
+  for (const ClientStatus& c : s.client_list) {
+    json e = {{"id", c.id},
+              {"watch", c.watch},
+              {"decimate", c.decimate},
+              {"lines_queued", c.lines_queued},
+              {"lines_sent", c.lines_sent},
+              {"buffered", c.buffered_bytes}};
+    if (c.pid) e["pid"] = *c.pid;
+    if (c.uid) e["uid"] = *c.uid;
+    if (c.self) e["self"] = true;
+    list.push_back(std::move(e));
+  }
+  j["client_list"] = std::move(list);
+  return json(j).dump(-1, ' ', false, json::error_handler_t::replace) + '\n';
+}
+
+Request parseRequest(std::string_view line) {
+  const json j = json::parse(line.begin(), line.end(), nullptr, /*allow_exceptions=*/false);
+  if (j.is_discarded()) throw ProtocolError(ErrorCode::NotJson, "the line is not valid JSON");
+  if (!j.is_object()) throw ProtocolError(ErrorCode::NotObject, std::string("expected a JSON object, got ") + jsonTypeName(j));
+  const auto cmd_it = j.find("cmd");
+  if (cmd_it == j.end()) throw ProtocolError(ErrorCode::MissingField, "no \"cmd\" field");
+  if (!cmd_it->is_string())
+    throw ProtocolError(ErrorCode::BadType, std::string("\"cmd\" must be a string, got ") + jsonTypeName(*cmd_it));
+  const std::string& cmd = cmd_it->get_ref<const std::string&>();
+
+  auto rejectOtherFields = [&](std::initializer_list<std::string_view> allowed) {
+    for (auto it = j.begin(); it != j.end(); ++it) {
+      bool known = it.key() == "cmd";
+      for (const auto a : allowed) known = known || it.key() == a;
+      if (!known) throw ProtocolError(ErrorCode::UnknownField, "\"" + cmd + "\" takes no field \"" + it.key() + "\"");
+    }
+  };
+
+  if (cmd == "watch") {
+    rejectOtherFields({"enable", "decimate"});
+    WatchRequest w;
+    if (const auto it = j.find("enable"); it != j.end()) {
+      if (!it->is_boolean())
+        throw ProtocolError(ErrorCode::BadType, std::string("\"enable\" must be true or false, got ") + jsonTypeName(*it));
+      w.enable = it->get<bool>();
+    }
+    if (const auto it = j.find("decimate"); it != j.end()) {
+      if (!it->is_number_integer())
+        throw ProtocolError(ErrorCode::BadType, std::string("\"decimate\" must be an integer, got ") +
+                                                    (it->is_number_float() ? std::string("a fractional number") : jsonTypeName(*it)));
+      const bool in_range = it->is_number_unsigned() && it->get<std::uint64_t>() >= 1 && it->get<std::uint64_t>() <= kMaxDecimate;
+      if (!in_range)
+        throw ProtocolError(ErrorCode::OutOfRange,
+                            "\"decimate\" must be in 1.." + std::to_string(kMaxDecimate) + ", got " + it->dump());
+      w.decimate = static_cast<std::uint32_t>(it->get<std::uint64_t>());
+    }
+    return w;
+  }
+  if (cmd == "allan") {
+    rejectOtherFields({});
+    return AllanRequest{};
+  }
+  if (cmd == "status") {
+    rejectOtherFields({});
+    return StatusRequest{};
+  }
+  throw ProtocolError(ErrorCode::UnknownCommand, "unknown cmd \"" + cmd + "\" (known: watch, allan, status)");
+}
+
+}  // namespace gyrod::daemon

@@ -1,0 +1,166 @@
+#pragma once
+// The gyrod socket protocol (docs/protocol.md is the reference for every field and unit).
+// gpsd style: server → client one JSON object per line, each with a "class"; fields that
+// have no value are omitted, never null. Client → server one JSON object per line with a
+// "cmd". This header is the single place where the wire format is written down in code:
+// the server formats with it, gyroctl and the tests read what it writes.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "processing/noise_terms.hpp"
+
+namespace gyrod::daemon {
+
+inline constexpr int kProtocolMajor = 1;  // incompatible changes
+inline constexpr int kProtocolMinor = 0;  // compatible additions (new classes, new fields)
+
+// A client line longer than this (not counting the '\n' and an optional '\r') is refused
+// with an ERROR and the client is disconnected.
+inline constexpr std::size_t kMaxRequestLineBytes = 4096;
+inline constexpr std::uint32_t kMaxDecimate = 1'000'000;
+
+inline constexpr std::array<std::string_view, 3> kAxisNames = {"x", "y", "z"};
+inline constexpr std::array<std::string_view, 3> kStreamNames = {"raw", "mean", "kalman"};
+
+// ---- server → client: per-sample lines (formatted without heap allocation) -------------
+
+// One sample of the three axes after each stage of the chain.
+struct RateSample {
+  std::uint64_t seq = 0;             // sample sequence number, +1 per sample of the device
+  double t_s = 0.0;                  // sample time, CLOCK_MONOTONIC [s]
+  double temp_c = 0.0;               // die temperature [°C]
+  std::array<double, 3> raw_dps{};     // x, y, z angular rate as read [°/s]
+  std::array<double, 3> mean_dps{};    // after the gross-error mean filter [°/s]
+  std::array<double, 3> kalman_dps{};  // after the Kalman filter [°/s]
+};
+
+// Samples that will never come: seq, seq+1, ..., seq+count−1.
+struct GapEvent {
+  std::uint64_t first_missing_seq = 0;
+  std::uint64_t count = 0;
+  // A token, 1..kMaxGapReasonBytes of [a-z0-9_], e.g. "fifo_overflow" (docs/protocol.md).
+  std::string_view reason;
+};
+inline constexpr std::size_t kMaxGapReasonBytes = 48;
+
+// Longest possible RATE line: 11 doubles of ≤ 24 characters in shortest round-trip form,
+// a 20-digit seq, the keys and punctuation (about 110) and the newline, rounded up.
+inline constexpr std::size_t kMaxRateLineBytes = 512;
+inline constexpr std::size_t kMaxGapLineBytes = 160;
+
+// Writes {"class":"RATE",...}\n into `out` and returns its length (newline included).
+// Doubles in shortest round-trip form (std::to_chars): parsing them gives back the very
+// same double. A field with a non-finite value (a whole array if one element is) is
+// omitted, so the line is always valid JSON. Allocates nothing.
+std::size_t formatRateLine(const RateSample& sample, std::span<char, kMaxRateLineBytes> out) noexcept;
+// {"class":"GAP","seq":..,"count":..,"reason":".."}\n. Throws std::invalid_argument for a
+// count of 0 or a reason that is not a token (see GapEvent). Allocates nothing.
+std::size_t formatGapLine(const GapEvent& gap, std::span<char, kMaxGapLineBytes> out);
+
+// ---- server → client: replies (may allocate; not on the per-sample path) ------------
+
+std::string versionLine(std::string_view release);
+std::string watchLine(bool enable, std::uint32_t decimate);
+
+// What ERROR lines name as the problem ("code" field).
+enum class ErrorCode {
+  NotJson,         // the line does not parse as JSON
+  NotObject,       // JSON, but not an object
+  MissingField,    // a required field is absent ("cmd")
+  BadType,         // a field has the wrong JSON type
+  UnknownCommand,  // "cmd" names no command
+  UnknownField,    // a field the command does not take (catches typos)
+  OutOfRange,      // a number outside its range (decimate)
+  LineTooLong,     // over kMaxRequestLineBytes; the client is then disconnected
+  TooManyClients,  // the server is full; the client is then disconnected
+  Internal,        // the daemon could not produce the reply
+};
+std::string_view errorCodeName(ErrorCode code);
+std::string errorLine(ErrorCode code, std::string_view message);
+
+// The Allan statistics of the rolling window, one curve per axis and stream.
+struct AllanCurve {
+  std::vector<double> adev_dps;  // overlapping Allan deviation at each τ [°/s]; empty: not computed
+  std::optional<processing::NoiseTerms> noise;  // fitted IEEE 952 terms (NaN term: not estimated)
+};
+struct AllanReport {
+  double window_s = 0.0;       // time spanned by the samples in the window [s]
+  std::uint64_t samples = 0;   // samples in the window
+  double tau0_s = 0.0;         // sample period [s]
+  std::vector<double> tau_s;   // averaging times [s]
+  std::array<std::array<AllanCurve, 3>, 3> curves;  // [axis x,y,z][stream raw,mean,kalman]
+};
+// Throws std::invalid_argument when a computed curve's length differs from tau_s's. A τ at
+// which some computed curve is not finite is left out of every list (no nulls).
+std::string allanLine(const AllanReport& report);
+
+// What the daemon knows about itself (STATUS); empty optionals are omitted.
+struct StatusReport {
+  double uptime_s = 0.0;              // since the daemon started [s]
+  std::uint64_t samples = 0;          // samples published since start
+  std::uint64_t gaps = 0;             // GAP events since start
+  std::uint64_t missing_samples = 0;  // samples lost in those gaps
+  std::uint64_t bus_errors = 0;       // failed bus transfers
+  std::uint64_t resets = 0;           // device resets (FIFO overflow, silent reset, errors)
+  std::string device_state;           // e.g. "streaming" (docs/protocol.md lists them)
+  std::optional<std::string> device;  // e.g. "/dev/i2c-1@0x68"
+  std::optional<double> rate_hz;          // measured sample rate [Hz]
+  std::optional<double> nominal_rate_hz;  // configured sample rate [Hz]
+  std::optional<double> temp_c;           // latest die temperature [°C]
+  std::optional<std::string> bias_source;  // where the bias subtracted from raw comes from
+  std::optional<std::string> recording;    // file being recorded to
+};
+
+// What the server knows about its clients; added to every STATUS line.
+struct ClientStatus {
+  std::uint64_t id = 0;  // 1, 2, ... in order of connection
+  std::optional<std::int64_t> pid, uid;  // of the peer (SO_PEERCRED)
+  bool watch = false;
+  std::uint32_t decimate = 1;
+  std::uint64_t lines_queued = 0;  // lines put into its output buffer
+  std::uint64_t lines_sent = 0;    // lines completely written to the socket
+  std::size_t buffered_bytes = 0;  // bytes waiting in its output buffer
+  bool self = false;               // the client that asked
+};
+struct ServerStatus {
+  std::size_t clients = 0;              // connected now
+  std::uint64_t clients_total = 0;      // accepted since start
+  std::uint64_t clients_dropped = 0;    // disconnected because their buffer was full
+  std::uint64_t lines_dropped = 0;      // lines those clients never received
+  std::size_t client_buffer_bytes = 0;  // capacity of each client's output buffer
+  std::vector<ClientStatus> client_list;
+};
+std::string statusLine(const StatusReport& daemon, const ServerStatus& server);
+
+// ---- client → server ------------------------------------------------------------------
+
+struct WatchRequest {
+  bool enable = true;
+  std::uint32_t decimate = 1;
+};
+struct AllanRequest {};
+struct StatusRequest {};
+using Request = std::variant<WatchRequest, AllanRequest, StatusRequest>;
+
+// A client line that is not a valid request: what the ERROR line will say.
+class ProtocolError : public std::invalid_argument {
+ public:
+  ProtocolError(ErrorCode code, const std::string& message) : std::invalid_argument(message), code_(code) {}
+  ErrorCode code() const noexcept { return code_; }
+
+ private:
+  ErrorCode code_;
+};
+
+// Parses one line (without its '\n'). Throws ProtocolError saying what is wrong.
+Request parseRequest(std::string_view line);
+
+}  // namespace gyrod::daemon

@@ -1,0 +1,548 @@
+#include "daemon/unix_socket_server.hpp"
+
+#include <fcntl.h>
+#include <grp.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/uio.h>
+#include <sys/un.h>
+#include <systemd/sd-daemon.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <spdlog/spdlog.h>
+#include <stdexcept>
+
+namespace gyrod::daemon {
+namespace {
+
+constexpr int kListenBacklog = 64;
+constexpr int kMaxAcceptsPerWake = 16;
+constexpr int kMaxReadsPerWake = 8;
+constexpr std::size_t kMinClientBufferBytes = 4096;
+// Room for the longest accepted line plus "\r\n".
+constexpr std::size_t kInputBufferBytes = kMaxRequestLineBytes + 2;
+
+std::string singleQuoted(std::string_view s) { return "'" + std::string(s) + "'"; }
+
+sockaddr_un socketAddress(const std::string& path) {
+  sockaddr_un addr{};
+  addr.sun_family = AF_UNIX;
+  if (path.empty()) throw std::invalid_argument("socket path is empty");
+  if (path.size() >= sizeof addr.sun_path)
+    throw std::invalid_argument("socket path " + singleQuoted(path) + " is " + std::to_string(path.size()) +
+                                " bytes long; a Unix socket path must be shorter than " + std::to_string(sizeof addr.sun_path));
+  std::memcpy(addr.sun_path, path.data(), path.size());
+  return addr;
+}
+
+void setNonBlockingCloseOnExec(int fd) {
+  const int fl = ::fcntl(fd, F_GETFL);
+  if (fl < 0 || ::fcntl(fd, F_SETFL, fl | O_NONBLOCK) != 0) throw errnoError("fcntl(O_NONBLOCK)");
+  const int fdfl = ::fcntl(fd, F_GETFD);
+  if (fdfl < 0 || ::fcntl(fd, F_SETFD, fdfl | FD_CLOEXEC) != 0) throw errnoError("fcntl(FD_CLOEXEC)");
+}
+
+gid_t groupId(const std::string& name) {
+  std::vector<char> buf(16384);
+  group gr{};
+  group* found = nullptr;
+  const int rc = ::getgrnam_r(name.c_str(), &gr, buf.data(), buf.size(), &found);
+  if (rc != 0) throw std::system_error(rc, std::generic_category(), "getgrnam_r(" + singleQuoted(name) + ")");
+  if (found == nullptr) throw std::invalid_argument("socket group " + singleQuoted(name) + " does not exist");
+  return gr.gr_gid;
+}
+
+// Is someone accepting connections on the socket file at `path`? Only a refused
+// connection proves the file stale; anything else (success, busy backlog, no permission)
+// is treated as "in use" or reported.
+bool socketIsLive(const std::string& path) {
+  const Fd probe(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
+  if (!probe) throw errnoError("socket(AF_UNIX) for probing " + singleQuoted(path));
+  const sockaddr_un addr = socketAddress(path);
+  if (::connect(probe.get(), reinterpret_cast<const sockaddr*>(&addr), sizeof addr) == 0) return true;
+  if (errno == ECONNREFUSED) return false;
+  if (errno == EAGAIN || errno == EINPROGRESS) return true;  // a full backlog: alive but busy
+  throw errnoError("connect(" + singleQuoted(path) + ") to check whether the socket is in use");
+}
+
+// Preallocated ring of bytes: whole lines in, any prefix out (partial writes).
+class RingBuffer {
+ public:
+  explicit RingBuffer(std::size_t capacity) : data_(new char[capacity]), capacity_(capacity) {}
+  std::size_t size() const noexcept { return size_; }
+  std::size_t free() const noexcept { return capacity_ - size_; }
+  bool empty() const noexcept { return size_ == 0; }
+  // Caller checks free() first.
+  void append(const char* p, std::size_t n) noexcept {
+    const std::size_t tail = (head_ + size_) % capacity_;
+    const std::size_t first = std::min(n, capacity_ - tail);
+    std::memcpy(data_.get() + tail, p, first);
+    std::memcpy(data_.get(), p + first, n - first);
+    size_ += n;
+  }
+  // The buffered bytes as at most two pieces, oldest first.
+  int pieces(std::array<iovec, 2>& iov) const noexcept {
+    if (size_ == 0) return 0;
+    const std::size_t first = std::min(size_, capacity_ - head_);
+    iov[0] = {data_.get() + head_, first};
+    if (first == size_) return 1;
+    iov[1] = {data_.get(), size_ - first};
+    return 2;
+  }
+  // Drops the n oldest bytes; returns how many '\n' they contained (lines completed).
+  std::size_t consume(std::size_t n) noexcept {
+    std::size_t newlines = 0;
+    std::size_t left = n;
+    while (left > 0) {
+      const std::size_t piece = std::min(left, capacity_ - head_);
+      const char* p = data_.get() + head_;
+      const char* end = p + piece;
+      while ((p = static_cast<const char*>(std::memchr(p, '\n', static_cast<std::size_t>(end - p)))) != nullptr) {
+        ++newlines;
+        ++p;
+      }
+      head_ = (head_ + piece) % capacity_;
+      left -= piece;
+    }
+    size_ -= n;
+    if (size_ == 0) head_ = 0;
+    return newlines;
+  }
+
+ private:
+  std::unique_ptr<char[]> data_;
+  std::size_t capacity_;
+  std::size_t head_ = 0;
+  std::size_t size_ = 0;
+};
+
+}  // namespace
+
+// ---- listening socket --------------------------------------------------------------------
+
+ListeningSocket bindListeningSocket(const SocketOptions& options) {
+  namespace fs = std::filesystem;
+  const sockaddr_un addr = socketAddress(options.path);
+  if ((options.mode & ~mode_t{0777}) != 0) throw std::invalid_argument("socket mode " + std::to_string(options.mode) + " has bits outside 0777");
+  // (gid_t)-1 tells chown() to leave the group as it is.
+  const gid_t gid = options.group ? groupId(*options.group) : static_cast<gid_t>(-1);
+
+  const fs::path parent = fs::path(options.path).parent_path();
+  if (!parent.empty()) {
+    std::error_code ec;
+    if (!fs::exists(parent, ec)) {
+      fs::create_directories(parent, ec);
+      if (ec) throw std::system_error(ec, "cannot create the socket folder " + singleQuoted(parent.string()));
+      fs::permissions(parent, fs::perms(0755), ec);
+    }
+  }
+
+  struct stat st{};
+  if (::lstat(options.path.c_str(), &st) == 0) {
+    if (!S_ISSOCK(st.st_mode))
+      throw std::runtime_error(options.path + " exists and is not a socket; refusing to replace it");
+    if (socketIsLive(options.path))
+      throw std::runtime_error(options.path + " is already in use by a running server (is gyrod already running?)");
+    if (::unlink(options.path.c_str()) != 0) throw errnoError("unlink(" + singleQuoted(options.path) + ") of a stale socket");
+    spdlog::info("removed stale socket file {}", options.path);
+  } else if (errno != ENOENT) {
+    throw errnoError("lstat(" + singleQuoted(options.path) + ")");
+  }
+
+  ListeningSocket ls;
+  ls.fd.reset(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
+  if (!ls.fd) throw errnoError("socket(AF_UNIX)");
+  // The file bind() creates gets its mode from the umask: keep it owner-only until the
+  // configured mode and group are in place, so nobody else can connect in between.
+  const mode_t old_umask = ::umask(0177);
+  const int bind_rc = ::bind(ls.fd.get(), reinterpret_cast<const sockaddr*>(&addr), sizeof addr);
+  const int bind_errno = errno;
+  ::umask(old_umask);
+  if (bind_rc != 0) {
+    errno = bind_errno;
+    throw errnoError("bind(" + singleQuoted(options.path) + ")");
+  }
+  ls.path = options.path;
+  auto removeOnError = [&] { ::unlink(options.path.c_str()); };
+  if (options.group && ::chown(options.path.c_str(), static_cast<uid_t>(-1), gid) != 0) {
+    const auto err = errnoError("chown(" + singleQuoted(options.path) + ", group " + singleQuoted(*options.group) + ")");
+    removeOnError();
+    throw err;
+  }
+  if (::chmod(options.path.c_str(), options.mode) != 0) {
+    const auto err = errnoError("chmod(" + singleQuoted(options.path) + ")");
+    removeOnError();
+    throw err;
+  }
+  if (::stat(options.path.c_str(), &st) != 0 || ::listen(ls.fd.get(), kListenBacklog) != 0) {
+    const auto err = errnoError("listen(" + singleQuoted(options.path) + ")");
+    removeOnError();
+    throw err;
+  }
+  ls.device = st.st_dev;
+  ls.inode = st.st_ino;
+  return ls;
+}
+
+std::optional<ListeningSocket> adoptActivatedSocket(std::string_view name) {
+  char** names = nullptr;
+  const int n = ::sd_listen_fds_with_names(/*unset_environment=*/0, &names);
+  std::vector<std::string> fd_names;
+  if (names != nullptr) {
+    for (char** p = names; *p != nullptr; ++p) {
+      fd_names.emplace_back(*p);
+      std::free(*p);
+    }
+    std::free(names);
+  }
+  if (n < 0) throw std::system_error(-n, std::generic_category(), "sd_listen_fds_with_names");
+  if (n == 0) return std::nullopt;
+
+  int chosen = -1;
+  for (int i = 0; i < n && static_cast<std::size_t>(i) < fd_names.size(); ++i)
+    if (fd_names[static_cast<std::size_t>(i)] == name) chosen = SD_LISTEN_FDS_START + i;
+  if (chosen < 0 && n == 1) chosen = SD_LISTEN_FDS_START;
+  if (chosen < 0) {
+    std::string list;
+    for (const auto& s : fd_names) list += (list.empty() ? "" : ", ") + s;
+    throw std::runtime_error("systemd passed " + std::to_string(n) + " sockets (" + list + ") but none is named " +
+                             singleQuoted(name) + " (set FileDescriptorName=" + std::string(name) + " in the socket unit)");
+  }
+  if (::sd_is_socket_unix(chosen, SOCK_STREAM, /*listening=*/1, nullptr, 0) <= 0)
+    throw std::runtime_error("fd " + std::to_string(chosen) + " passed by systemd is not a listening Unix stream socket");
+  ListeningSocket ls;
+  ls.fd.reset(chosen);
+  ls.activated = true;
+  setNonBlockingCloseOnExec(chosen);
+  return ls;
+}
+
+ListeningSocket openListeningSocket(const SocketOptions& options) {
+  if (auto activated = adoptActivatedSocket()) {
+    spdlog::info("using the socket passed by systemd (fd {})", activated->fd.get());
+    return std::move(*activated);
+  }
+  ListeningSocket ls = bindListeningSocket(options);
+  spdlog::info("listening on {}", ls.path);
+  return ls;
+}
+
+// ---- clients -------------------------------------------------------------------------------
+
+struct UnixSocketServer::Client {
+  Client(Fd f, std::uint64_t i, std::size_t buffer_bytes)
+      : fd(std::move(f)), id(i), out(buffer_bytes), in(new char[kInputBufferBytes]) {}
+  Fd fd;
+  std::uint64_t id;
+  std::optional<std::int64_t> pid, uid;
+  RingBuffer out;
+  std::unique_ptr<char[]> in;
+  std::size_t in_used = 0;
+  bool watch = false;
+  std::uint32_t decimate = 1;
+  std::uint32_t countdown = 0;  // RATE lines to skip before the next one is sent
+  bool closing = false;         // no more input; close once the output is flushed
+  bool dead = false;            // to be removed by reapDeadClients()
+  bool epollout = false;        // EPOLLOUT currently requested
+  std::uint64_t lines_queued = 0;
+  std::uint64_t lines_sent = 0;
+};
+
+UnixSocketServer::UnixSocketServer(EventLoop& loop, ListeningSocket listening, ServerContent& content, ServerOptions options)
+    : loop_(loop), listening_(std::move(listening)), content_(content), options_(std::move(options)) {
+  if (!listening_.fd) throw std::invalid_argument("UnixSocketServer: no listening socket");
+  if (options_.client_buffer_bytes < kMinClientBufferBytes)
+    throw std::invalid_argument("UnixSocketServer: client_buffer_bytes = " + std::to_string(options_.client_buffer_bytes) +
+                                " is below the minimum of " + std::to_string(kMinClientBufferBytes));
+  if (options_.max_clients == 0) throw std::invalid_argument("UnixSocketServer: max_clients must be >= 1");
+  // Reserved once, so that adding and removing clients never reallocates the list.
+  clients_.reserve(options_.max_clients);
+  setNonBlockingCloseOnExec(listening_.fd.get());
+  loop_.addFd(listening_.fd.get(), EPOLLIN, [this](std::uint32_t) { onListenerReadable(); });
+}
+
+UnixSocketServer::~UnixSocketServer() {
+  if (accept_pause_timer_) loop_.removeSource(*accept_pause_timer_);
+  for (const auto& c : clients_) loop_.removeFd(c->fd.get());
+  clients_.clear();
+  loop_.removeFd(listening_.fd.get());
+  if (!listening_.path.empty()) {
+    struct stat st{};
+    if (::lstat(listening_.path.c_str(), &st) == 0 && st.st_dev == listening_.device && st.st_ino == listening_.inode)
+      ::unlink(listening_.path.c_str());
+  }
+}
+
+std::size_t UnixSocketServer::watcherCount() const noexcept {
+  return static_cast<std::size_t>(std::count_if(clients_.begin(), clients_.end(), [](const auto& c) { return c->watch && !c->dead; }));
+}
+
+void UnixSocketServer::onListenerReadable() {
+  for (int i = 0; i < kMaxAcceptsPerWake; ++i) {
+    Fd fd(::accept4(listening_.fd.get(), nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC));
+    if (fd) {
+      acceptClient(std::move(fd));
+      continue;
+    }
+    if (errno == EAGAIN || errno == EWOULDBLOCK) return;
+    if (errno == EINTR || errno == ECONNABORTED) continue;
+    if (errno == EMFILE || errno == ENFILE || errno == ENOBUFS || errno == ENOMEM) {
+      // Out of descriptors or memory: the pending connection stays in the backlog and
+      // would wake us at once again. Pause accepting for a moment instead of spinning.
+      spdlog::warn("accept: {}; not accepting clients for 1 s", std::strerror(errno));
+      loop_.modifyFd(listening_.fd.get(), 0);
+      accept_pause_timer_ = loop_.addOneShotTimer(std::chrono::seconds(1), [this](std::uint64_t) {
+        accept_pause_timer_.reset();
+        loop_.modifyFd(listening_.fd.get(), EPOLLIN);
+      });
+      return;
+    }
+    throw errnoError("accept4 on the gyrod socket");
+  }
+}
+
+void UnixSocketServer::acceptClient(Fd fd) {
+  ++clients_total_;
+  if (clients_.size() >= options_.max_clients) {
+    const std::string line = errorLine(ErrorCode::TooManyClients,
+                                       "gyrod serves at most " + std::to_string(options_.max_clients) + " clients at once");
+    [[maybe_unused]] const ssize_t n = ::send(fd.get(), line.data(), line.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
+    spdlog::warn("refused a client: {} clients already connected", clients_.size());
+    return;  // fd closes here
+  }
+  auto client = std::make_unique<Client>(std::move(fd), next_client_id_++, options_.client_buffer_bytes);
+  ucred cred{};
+  socklen_t len = sizeof cred;
+  if (::getsockopt(client->fd.get(), SOL_SOCKET, SO_PEERCRED, &cred, &len) == 0) {
+    client->pid = cred.pid;
+    client->uid = cred.uid;
+  }
+  Client& c = *client;
+  loop_.addFd(c.fd.get(), EPOLLIN, [this, &c](std::uint32_t events) { onClientEvents(c, events); });
+  clients_.push_back(std::move(client));
+  spdlog::info("client {} connected (pid {}, uid {})", c.id, c.pid.value_or(-1), c.uid.value_or(-1));
+  queueLine(c, versionLine(options_.release));
+  reapDeadClients();
+}
+
+void UnixSocketServer::onClientEvents(Client& c, std::uint32_t events) {
+  if (events & EPOLLERR) {
+    c.dead = true;
+  } else {
+    if ((events & EPOLLIN) && !c.closing) readRequests(c);
+    if ((events & EPOLLHUP) && !(events & EPOLLIN)) c.dead = true;  // both directions closed
+    if ((events & EPOLLOUT) && !c.dead) flush(c);
+  }
+  reapDeadClients();
+}
+
+void UnixSocketServer::readRequests(Client& c) {
+  for (int i = 0; i < kMaxReadsPerWake && !c.closing && !c.dead; ++i) {
+    const ssize_t n = ::recv(c.fd.get(), c.in.get() + c.in_used, kInputBufferBytes - c.in_used, 0);
+    if (n == 0) {  // the client will send nothing more; answer what it asked, then close
+      beginClose(c);
+      return;
+    }
+    if (n < 0) {
+      if (errno == EAGAIN || errno == EWOULDBLOCK) return;
+      if (errno == EINTR) continue;
+      spdlog::info("client {}: read failed: {}", c.id, std::strerror(errno));
+      c.dead = true;
+      return;
+    }
+    c.in_used += static_cast<std::size_t>(n);
+    std::size_t start = 0;
+    while (!c.closing && !c.dead) {
+      const void* nl = std::memchr(c.in.get() + start, '\n', c.in_used - start);
+      if (nl == nullptr) break;
+      const std::size_t end = static_cast<std::size_t>(static_cast<const char*>(nl) - c.in.get());
+      std::size_t line_end = end;
+      if (line_end > start && c.in[line_end - 1] == '\r') --line_end;
+      handleLine(c, std::string_view(c.in.get() + start, line_end - start));
+      start = end + 1;
+    }
+    std::memmove(c.in.get(), c.in.get() + start, c.in_used - start);
+    c.in_used -= start;
+    if (c.in_used == kInputBufferBytes && !c.closing && !c.dead) {
+      handleLine(c, std::string_view(c.in.get(), c.in_used));  // reports the over-long line
+    }
+  }
+}
+
+void UnixSocketServer::handleLine(Client& c, std::string_view line) {
+  if (line.size() > kMaxRequestLineBytes) {
+    spdlog::warn("client {}: request line longer than {} bytes; disconnecting it", c.id, kMaxRequestLineBytes);
+    queueLine(c, errorLine(ErrorCode::LineTooLong, "request lines are limited to " + std::to_string(kMaxRequestLineBytes) +
+                                                       " bytes; disconnecting"));
+    beginClose(c);
+    return;
+  }
+  if (line.find_first_not_of(" \t\r") == std::string_view::npos) return;  // blank lines are ignored
+  try {
+    const Request request = parseRequest(line);
+    if (const auto* w = std::get_if<WatchRequest>(&request)) {
+      c.watch = w->enable;
+      c.decimate = w->decimate;
+      c.countdown = 0;  // the next sample is sent, then every decimate-th
+      queueLine(c, watchLine(c.watch, c.decimate));
+    } else if (std::holds_alternative<AllanRequest>(request)) {
+      std::string reply;
+      try {
+        reply = allanLine(content_.allanReport());
+      } catch (const std::exception& e) {
+        spdlog::error("ALLAN reply for client {} failed: {}", c.id, e.what());
+        reply = errorLine(ErrorCode::Internal, std::string("the daemon could not produce ALLAN: ") + e.what());
+      }
+      queueLine(c, reply);
+    } else {
+      std::string reply;
+      try {
+        reply = statusLine(content_.statusReport(), serverStatusFor(&c));
+      } catch (const std::exception& e) {
+        spdlog::error("STATUS reply for client {} failed: {}", c.id, e.what());
+        reply = errorLine(ErrorCode::Internal, std::string("the daemon could not produce STATUS: ") + e.what());
+      }
+      queueLine(c, reply);
+    }
+  } catch (const ProtocolError& e) {
+    queueLine(c, errorLine(e.code(), e.what()));
+  }
+}
+
+void UnixSocketServer::queueLine(Client& c, const char* data, std::size_t size) {
+  if (c.dead) return;
+  if (size > c.out.free()) {
+    dropSlowClient(c, size);
+    return;
+  }
+  c.out.append(data, size);
+  ++c.lines_queued;
+  // Write at once unless the socket is already known to be full (EPOLLOUT pending): most
+  // lines then leave in the same wake-up, and the buffer only holds what the kernel refused.
+  if (!c.epollout) flush(c);
+}
+
+void UnixSocketServer::flush(Client& c) {
+  std::array<iovec, 2> iov{};
+  while (!c.out.empty()) {
+    msghdr msg{};
+    msg.msg_iov = iov.data();
+    msg.msg_iovlen = static_cast<std::size_t>(c.out.pieces(iov));
+    const ssize_t n = ::sendmsg(c.fd.get(), &msg, MSG_NOSIGNAL | MSG_DONTWAIT);
+    if (n > 0) {
+      c.lines_sent += c.out.consume(static_cast<std::size_t>(n));
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) break;
+    // EPIPE, ECONNRESET: the client has gone away.
+    c.dead = true;
+    return;
+  }
+  if (c.closing && c.out.empty()) {
+    c.dead = true;
+    return;
+  }
+  updateInterest(c);
+}
+
+void UnixSocketServer::updateInterest(Client& c) {
+  const bool want_out = !c.out.empty();
+  if (want_out == c.epollout && !c.closing) return;
+  const std::uint32_t events = (c.closing ? 0u : std::uint32_t{EPOLLIN}) | (want_out ? std::uint32_t{EPOLLOUT} : 0u);
+  loop_.modifyFd(c.fd.get(), events);
+  c.epollout = want_out;
+}
+
+void UnixSocketServer::beginClose(Client& c) {
+  c.closing = true;
+  c.watch = false;
+  if (c.out.empty()) {
+    c.dead = true;
+    return;
+  }
+  flush(c);
+}
+
+void UnixSocketServer::dropSlowClient(Client& c, std::size_t line_size) {
+  const std::uint64_t lost = c.lines_queued - c.lines_sent + 1;  // unsent lines, the one that did not fit
+  ++clients_dropped_;
+  lines_dropped_ += lost;
+  spdlog::warn("client {} (pid {}) is not reading: its {} byte buffer cannot take a {} byte line; "
+               "disconnecting it ({} lines not delivered)",
+               c.id, c.pid.value_or(-1), options_.client_buffer_bytes, line_size, lost);
+  c.dead = true;
+}
+
+void UnixSocketServer::reapDeadClients() {
+  const auto first_dead = std::remove_if(clients_.begin(), clients_.end(), [this](const std::unique_ptr<Client>& c) {
+    if (!c->dead) return false;
+    loop_.removeFd(c->fd.get());
+    spdlog::info("client {} disconnected ({} lines sent)", c->id, c->lines_sent);
+    return true;
+  });
+  clients_.erase(first_dead, clients_.end());
+}
+
+void UnixSocketServer::publishRate(const RateSample& sample) {
+  std::array<char, kMaxRateLineBytes> line;
+  const std::size_t n = formatRateLine(sample, line);
+  bool any_dead = false;
+  for (const auto& client : clients_) {
+    Client& c = *client;
+    if (!c.watch || c.dead) continue;
+    if (c.countdown > 0) {
+      --c.countdown;
+      continue;
+    }
+    c.countdown = c.decimate - 1;
+    queueLine(c, line.data(), n);
+    any_dead = any_dead || c.dead;
+  }
+  if (any_dead) reapDeadClients();
+}
+
+void UnixSocketServer::publishGap(const GapEvent& gap) {
+  std::array<char, kMaxGapLineBytes> line;
+  const std::size_t n = formatGapLine(gap, line);
+  bool any_dead = false;
+  for (const auto& client : clients_) {
+    Client& c = *client;
+    if (!c.watch || c.dead) continue;
+    queueLine(c, line.data(), n);
+    any_dead = any_dead || c.dead;
+  }
+  if (any_dead) reapDeadClients();
+}
+
+ServerStatus UnixSocketServer::serverStatusFor(const Client* self) const {
+  ServerStatus s;
+  s.clients_total = clients_total_;
+  s.clients_dropped = clients_dropped_;
+  s.lines_dropped = lines_dropped_;
+  s.client_buffer_bytes = options_.client_buffer_bytes;
+  for (const auto& c : clients_) {
+    if (c->dead) continue;
+    ClientStatus cs;
+    cs.id = c->id;
+    cs.pid = c->pid;
+    cs.uid = c->uid;
+    cs.watch = c->watch;
+    cs.decimate = c->decimate;
+    cs.lines_queued = c->lines_queued;
+    cs.lines_sent = c->lines_sent;
+    cs.buffered_bytes = c->out.size();
+    cs.self = c.get() == self;
+    s.client_list.push_back(cs);
+  }
+  s.clients = s.client_list.size();
+  return s;
+}
+
+ServerStatus UnixSocketServer::serverStatus() const { return serverStatusFor(nullptr); }
+
+}  // namespace gyrod::daemon

@@ -1,0 +1,133 @@
+#pragma once
+// The client side of gyrod: a Unix stream socket, many non-blocking clients, the protocol
+// of daemon/protocol.hpp, and a bounded output buffer per client.
+//
+// Backpressure policy (gpsd's weakness to avoid: slow clients silently losing data): each
+// client has a preallocated output buffer of ServerOptions::client_buffer_bytes. A line
+// that does not fit means the client has stopped reading for longer than the buffer
+// covers (256 KiB: 750–1 300 RATE lines of 200–350 bytes, 15–25 s at 50 Hz): it is
+// disconnected, logged and counted (STATUS: clients_dropped, lines_dropped). No client
+// ever sees a gap because of another client. A dropped client has received a prefix of
+// its stream; its last line may be incomplete if the kernel had taken part of it
+// (docs/protocol.md: a line without its newline at EOF is to be discarded).
+#include <sys/types.h>
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "daemon/event_loop.hpp"
+#include "daemon/fd.hpp"
+#include "daemon/protocol.hpp"
+
+namespace gyrod::daemon {
+
+inline constexpr const char* kDefaultSocketPath = "/run/gyrod/gyrod.sock";
+// FileDescriptorName= of the socket unit that gyrod takes when systemd passes several.
+inline constexpr const char* kActivatedSocketName = "gyrod";
+
+struct SocketOptions {
+  std::string path = kDefaultSocketPath;
+  mode_t mode = 0660;                // permission bits of the socket file (connect needs w)
+  std::optional<std::string> group;  // group owning the socket file (name); none: keep ours
+};
+
+// A listening socket and, when we bound it ourselves, the file to remove at exit.
+struct ListeningSocket {
+  Fd fd;
+  std::string path;            // empty when adopted from systemd (systemd owns the file)
+  dev_t device = 0;            // identity of the file we bound, so that we never remove
+  ino_t inode = 0;             //   a socket that another process bound there later
+  bool activated = false;
+};
+
+// Binds options.path: creates missing parent folders (0755), replaces a stale socket file
+// (one nobody listens on: connect() is refused), refuses a live one (std::runtime_error:
+// "already in use") and anything that is not a socket; the file is never more permissive
+// than 0600 before mode and group are applied. Throws std::invalid_argument for a path too
+// long for sockaddr_un, mode bits outside 0777 or an unknown group; std::system_error when
+// a system call fails (the message names the call and the path).
+ListeningSocket bindListeningSocket(const SocketOptions& options);
+
+// The socket passed by systemd socket activation (sd_listen_fds_with_names), if any: the
+// one named `name` (FileDescriptorName=), or the only one when exactly one is passed.
+// Throws std::runtime_error when fds were passed but none fits, or the chosen one is not
+// a listening Unix stream socket. Other passed fds are left alone. The environment
+// (LISTEN_FDS, ...) is left set so that other names can still be looked up.
+std::optional<ListeningSocket> adoptActivatedSocket(std::string_view name = kActivatedSocketName);
+
+// Socket activation if systemd passed a socket, otherwise bindListeningSocket(options).
+ListeningSocket openListeningSocket(const SocketOptions& options);
+
+// What the daemon answers to "allan" and "status". Not on the per-sample path: may
+// allocate. An exception thrown here becomes an ERROR "internal" line for that client.
+class ServerContent {
+ public:
+  virtual ~ServerContent() = default;
+  virtual AllanReport allanReport() = 0;
+  virtual StatusReport statusReport() = 0;
+};
+
+struct ServerOptions {
+  std::string release = GYROD_RELEASE;         // VERSION "release" (the project version)
+  std::size_t client_buffer_bytes = 256 * 1024;  // per client, preallocated
+  std::size_t max_clients = 32;                  // more are refused with ERROR too_many_clients
+};
+
+class UnixSocketServer {
+ public:
+  // Serves `listening` on `loop`; `content` must outlive the server. Throws
+  // std::invalid_argument for client_buffer_bytes < 4096 or max_clients = 0.
+  UnixSocketServer(EventLoop& loop, ListeningSocket listening, ServerContent& content, ServerOptions options = {});
+  // Disconnects every client and removes the socket file if it is still the one bound.
+  ~UnixSocketServer();
+  UnixSocketServer(const UnixSocketServer&) = delete;
+  UnixSocketServer& operator=(const UnixSocketServer&) = delete;
+
+  // Per sample: formats one RATE line into a stack buffer and copies it into the buffer of
+  // each watching client whose decimation is due. Allocates nothing (a client dropped
+  // here for a full buffer frees its memory and logs, which are not the steady state).
+  void publishRate(const RateSample& sample);
+  // A GAP line to every watching client, whatever its decimation. Throws
+  // std::invalid_argument for a malformed gap (see formatGapLine).
+  void publishGap(const GapEvent& gap);
+
+  ServerStatus serverStatus() const;
+  std::size_t clientCount() const noexcept { return clients_.size(); }
+  std::size_t watcherCount() const noexcept;
+  const std::string& socketPath() const noexcept { return listening_.path; }
+
+ private:
+  struct Client;
+
+  void onListenerReadable();
+  void acceptClient(Fd fd);
+  void onClientEvents(Client& c, std::uint32_t events);
+  void readRequests(Client& c);
+  void handleLine(Client& c, std::string_view line);
+  // Appends a whole line to c's buffer, or drops c if it does not fit.
+  void queueLine(Client& c, const char* data, std::size_t size);
+  void queueLine(Client& c, const std::string& line) { queueLine(c, line.data(), line.size()); }
+  void flush(Client& c);
+  void updateInterest(Client& c);
+  void beginClose(Client& c);
+  void dropSlowClient(Client& c, std::size_t line_size);
+  void reapDeadClients();
+  ServerStatus serverStatusFor(const Client* self) const;
+
+  EventLoop& loop_;
+  ListeningSocket listening_;
+  ServerContent& content_;
+  ServerOptions options_;
+  std::vector<std::unique_ptr<Client>> clients_;
+  std::uint64_t next_client_id_ = 1;
+  std::uint64_t clients_total_ = 0;
+  std::uint64_t clients_dropped_ = 0;
+  std::uint64_t lines_dropped_ = 0;
+  std::optional<EventLoop::SourceId> accept_pause_timer_;
+};
+
+}  // namespace gyrod::daemon

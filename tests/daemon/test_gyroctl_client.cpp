@@ -1,0 +1,292 @@
+// gyroctl watch / allan / status as a user runs them: a real gyroctl process against a
+// server in this test process (the loop is pumped while gyroctl runs).
+#include <fcntl.h>
+#include <grp.h>
+#include <pwd.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+#include <sstream>
+
+#include "server_fixture.hpp"
+
+extern char** environ;
+
+using namespace gyrod;
+using namespace gyrod::test;
+
+namespace {
+
+std::vector<std::string> splitLines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  return lines;
+}
+
+std::vector<std::string> words(const std::string& line) {
+  std::vector<std::string> w;
+  std::istringstream in(line);
+  for (std::string s; in >> s;) w.push_back(s);
+  return w;
+}
+
+std::string fixed(double v, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+
+class GyroctlTest : public ServerFixture {
+ protected:
+  // Starts gyroctl with `args`, pumps our loop until it exits, returns what it printed.
+  // `env`: NAME=value entries replacing or adding to ours; `as_user`: run as this uid
+  // (and its group), which needs root.
+  CommandResult run(const std::vector<std::string>& args, const std::vector<std::string>& env = {},
+                    std::optional<uid_t> as_user = std::nullopt) {
+    const auto out_path = dir_.path() / "out.txt";
+    const auto err_path = dir_.path() / "err.txt";
+    const daemon::Fd out(::open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666));
+    const daemon::Fd err(::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666));
+    const std::string exe = std::string(GYROD_BIN_DIR) + "/gyroctl";
+    std::vector<std::string> argv_s{exe};
+    argv_s.insert(argv_s.end(), args.begin(), args.end());
+    std::vector<std::string> env_s;
+    for (char** e = environ; *e != nullptr; ++e) {
+      const std::string entry(*e);
+      const std::string name = entry.substr(0, entry.find('='));
+      bool replaced = false;
+      for (const auto& mine : env) replaced = replaced || mine.substr(0, mine.find('=')) == name;
+      if (!replaced) env_s.push_back(entry);
+    }
+    env_s.insert(env_s.end(), env.begin(), env.end());
+    std::vector<char*> argv, envp;
+    for (auto& a : argv_s) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    for (auto& e : env_s) envp.push_back(e.data());
+    envp.push_back(nullptr);
+    const passwd* user = as_user ? ::getpwuid(*as_user) : nullptr;
+    const gid_t user_gid = user ? user->pw_gid : 0;
+
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+      ::dup2(out.get(), 1);
+      ::dup2(err.get(), 2);
+      const int devnull = ::open("/dev/null", O_RDONLY);
+      ::dup2(devnull, 0);
+      if (as_user && (::setgroups(0, nullptr) != 0 || ::setgid(user_gid) != 0 || ::setuid(*as_user) != 0)) ::_exit(125);
+      ::execve(exe.c_str(), argv.data(), envp.data());
+      ::_exit(126);
+    }
+    CommandResult result;
+    if (pid < 0) {
+      ADD_FAILURE() << "fork failed";
+      return result;
+    }
+    int status = 0;
+    bool reaped = false;
+    const bool exited = pumpUntil(loop_, [&] { return reaped || (reaped = ::waitpid(pid, &status, WNOHANG) == pid); });
+    if (!exited) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, &status, 0);
+      ADD_FAILURE() << "gyroctl did not finish";
+    }
+    result.exit_status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    result.out = readWholeFile(out_path);
+    result.err = readWholeFile(err_path);
+    return result;
+  }
+
+  // Publishes sample k (k = 0, 1, ...) every 200 µs while someone watches; `after(k)` runs
+  // after each, for GAPs.
+  void publishWhileWatched(std::function<void(std::uint64_t)> after = {}) {
+    auto next = std::make_shared<std::uint64_t>(0);
+    loop_.addPeriodicTimer(200us, [this, next, after](std::uint64_t) {
+      if (server_->watcherCount() == 0) return;
+      const std::uint64_t k = (*next)++;
+      server_->publishRate(syntheticSample(k));
+      if (after) after(k);
+    });
+  }
+};
+
+}  // namespace
+
+TEST_F(GyroctlTest, WatchJsonPassesLinesThroughUnchangedAndStopsAtCount) {
+  startServer();
+  publishWhileWatched();
+  const CommandResult r = run({"watch", "--socket", socketPath(), "--json", "--count", "5"});
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const auto lines = splitLines(r.out);
+  ASSERT_EQ(lines.size(), 7u) << r.out;
+  EXPECT_EQ(json::parse(lines[0])["class"], "VERSION");
+  EXPECT_EQ(json::parse(lines[1]), json::parse(R"({"class":"WATCH","enable":true,"decimate":1})"));
+  for (std::size_t k = 0; k < 5; ++k) {
+    std::array<char, daemon::kMaxRateLineBytes> expected;
+    const std::size_t n = daemon::formatRateLine(syntheticSample(k), expected);
+    EXPECT_EQ(lines[2 + k] + "\n", std::string(expected.data(), n));  // byte for byte
+    expectRateLineCarries(lines[2 + k], syntheticSample(k));
+  }
+}
+
+TEST_F(GyroctlTest, WatchShowsRawAndKalmanPerAxisAndGaps) {
+  startServer();
+  publishWhileWatched([this](std::uint64_t k) {
+    if (k == 1) server_->publishGap({1002, 2, "fifo_overflow"});
+  });
+  const CommandResult r = run({"watch", "--socket", socketPath(), "--count", "3", "--decimate", "2"});
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const auto lines = splitLines(r.out);
+  ASSERT_EQ(lines.size(), 5u) << r.out;  // header, row, gap, row, row
+  const auto header = words(lines[0]);
+  EXPECT_EQ(header.front(), "seq");
+  EXPECT_NE(lines[0].find("kalman z"), std::string::npos);
+  EXPECT_EQ(lines[2], "--- gap: 2 sample(s) missing from seq 1002 (fifo_overflow)");
+  const std::size_t rows[] = {1, 3, 4};
+  for (std::size_t i = 0; i < 3; ++i) {
+    const daemon::RateSample s = syntheticSample(2 * i);  // decimate 2: samples 0, 2, 4
+    const auto w = words(lines[rows[i]]);
+    ASSERT_EQ(w.size(), 8u) << lines[rows[i]];
+    EXPECT_EQ(w[0], std::to_string(s.seq));
+    EXPECT_EQ(w[1], fixed(s.t_s, 3));
+    for (std::size_t a = 0; a < 3; ++a) {
+      EXPECT_EQ(w[2 + a], fixed(s.raw_dps[a], 5)) << lines[rows[i]];
+      EXPECT_EQ(w[5 + a], fixed(s.kalman_dps[a], 5)) << lines[rows[i]];
+    }
+  }
+}
+
+TEST_F(GyroctlTest, StatusHumanAndJson) {
+  content_.status.device_state = "streaming";
+  content_.status.samples = 1234;
+  content_.status.rate_hz = 49.97;
+  content_.status.device = "/dev/i2c-1@0x68";
+  startServer();
+  const CommandResult j = run({"status", "--json"}, {"GYROD_SOCKET=" + socketPath()});  // socket from the environment
+  ASSERT_EQ(j.exit_status, 0) << j.err;
+  const json s = json::parse(j.out);
+  EXPECT_EQ(s["class"], "STATUS");
+  EXPECT_EQ(s["samples"], 1234);
+  EXPECT_EQ(s["rate"].get<double>(), 49.97);
+  ASSERT_EQ(s["client_list"].size(), 1u);
+  EXPECT_EQ(s["client_list"][0]["self"], true);
+
+  const CommandResult h = run({"status", "--socket", socketPath()});
+  ASSERT_EQ(h.exit_status, 0) << h.err;
+  EXPECT_NE(h.out.find(std::string("gyrod ") + GYROD_RELEASE + " (protocol 1.0)"), std::string::npos) << h.out;
+  EXPECT_NE(h.out.find("device_state:    streaming\n"), std::string::npos) << h.out;
+  EXPECT_NE(h.out.find("device:          /dev/i2c-1@0x68\n"), std::string::npos) << h.out;
+  EXPECT_NE(h.out.find("samples:         1234\n"), std::string::npos) << h.out;
+  EXPECT_NE(h.out.find("rate:            49.97 Hz\n"), std::string::npos) << h.out;
+  EXPECT_NE(h.out.find("(this gyroctl)"), std::string::npos) << h.out;
+}
+
+namespace {
+
+daemon::AllanReport exampleAllan() {
+  daemon::AllanReport a;
+  a.window_s = 600.0;
+  a.samples = 30000;
+  a.tau0_s = 0.02;
+  a.tau_s = {0.02, 0.2, 2.0};
+  // White rate noise: σ(τ) ∝ τ^−1/2.
+  for (std::size_t axis = 0; axis < 3; ++axis)
+    for (const double tau : a.tau_s) {
+      a.curves[axis][0].adev_dps.push_back(0.01 * (axis + 1) / std::sqrt(tau / 0.02));
+      a.curves[axis][2].adev_dps.push_back(0.001 * (axis + 1) / std::sqrt(tau / 0.02));
+    }
+  processing::NoiseTerms t;
+  t.quantization_urad = std::numeric_limits<double>::quiet_NaN();
+  t.arw_deg_per_sqrt_h = 0.42;
+  t.bias_instability_deg_per_h = std::numeric_limits<double>::quiet_NaN();
+  t.rrw_deg_per_h_sqrt_h = std::numeric_limits<double>::quiet_NaN();
+  t.rate_ramp_deg_per_h2 = std::numeric_limits<double>::quiet_NaN();
+  a.curves[0][0].noise = t;
+  return a;
+}
+
+}  // namespace
+
+TEST_F(GyroctlTest, AllanTableJsonAndPlot) {
+  content_.allan = exampleAllan();
+  startServer();
+  const CommandResult h = run({"allan", "--socket", socketPath()});
+  ASSERT_EQ(h.exit_status, 0) << h.err;
+  const auto lines = splitLines(h.out);
+  ASSERT_GE(lines.size(), 5u) << h.out;
+  EXPECT_NE(lines[0].find("window 600 s (30000 samples, tau0 0.02 s)"), std::string::npos) << lines[0];
+  const auto head = words(lines[1]);
+  const std::vector<std::string> expected_head = {"tau", "[s]", "x", "raw", "x", "kalman", "y", "raw", "y", "kalman", "z", "raw", "z", "kalman"};
+  EXPECT_EQ(head, expected_head);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const auto w = words(lines[2 + i]);
+    ASSERT_EQ(w.size(), 7u) << lines[2 + i];
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.4e", content_.allan.curves[1][2].adev_dps[i]);
+    EXPECT_EQ(w[4], buf);  // y kalman
+  }
+  EXPECT_NE(h.out.find("x raw: angle random walk N [deg/sqrt(h)] = 0.42"), std::string::npos) << h.out;
+
+  const CommandResult j = run({"allan", "--socket", socketPath(), "--json"});
+  ASSERT_EQ(j.exit_status, 0) << j.err;
+  EXPECT_EQ(j.out, daemon::allanLine(content_.allan));
+
+  const auto png = dir_.path() / "adev.png";
+  const CommandResult p = run({"allan", "--socket", socketPath(), "--plot", png.string()});
+  if (p.err.find("gnuplot is not installed") != std::string::npos) GTEST_SKIP() << "gnuplot is not installed here";
+  ASSERT_EQ(p.exit_status, 0) << p.err;
+  const std::string image = readWholeFile(png);
+  ASSERT_GT(image.size(), 1000u);
+  EXPECT_EQ(image.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+}
+
+TEST_F(GyroctlTest, PlotWithoutGnuplotSaysSoAfterTheTable) {
+  content_.allan = exampleAllan();
+  startServer();
+  const auto png = dir_.path() / "adev.png";
+  const CommandResult r = run({"allan", "--socket", socketPath(), "--plot", png.string()}, {"PATH=/nonexistent-gyrod-test"});
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("gnuplot is not installed (apt-get install gnuplot-nox)"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("tau [s]"), std::string::npos) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(png));
+  const CommandResult bad = run({"allan", "--socket", socketPath(), "--plot", (dir_.path() / "adev.gif").string()});
+  EXPECT_EQ(bad.exit_status, 2);
+  EXPECT_NE(bad.err.find("must end in .png, .svg or .pdf"), std::string::npos) << bad.err;
+}
+
+TEST_F(GyroctlTest, ConnectionProblemsAreExplained) {
+  const std::string missing = (dir_.path() / "none.sock").string();
+  for (const char* cmd : {"watch", "allan", "status"}) {
+    const CommandResult r = run({cmd, "--socket", missing});
+    EXPECT_EQ(r.exit_status, 1) << cmd;
+    EXPECT_EQ(r.err, "gyroctl: " + missing + ": no such socket (is gyrod running?)\n") << cmd;
+    EXPECT_TRUE(r.out.empty());
+  }
+
+  // A socket file nobody listens on (a daemon that crashed).
+  const std::string stale = (dir_.path() / "stale.sock").string();
+  {
+    daemon::SocketOptions so;
+    so.path = stale;
+    daemon::bindListeningSocket(so);
+  }
+  const CommandResult refused = run({"status", "--socket", stale});
+  EXPECT_EQ(refused.exit_status, 1);
+  EXPECT_NE(refused.err.find("connection refused"), std::string::npos) << refused.err;
+
+  // A socket the user may not open (root may open anything, so run as nobody then).
+  daemon::SocketOptions so;
+  so.path = socketPath();
+  so.mode = 0600;
+  server_ = std::make_unique<daemon::UnixSocketServer>(loop_, daemon::bindListeningSocket(so), content_);
+  std::optional<uid_t> as_user;
+  if (::geteuid() == 0) {
+    const passwd* nobody = ::getpwnam("nobody");
+    if (nobody == nullptr) GTEST_SKIP() << "no 'nobody' user to test a permission refusal as";
+    as_user = nobody->pw_uid;
+  }
+  const CommandResult r = run({"status", "--socket", socketPath()}, {}, as_user);
+  EXPECT_EQ(r.exit_status, 1) << r.err;
+  EXPECT_NE(r.err.find(socketPath() + ": permission denied (the socket is for members of group '"), std::string::npos) << r.err;
+}
