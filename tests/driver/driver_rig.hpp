@@ -130,7 +130,7 @@ class DriverRig {
       } else {
         t = std::min(t, polling->nextPollNs());
       }
-      if (auto d = driver.nextDeadlineNs()) t = std::min(t, *d);
+      if (auto d = driver.nextDeadlineNs(); d && !stalled_) t = std::min(t, *d);
       t = std::max(t, clock.nowNs());
       clock.setNs(t);
       mock.sync();
