@@ -43,3 +43,27 @@ gyrod_require(spdlog_FOUND libspdlog-dev "spdlog (daemon logging)")
 
 pkg_check_modules(LIBSYSTEMD QUIET IMPORTED_TARGET libsystemd)
 gyrod_require(LIBSYSTEMD_FOUND libsystemd-dev "libsystemd (socket activation, sd_notify)")
+
+# driver/: libi2c (i2c-tools' SMBus helpers) for /dev/i2c-N, libgpiod v1 for the INT line.
+find_path(I2C_INCLUDE_DIR i2c/smbus.h)
+find_library(I2C_LIBRARY i2c)
+if(I2C_INCLUDE_DIR AND I2C_LIBRARY)
+  set(GYROD_I2C_FOUND TRUE)
+endif()
+gyrod_require(GYROD_I2C_FOUND libi2c-dev "libi2c (i2c/smbus.h, SMBus access to /dev/i2c-N)")
+if(NOT TARGET gyrod::i2c)
+  add_library(gyrod::i2c UNKNOWN IMPORTED)
+  set_target_properties(gyrod::i2c PROPERTIES
+    IMPORTED_LOCATION ${I2C_LIBRARY}
+    INTERFACE_INCLUDE_DIRECTORIES ${I2C_INCLUDE_DIR})
+endif()
+
+# libgpiod's v1 API (gpiod_chip_open_lookup, gpiod_line_request_*_events): 1.6.x is what
+# Debian bookworm and Raspberry Pi OS ship. v2 changed the API completely.
+pkg_check_modules(LIBGPIOD QUIET IMPORTED_TARGET libgpiod>=1.6)
+gyrod_require(LIBGPIOD_FOUND libgpiod-dev "libgpiod 1.6 (GPIO line events for the MPU6050 INT pin)")
+if(LIBGPIOD_VERSION VERSION_GREATER_EQUAL 2)
+  message(FATAL_ERROR
+    "gyrod needs the libgpiod v1 API (1.6.x, Debian bookworm); found libgpiod ${LIBGPIOD_VERSION}.\n"
+    "    apt-get install libgpiod-dev   (on bookworm this is 1.6.3)\n")
+endif()
