@@ -43,7 +43,9 @@ std::string_view toString(BiasOrigin origin) {
 }
 
 SamplePipeline::SamplePipeline(const PipelineSettings& settings)
-    : settings_(validated(settings)), allan_raw_(makeAllanArray(settings)), allan_kalman_(makeAllanArray(settings)) {
+    : settings_(validated(settings)), allan_raw_(makeAllanArray(settings)),
+      allan_mean_(makeAllanArray(settings)),
+      allan_kalman_(makeAllanArray(settings)) {
   if (settings_.bias_origin != BiasOrigin::Estimate) bias_ = settings_.bias_dps;
   for (auto& p : params_) {
     p.mean_window = settings_.mean_window;
@@ -127,6 +129,7 @@ ProcessedSample SamplePipeline::process(std::uint64_t seq, double t_s, const Vec
     const processing::FilteredRate f = chains_[axis].update(raw_dps[axis] - bias_[axis]);
     out.mean[axis] = f.mean_dps;
     out.kalman[axis] = f.kalman_dps;
+    allan_mean_[axis].push(f.mean_dps);
     allan_kalman_[axis].push(f.kalman_dps);
   }
   out.filtered = true;
@@ -165,6 +168,7 @@ AllanStreams SamplePipeline::allanSnapshot() const {
   s.window_s = static_cast<double>(settings_.allan_window_samples) / settings_.rate_hz;
   for (std::size_t axis = 0; axis < kAxes; ++axis) {
     s.raw[axis] = allan_raw_[axis].snapshot(s.tau0_s);
+    s.mean[axis] = allan_mean_[axis].snapshot(s.tau0_s);
     s.kalman[axis] = allan_kalman_[axis].snapshot(s.tau0_s);
   }
   return s;

@@ -1,7 +1,7 @@
 #pragma once
 // What gyrod does with each sample, per axis, in order (issue: "the loop"):
 //   bias removal → mean filter → Kalman (processing/filter_chain.hpp, the same code and
-//   numbers as `gyroctl filter`) → rolling Allan update of the raw and filtered streams.
+//   numbers as `gyroctl filter`) → rolling Allan update of the raw, mean and Kalman streams.
 // Pure computation: no I/O, no logging, no clock. process() allocates nothing.
 //
 // Where the bias and the Kalman parameters come from (said in STATUS):
@@ -58,7 +58,7 @@ struct ProcessedSample {
 struct AllanStreams {
   double tau0_s = 0.0;
   double window_s = 0.0;
-  std::array<processing::RollingOverlappingAllan::Snapshot, kAxes> raw, kalman;
+  std::array<processing::RollingOverlappingAllan::Snapshot, kAxes> raw, mean, kalman;
 };
 
 class SamplePipeline {
@@ -105,7 +105,7 @@ class SamplePipeline {
   std::array<std::vector<double>, kAxes> still_;  // reserved once
   std::array<processing::FilterChainParameters, kAxes> params_{};
   std::vector<processing::AxisFilterChain> chains_;  // kAxes, built at start and on reload
-  std::array<processing::RollingOverlappingAllan, kAxes> allan_raw_, allan_kalman_;
+  std::array<processing::RollingOverlappingAllan, kAxes> allan_raw_, allan_mean_, allan_kalman_;
   std::array<std::optional<processing::NoiseTermFit>, kAxes> noise_terms_;
   std::uint64_t processed_ = 0;
 };

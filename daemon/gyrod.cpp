@@ -1,0 +1,329 @@
+#include "daemon/gyrod.hpp"
+
+#include <spdlog/spdlog.h>
+#include <sys/timerfd.h>
+#include <systemd/sd-daemon.h>
+#include <time.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <limits>
+#include <sstream>
+#include <system_error>
+
+#include "tools/recording/model_toml.hpp"
+
+namespace gyrod::daemon {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// The accelerated mock's virtual clock is pumped from this real-time timer, in steps of
+// at most kMaxVirtualStepNs so that the FIFO (2.5 s at 50 Hz) never overflows in a step.
+constexpr auto kPumpPeriod = std::chrono::milliseconds(10);
+constexpr std::int64_t kMaxVirtualStepNs = 200'000'000;
+
+std::int64_t monotonicNowNs() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+// GAP reasons on the socket are [a-z0-9_] tokens (docs/protocol.md).
+std::string_view protocolGapReason(driver::GapCause cause) {
+  switch (cause) {
+    case driver::GapCause::FifoOverflow: return "fifo_overflow";
+    case driver::GapCause::MisalignedFrames: return "misaligned_frames";
+    case driver::GapCause::TransferError: return "transfer_error";
+    case driver::GapCause::DeviceUnreachable: return "device_unreachable";
+    case driver::GapCause::SilentReset: return "silent_reset";
+    case driver::GapCause::Reinitialised: return "reinitialised";
+  }
+  return "unknown";
+}
+
+spdlog::level::level_enum spdlogLevel(driver::LogLevel level) {
+  switch (level) {
+    case driver::LogLevel::Debug: return spdlog::level::debug;
+    case driver::LogLevel::Info: return spdlog::level::info;
+    case driver::LogLevel::Warning: return spdlog::level::warn;
+    case driver::LogLevel::Error: return spdlog::level::err;
+  }
+  return spdlog::level::info;
+}
+
+Vec3 modelBias(const std::string& path) {
+  const processing::SimulationModel model = recording::readModelToml(path);
+  return {model.axes[0].bias_dps, model.axes[1].bias_dps, model.axes[2].bias_dps};
+}
+
+}  // namespace
+
+PipelineSettings Gyrod::pipelineSettings(const GyrodConfig& c) {
+  PipelineSettings s;
+  s.rate_hz = c.device.rate_hz;
+  switch (c.bias.source) {
+    case BiasSource::Config:
+      s.bias_origin = BiasOrigin::Config;
+      for (std::size_t a = 0; a < kAxes; ++a) s.bias_dps[a] = c.bias.values.at(a);
+      break;
+    case BiasSource::Model:
+      s.bias_origin = BiasOrigin::Model;
+      s.bias_dps = modelBias(c.filter.model);
+      break;
+    case BiasSource::Estimate:
+      s.bias_origin = BiasOrigin::Estimate;
+      break;
+  }
+  s.still_seconds = c.bias.still_seconds;
+  s.mean_window = c.filter.mean_window;
+  s.mean_threshold_dps = c.filter.mean_threshold_dps;
+  s.kalman = {c.filter.kalman.a, c.filter.kalman.q, c.filter.kalman.r};
+  s.allan_window_samples = static_cast<std::size_t>(std::llround(c.allan.window_s * c.device.rate_hz));
+  for (double tau : c.allan.taus_s)
+    s.allan_cluster_sizes.push_back(static_cast<std::size_t>(std::llround(tau * c.device.rate_hz)));
+  return s;
+}
+
+Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
+    : config_(config),
+      config_file_(std::move(config_file)),
+      device_(makeDeviceParts(config)),
+      pipeline_(pipelineSettings(config)) {
+  start_real_ns_ = monotonicNowNs();
+  last_pump_real_ns_ = start_real_ns_;
+
+  SocketOptions socket_options;
+  socket_options.path = config_.socket.path;
+  socket_options.mode = static_cast<mode_t>(config_.socket.mode);
+  if (!config_.socket.group.empty()) socket_options.group = config_.socket.group;
+  ServerOptions server_options;
+  server_options.client_buffer_bytes = config_.socket.client_buffer_kib * 1024;
+  server_ = std::make_unique<UnixSocketServer>(loop_, openListeningSocket(socket_options), *this, server_options);
+
+  if (config_.record.enabled()) {
+    RecorderOptions options = recorderOptions(config_.record, config_.device.rate_hz);
+    options.header_comments.push_back("gyrod " + std::string(GYROD_RELEASE) + " recording of " + device_.description);
+    options.header_comments.push_back("raw rates as read from the chip (bias not removed); GAP lines mark lost samples");
+    recorder_ = std::make_unique<Recorder>(options);
+  }
+
+  auto log = [](driver::LogLevel level, std::string_view message) { spdlog::log(spdlogLevel(level), "{}", message); };
+  driver_ = std::make_unique<driver::Mpu6050Driver>(*device_.bus, *device_.data_ready, *device_.clock, *this,
+                                                    device_.driver_config, log);
+
+  loop_.addSignals({SIGTERM, SIGINT, SIGHUP}, [this](int signal_number) {
+    if (signal_number == SIGHUP) {
+      reload();
+    } else {
+      spdlog::info("{} received: stopping", signal_number == SIGTERM ? "SIGTERM" : "SIGINT");
+      loop_.stop();
+    }
+  });
+
+  if (device_.virtual_clock) {
+    loop_.addPeriodicTimer(kPumpPeriod, [this](std::uint64_t) { pumpVirtualClock(); });
+  } else {
+    loop_.addFd(driver_->pollFd(), EPOLLIN, [this](std::uint32_t) {
+      driver_->onDataReady();
+      rearmDriverTimer();
+    });
+    driver_timer_ = Fd(::timerfd_create(CLOCK_MONOTONIC, TFD_NONBLOCK | TFD_CLOEXEC));
+    if (!driver_timer_) throw std::system_error(errno, std::generic_category(), "timerfd_create");
+    loop_.addFd(driver_timer_.get(), EPOLLIN, [this](std::uint32_t) {
+      std::uint64_t expirations = 0;
+      [[maybe_unused]] const ssize_t n = ::read(driver_timer_.get(), &expirations, sizeof expirations);
+      driver_->onTimer(monotonicNowNs());
+      rearmDriverTimer();
+    });
+  }
+
+  const auto refit = std::chrono::duration_cast<std::chrono::nanoseconds>(
+      std::chrono::duration<double>(config_.allan.refit_interval_s));
+  loop_.addPeriodicTimer(refit, [this](std::uint64_t) { pipeline_.refitNoiseTerms(); });
+
+  if (::sd_watchdog_enabled(0, &watchdog_usec_) > 0 && watchdog_usec_ > 0) {
+    loop_.addPeriodicTimer(std::chrono::microseconds(watchdog_usec_ / 2), [this](std::uint64_t) { petWatchdog(); });
+  } else {
+    watchdog_usec_ = 0;
+  }
+
+  spdlog::info("gyrod {}: {} at {} Hz, DLPF_CFG {}, +-{} deg/s; socket {}{}", GYROD_RELEASE, device_.description,
+               config_.device.rate_hz, config_.device.dlpf, config_.device.full_scale_dps, server_->socketPath().empty()
+                   ? std::string("(socket activation)") : server_->socketPath(),
+               recorder_ ? ", recording to " + recorder_->currentFile() : std::string());
+  if (pipeline_.phase() == PipelinePhase::Estimating)
+    spdlog::info("keep the sensor still: estimating {} over the first {:.1f} s",
+                 config_.bias.source == BiasSource::Estimate ? "the bias and the filter" : "the filter",
+                 pipeline_.stillSecondsNeeded());
+  driver_->start();
+  if (!device_.virtual_clock) rearmDriverTimer();
+}
+
+Gyrod::~Gyrod() = default;
+
+int Gyrod::run() {
+  loop_.run();
+  ::sd_notify(0, "STOPPING=1");
+  if (recorder_) recorder_->stop();
+  spdlog::info("stopped after {} samples, {} gaps ({} samples lost)", samples_published_, gaps_, missing_samples_);
+  return 0;
+}
+
+void Gyrod::rearmDriverTimer() {
+  itimerspec spec{};
+  if (const auto deadline = driver_->nextDeadlineNs()) {
+    const std::int64_t at = std::max<std::int64_t>(*deadline, 1);  // 0 would disarm
+    spec.it_value.tv_sec = at / 1'000'000'000;
+    spec.it_value.tv_nsec = at % 1'000'000'000;
+  }
+  ::timerfd_settime(driver_timer_.get(), TFD_TIMER_ABSTIME, &spec, nullptr);
+}
+
+void Gyrod::pumpVirtualClock() {
+  const std::int64_t now = monotonicNowNs();
+  const double speed = config_.mock.speed;
+  auto budget = static_cast<std::int64_t>(static_cast<double>(now - last_pump_real_ns_) * speed);
+  last_pump_real_ns_ = now;
+  while (budget > 0) {
+    const std::int64_t step = std::min(budget, kMaxVirtualStepNs);
+    device_.virtual_clock->advanceNs(step);
+    budget -= step;
+    device_.mock->sync();
+    driver_->onDataReady();
+    // The driver's timers are on sensor time: run every one that is due.
+    for (int guard = 0; guard < 64; ++guard) {
+      const auto deadline = driver_->nextDeadlineNs();
+      if (!deadline || *deadline > device_.virtual_clock->nowNs()) break;
+      driver_->onTimer(device_.virtual_clock->nowNs());
+    }
+  }
+}
+
+void Gyrod::onSample(const driver::GyroSample& s) {
+  last_sample_real_ns_ = monotonicNowNs();
+  ProcessedSample out;
+  try {
+    out = pipeline_.process(s.seq, static_cast<double>(s.t_ns) * 1e-9, s.rate_dps, s.temp_c);
+  } catch (const std::exception& e) {  // a sample the statistics refuse (non-finite): skip it, say why
+    spdlog::error("sample {} skipped: {}", s.seq, e.what());
+    return;
+  }
+  RateSample r;
+  r.seq = out.seq;
+  r.t_s = out.t_s;
+  r.temp_c = out.temp_c;
+  r.raw_dps = out.raw;
+  if (out.filtered) {
+    r.mean_dps = out.mean;
+    r.kalman_dps = out.kalman;
+  } else {  // still period: non-finite values are omitted from the line
+    r.mean_dps = {kNaN, kNaN, kNaN};
+    r.kalman_dps = {kNaN, kNaN, kNaN};
+  }
+  server_->publishRate(r);
+  if (recorder_) recorder_->pushSample(r.t_s, r.raw_dps[0], r.raw_dps[1], r.raw_dps[2], r.temp_c);
+  ++samples_published_;
+  last_temp_c_ = r.temp_c;
+  last_t_s_ = r.t_s;
+}
+
+void Gyrod::onGap(const driver::SampleGap& gap) {
+  pipeline_.discontinuity();
+  ++gaps_;
+  missing_samples_ += gap.count;
+  const std::string_view reason = protocolGapReason(gap.cause);
+  server_->publishGap({gap.first_seq, gap.count, reason});
+  if (recorder_) {
+    const double t = last_t_s_ ? *last_t_s_ + 1.0 / config_.device.rate_hz : 0.0;
+    recorder_->pushGap(gap.first_seq, t, static_cast<std::uint32_t>(std::min<std::uint64_t>(gap.count, UINT32_MAX)),
+                       reason);
+  }
+}
+
+void Gyrod::onStatus(const driver::DeviceStatus& status) {
+  if (status.state == driver::DeviceState::Streaming) notifyReadyOnce();
+  std::string text = std::string("STATUS=") + driver::deviceStateName(status.state);
+  if (!status.reason.empty()) text += ": " + status.reason;
+  ::sd_notify(0, text.c_str());
+}
+
+void Gyrod::notifyReadyOnce() {
+  if (ready_sent_) return;
+  ready_sent_ = true;
+  ::sd_notify(0, "READY=1");
+  spdlog::info("device configured and streaming; socket listening: ready");
+}
+
+void Gyrod::petWatchdog() {
+  // Only while fresh samples arrive: a timer that pets blindly would hide a dead sensor.
+  if (last_sample_real_ns_ != 0 &&
+      monotonicNowNs() - last_sample_real_ns_ < static_cast<std::int64_t>(watchdog_usec_) * 1000)
+    ::sd_notify(0, "WATCHDOG=1");
+}
+
+void Gyrod::reload() {
+  if (config_file_.empty()) {
+    spdlog::warn("SIGHUP: no configuration file was loaded, nothing to reload");
+    return;
+  }
+  try {
+    const GyrodConfig fresh = loadConfigFile(config_file_);
+    const auto& f = fresh.filter;
+    pipeline_.reloadFilter(f.mean_window, f.mean_threshold_dps, {f.kalman.a, f.kalman.q, f.kalman.r});
+    config_.filter = f;
+    ++reloads_;
+    spdlog::info("SIGHUP: filter reloaded from {} (L = {}, r = {} deg/s); other sections apply at restart",
+                 config_file_, f.mean_window, f.mean_threshold_dps);
+  } catch (const std::exception& e) {
+    spdlog::error("SIGHUP: keeping the running filter: {}", e.what());
+  }
+}
+
+AllanReport Gyrod::allanReport() {
+  const AllanStreams s = pipeline_.allanSnapshot();
+  AllanReport report;
+  report.tau0_s = s.tau0_s;
+  report.window_s = s.window_s;
+  for (const auto& p : s.raw[0].window) report.tau_s.push_back(p.tau_s);
+  report.samples = std::min<std::uint64_t>(pipeline_.samplesProcessed(),
+                                           static_cast<std::uint64_t>(std::llround(s.window_s / s.tau0_s)));
+  for (std::size_t axis = 0; axis < kAxes; ++axis) {
+    const std::array<const processing::RollingOverlappingAllan::Snapshot*, 3> streams = {&s.raw[axis], &s.mean[axis],
+                                                                                         &s.kalman[axis]};
+    for (std::size_t k = 0; k < 3; ++k)
+      for (const auto& p : streams[k]->window) report.curves[axis][k].adev_dps.push_back(p.oadev);
+    if (const auto& fit = pipeline_.noiseTerms()[axis]) report.curves[axis][0].noise = fit->value;
+  }
+  return report;
+}
+
+StatusReport Gyrod::statusReport() {
+  StatusReport r;
+  r.uptime_s = static_cast<double>(monotonicNowNs() - start_real_ns_) * 1e-9;
+  r.samples = samples_published_;
+  r.gaps = gaps_;
+  r.missing_samples = missing_samples_;
+  const auto& c = driver_->counters();
+  r.bus_errors = c.transfers_failed;
+  r.resets = c.device_resets + c.fifo_resets;
+  r.device_state = driver::deviceStateName(driver_->status().state);
+  r.device = device_.description;
+  r.nominal_rate_hz = config_.device.rate_hz;
+  if (samples_published_ > 0) r.rate_hz = driver_->estimatedSampleRateHz();
+  r.temp_c = last_temp_c_;
+  std::ostringstream bias;
+  bias << toString(pipeline_.biasOrigin());
+  if (pipeline_.phase() == PipelinePhase::Estimating) {
+    bias << " (estimating)";
+  } else {
+    bias.precision(6);
+    bias << " [" << pipeline_.bias()[0] << ", " << pipeline_.bias()[1] << ", " << pipeline_.bias()[2] << "] deg/s";
+  }
+  r.bias_source = bias.str();
+  if (recorder_) r.recording = recorder_->currentFile();
+  return r;
+}
+
+}  // namespace gyrod::daemon

@@ -1,0 +1,75 @@
+#pragma once
+// gyrod wired together: device → driver → pipeline → socket clients and recorder, all in
+// one epoll loop (daemon/event_loop.hpp). Data flows one way:
+//   FIFO bytes → samples (driver/) → filters and statistics (daemon/sample_pipeline) →
+//   RATE/GAP lines (daemon/unix_socket_server) and the recording (daemon/recorder).
+// Nothing on the per-sample path allocates or blocks: the recorder is a lock-free ring
+// drained by its own thread, every client has a bounded buffer.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "daemon/config.hpp"
+#include "daemon/device_backend.hpp"
+#include "daemon/event_loop.hpp"
+#include "daemon/recorder.hpp"
+#include "daemon/sample_pipeline.hpp"
+#include "daemon/unix_socket_server.hpp"
+#include "driver/mpu6050_driver.hpp"
+
+namespace gyrod::daemon {
+
+class Gyrod final : public driver::SampleSink, public ServerContent {
+ public:
+  // Builds everything from the configuration; throws with a one-line message when the
+  // device, the socket, the recording or a model file cannot be set up.
+  Gyrod(const GyrodConfig& config, std::string config_file);
+  ~Gyrod() override;
+  Gyrod(const Gyrod&) = delete;
+  Gyrod& operator=(const Gyrod&) = delete;
+
+  // Runs until SIGTERM or SIGINT; returns the process exit status.
+  int run();
+
+  // driver::SampleSink
+  void onSample(const driver::GyroSample& sample) override;
+  void onGap(const driver::SampleGap& gap) override;
+  void onStatus(const driver::DeviceStatus& status) override;
+  // ServerContent
+  AllanReport allanReport() override;
+  StatusReport statusReport() override;
+
+ private:
+  static PipelineSettings pipelineSettings(const GyrodConfig& config);
+  void serviceDriver();
+  void rearmDriverTimer();
+  void pumpVirtualClock();
+  void reload();
+  void petWatchdog();
+  void notifyReadyOnce();
+
+  GyrodConfig config_;
+  std::string config_file_;
+  EventLoop loop_;
+  DeviceParts device_;
+  std::unique_ptr<driver::Mpu6050Driver> driver_;
+  SamplePipeline pipeline_;
+  std::unique_ptr<UnixSocketServer> server_;
+  std::unique_ptr<Recorder> recorder_;
+  Fd driver_timer_;  // absolute CLOCK_MONOTONIC deadline of the driver (real-time clocks)
+
+  std::int64_t start_real_ns_ = 0;
+  std::int64_t last_pump_real_ns_ = 0;
+  std::int64_t last_sample_real_ns_ = 0;
+  std::uint64_t watchdog_usec_ = 0;
+  bool ready_sent_ = false;
+  std::uint64_t samples_published_ = 0;
+  std::uint64_t gaps_ = 0;
+  std::uint64_t missing_samples_ = 0;
+  std::optional<double> last_temp_c_;
+  std::optional<double> last_t_s_;
+  std::uint64_t reloads_ = 0;
+};
+
+}  // namespace gyrod::daemon

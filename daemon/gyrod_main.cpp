@@ -1,0 +1,62 @@
+// gyrod: the MPU6050 gyro daemon. See README.md and docs/protocol.md.
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/sinks/systemd_sink.h>
+#include <spdlog/spdlog.h>
+
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+
+#include "daemon/config.hpp"
+#include "daemon/event_loop.hpp"
+#include "daemon/gyrod.hpp"
+
+namespace {
+
+// Under systemd (JOURNAL_STREAM set) log straight to the journal with priorities and
+// without our own timestamps (journald adds them); otherwise timestamped lines on stderr.
+void setUpLogging(spdlog::level::level_enum level) {
+  std::shared_ptr<spdlog::logger> logger;
+  if (std::getenv("JOURNAL_STREAM") != nullptr) {
+    logger = std::make_shared<spdlog::logger>("gyrod", std::make_shared<spdlog::sinks::systemd_sink_st>("gyrod"));
+    logger->set_pattern("%v");
+  } else {
+    logger = spdlog::stderr_color_st("gyrod");
+    logger->set_pattern("%Y-%m-%d %H:%M:%S.%e %^%l%$ %v");
+  }
+  logger->set_level(level);
+  spdlog::set_default_logger(logger);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace gyrod::daemon;
+  // Before any thread starts (the recorder's writer), so that signals reach only the
+  // loop's signalfd. SIGPIPE: writes to a vanished client fail with EPIPE instead.
+  EventLoop::blockSignals({SIGTERM, SIGINT, SIGHUP});
+  std::signal(SIGPIPE, SIG_IGN);
+
+  GyrodCommandLine command_line;
+  try {
+    command_line = parseGyrodCommandLine(argc, argv);
+  } catch (const ConfigError& e) {
+    std::fprintf(stderr, "gyrod: %s\n", e.what());
+    return kExitConfigError;
+  }
+  if (command_line.exit_code) {
+    std::fputs(command_line.message.c_str(), *command_line.exit_code == 0 ? stdout : stderr);
+    if (!command_line.message.empty() && command_line.message.back() != '\n')
+      std::fputc('\n', *command_line.exit_code == 0 ? stdout : stderr);
+    return *command_line.exit_code;
+  }
+  setUpLogging(command_line.config.log.level);
+  try {
+    Gyrod gyrod(command_line.config, command_line.config_file);
+    return gyrod.run();
+  } catch (const std::exception& e) {
+    spdlog::critical("{}", e.what());
+    return 1;
+  }
+}
