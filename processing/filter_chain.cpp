@@ -22,6 +22,14 @@ void AxisFilterChain::reset() {
 FilterChainParameters identifyFilterChain(std::span<const double> rate_dps, std::size_t mean_window,
                                           double mean_threshold_dps, const KalmanOverrides& overrides) {
   GrossErrorMeanFilter mean(mean_window, mean_threshold_dps);
+  if (overrides.a && overrides.q && overrides.r) {  // nothing to identify
+    FilterChainParameters given;
+    given.mean_window = mean_window;
+    given.mean_threshold_dps = mean_threshold_dps;
+    given.kalman = {*overrides.a, *overrides.q, *overrides.r, 0.0, {}};
+    ScalarKalmanFilter validate(given.kalman);
+    return given;
+  }
   std::vector<double> filtered(rate_dps.size());
   for (std::size_t i = 0; i < rate_dps.size(); ++i) filtered[i] = mean.update(rate_dps[i]);
 

@@ -44,7 +44,8 @@ struct KalmanOverrides {
 
 // Identifies A, Q, R from a (preprocessed) series as the paper does: mean-filter it,
 // fit AR(1) by Yule–Walker (A = φ1, Q = σa²), R = var(x − mean-filtered x); then
-// applies the overrides. Throws std::invalid_argument when the series is too short.
+// applies the overrides (when all three are given, nothing is identified and the series
+// may be anything). Throws std::invalid_argument when the series is too short.
 FilterChainParameters identifyFilterChain(std::span<const double> rate_dps, std::size_t mean_window,
                                           double mean_threshold_dps, const KalmanOverrides& overrides = {});
 

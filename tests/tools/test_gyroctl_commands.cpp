@@ -257,3 +257,20 @@ TEST(GyroctlAnalyze, WriteModelRoundTripsThroughSimulate) {
   const auto r = runGyroctl("simulate --model " + model.string() + " --duration 600 --seed 8 -o " + sim2.string(), d.path());
   EXPECT_EQ(r.exit_status, 0) << r.err;
 }
+
+TEST(GyroctlFilter, BiasSubtractsConstantsInsteadOfDetrending) {
+  ScratchDir d;
+  const auto in = d.write("in.csv", "t,gx,gy\n0,1.25,2\n0.02,1.5,2\n0.04,1.75,2.5\n");
+  const auto out = d.path() / "out.csv";
+  const auto r = runGyroctl("filter " + in.string() + " -o " + out.string() +
+                                " --bias 1,2 --ar-phi 0.5 --kalman-q 1 --kalman-r 1",
+                            d.path());
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  std::vector<std::string> header;
+  const auto cols = parseCsv(readWholeFile(out), header);
+  EXPECT_EQ(cols[1], (std::vector<double>{0.25, 0.5, 0.75}));
+  EXPECT_EQ(cols[4], (std::vector<double>{0, 0, 0.5}));
+  EXPECT_EQ(runGyroctl("filter " + in.string() + " -o " + out.string() + " --bias 1", d.path()).exit_status, 2);
+  EXPECT_EQ(runGyroctl("filter " + in.string() + " -o " + out.string() + " --bias 1,2 --no-detrend", d.path()).exit_status,
+            2);
+}

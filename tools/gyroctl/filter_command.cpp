@@ -24,6 +24,7 @@ struct FilterOptions {
   double mean_threshold_dps = 0.3;
   std::optional<double> ar_phi, kalman_q, kalman_r;
   bool no_detrend = false;
+  std::vector<double> bias_dps;  // --bias: subtract these constants instead of detrending
 };
 
 // 17 significant digits: every double survives the text round trip exactly.
@@ -39,6 +40,14 @@ int runFilter(const FilterOptions& opt) {
   if (opt.ar_phi && !std::isfinite(*opt.ar_phi)) throw std::invalid_argument("--ar-phi must be a finite number");
   LoadedInput in = loadInput(opt.file, opt.rate_hz, "all");
   const auto& rec = in.recording;
+  if (!opt.bias_dps.empty() && opt.bias_dps.size() != rec.axes.size()) {
+    std::ostringstream s;
+    s << "--bias has " << opt.bias_dps.size() << " value(s) but " << opt.file << " has " << rec.axes.size()
+      << " gyro column(s)";
+    throw std::invalid_argument(s.str());
+  }
+  for (double b : opt.bias_dps)
+    if (!std::isfinite(b)) throw std::invalid_argument("--bias values must be finite numbers");
   const std::size_t n = rec.size();
   const double dt = 1.0 / in.rate_hz;
 
@@ -46,7 +55,11 @@ int runFilter(const FilterOptions& opt) {
   std::vector<FilterChainParameters> params;
   for (std::size_t axis = 0; axis < rec.axes.size(); ++axis) {
     std::vector<double> x = rec.axes[axis];
-    if (!opt.no_detrend) removeLinearTrend(x, dt);
+    if (!opt.bias_dps.empty()) {
+      for (double& v : x) v -= opt.bias_dps[axis];  // as gyrod does: a constant bias, no trend
+    } else if (!opt.no_detrend) {
+      removeLinearTrend(x, dt);
+    }
     try {
       params.push_back(identifyFilterChain(x, opt.mean_window, opt.mean_threshold_dps,
                                            KalmanOverrides{opt.ar_phi, opt.kalman_q, opt.kalman_r}));
@@ -105,7 +118,11 @@ void addFilterCommand(CLI::App& app, CommandRunner& run) {
   sub->add_option("--ar-phi", opt->ar_phi, "Kalman A = phi1 (default: AR(1) fit of the mean-filtered series)");
   sub->add_option("--kalman-q", opt->kalman_q, "Kalman Q [(deg/s)^2] (default: AR(1) noise variance)");
   sub->add_option("--kalman-r", opt->kalman_r, "Kalman R [(deg/s)^2] (default: var(x - mean-filtered x))");
-  sub->add_flag("--no-detrend", opt->no_detrend, "feed the raw input to the mean filter");
+  auto* no_detrend = sub->add_flag("--no-detrend", opt->no_detrend, "feed the raw input to the mean filter");
+  sub->add_option("--bias", opt->bias_dps,
+                  "subtract these constants [deg/s], one per gyro column, instead of detrending (as gyrod does)")
+      ->delimiter(',')
+      ->excludes(no_detrend);
   sub->callback([&run, opt] { run = [opt] { return runFilter(*opt); }; });
 }
 
