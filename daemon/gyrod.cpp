@@ -23,6 +23,8 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // at most kMaxVirtualStepNs so that the FIFO (2.5 s at 50 Hz) never overflows in a step.
 constexpr auto kPumpPeriod = std::chrono::milliseconds(10);
 constexpr std::int64_t kMaxVirtualStepNs = 200'000'000;
+// Real time one pump may spend before returning to the loop.
+constexpr std::int64_t kMaxPumpWorkNs = 20'000'000;
 
 std::int64_t monotonicNowNs() {
   timespec ts{};
@@ -186,7 +188,18 @@ void Gyrod::pumpVirtualClock() {
   const double speed = config_.mock.speed;
   auto budget = static_cast<std::int64_t>(static_cast<double>(now - last_pump_real_ns_) * speed);
   last_pump_real_ns_ = now;
+  // When the machine cannot simulate the chip this fast, run slower rather than let the
+  // backlog grow: the loop must keep serving clients and signals between pump steps.
+  const auto max_budget = static_cast<std::int64_t>(speed * 2.0 * static_cast<double>(kPumpPeriod.count()) * 1e6);
+  if (budget > max_budget) {
+    budget = max_budget;
+    if (!pump_lagging_warned_) {
+      pump_lagging_warned_ = true;
+      spdlog::warn("this machine cannot run the mock at {}x real time; it runs as fast as it can", speed);
+    }
+  }
   while (budget > 0) {
+    if (monotonicNowNs() - now > kMaxPumpWorkNs) break;  // the rest of this slice is dropped
     const std::int64_t step = std::min(budget, kMaxVirtualStepNs);
     device_.virtual_clock->advanceNs(step);
     budget -= step;

@@ -238,7 +238,7 @@ void Recorder::writerLoop() {
 }
 
 void Recorder::flushOnce(bool final_flush) {
-  if (options_.rotate_after_s > 0.0 && fd_ >= 0 && file_records_ > 0 &&
+  if (!final_flush && options_.rotate_after_s > 0.0 && fd_ >= 0 && file_records_ > 0 &&
       static_cast<double>(steadyNowNs() - file_opened_ns_) >= options_.rotate_after_s * 1e9) {
     const auto previous = fs::path(currentFile()).filename().string();
     closeFile();

@@ -1,0 +1,56 @@
+// Latency from a sample's data-ready edge to a client holding its RATE line, measured
+// against a running gyrod: usage  gyrod_latency SOCKET [LINES]
+// The RATE line's `t` is the driver's CLOCK_MONOTONIC estimate of the sample's edge; the
+// client stamps each line with CLOCK_MONOTONIC when recv() returns it. Real-time backends
+// only (with an accelerated mock, t is sensor time). Prints p50, p90, p99 and max in µs.
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: %s SOCKET [LINES]\n", argv[0]);
+    return 2;
+  }
+  const std::size_t wanted = argc > 2 ? std::stoul(argv[2]) : 3000;
+  const int fd = ::socket(AF_UNIX, SOCK_STREAM, 0);
+  sockaddr_un addr{};
+  addr.sun_family = AF_UNIX;
+  std::strncpy(addr.sun_path, argv[1], sizeof(addr.sun_path) - 1);
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+    std::perror("connect");
+    return 1;
+  }
+  const std::string watch = "{\"cmd\":\"watch\"}\n";
+  if (::send(fd, watch.data(), watch.size(), 0) < 0) return 1;
+  std::string buffer;
+  std::vector<double> latency_us;
+  char chunk[65536];
+  while (latency_us.size() < wanted) {
+    const ssize_t n = ::recv(fd, chunk, sizeof chunk, 0);
+    if (n <= 0) break;
+    timespec now{};
+    ::clock_gettime(CLOCK_MONOTONIC, &now);
+    const double now_s = static_cast<double>(now.tv_sec) + static_cast<double>(now.tv_nsec) * 1e-9;
+    buffer.append(chunk, static_cast<std::size_t>(n));
+    std::size_t nl;
+    while ((nl = buffer.find('\n')) != std::string::npos) {
+      const auto j = nlohmann::json::parse(buffer.substr(0, nl));
+      buffer.erase(0, nl + 1);
+      if (j.value("class", "") == "RATE") latency_us.push_back((now_s - j["t"].get<double>()) * 1e6);
+    }
+  }
+  std::sort(latency_us.begin(), latency_us.end());
+  auto pct = [&](double p) { return latency_us[static_cast<std::size_t>(p * (latency_us.size() - 1))]; };
+  std::printf("RATE lines: %zu\nlatency edge -> client [us]: p50 %.0f  p90 %.0f  p99 %.0f  max %.0f\n",
+              latency_us.size(), pct(0.5), pct(0.9), pct(0.99), latency_us.back());
+  return 0;
+}
