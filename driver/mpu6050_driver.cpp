@@ -722,7 +722,11 @@ bool Mpu6050Driver::determineSegmentBase(std::optional<std::int64_t> observation
   }
   if (phase_broken_ || !sample_clock_.locked()) {
     sample_clock_.breakPhase();
-    (void)sample_clock_.observe(*observation, base + newest_local);
+    if (approximate) {
+      sample_clock_.lockApproximately(*observation, base + newest_local);
+    } else {
+      (void)sample_clock_.observe(*observation, base + newest_local);
+    }
   } else if (!approximate) {
     const auto verdict = sample_clock_.observe(*observation, base + newest_local);
     if (verdict == SampleClock::Verdict::Rejected || verdict == SampleClock::Verdict::Relocked) {

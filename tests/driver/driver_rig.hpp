@@ -207,7 +207,7 @@ struct StreamCheck {
     bool chip_ran = false;               // the chip's sample clock ran on across the gap
     std::uint64_t slots = 0;             // round(Δt_true / P_true) − 1
   };
-  std::vector<GapTruth> gaps;
+  std::vector<GapTruth> gaps;  // one per hole between delivered samples (adjacent gaps merged)
   double max_abs_time_error_ns = 0.0;
   std::uint64_t total_seq = 0;  // last seq + 1
 };
@@ -250,7 +250,12 @@ inline StreamCheck checkStream(const Recorder& rec, const std::vector<SampleReco
   const double window = opt.timestamp_bound_ns + true_period_ns;
   for (const StreamEvent& e : rec.events) {
     if (e.is_gap) {
-      pending_gap = e.gap;
+      // Gaps with no sample between them (a FIFO restart that failed again) form one hole.
+      if (pending_gap) {
+        pending_gap->count += e.gap.count;
+      } else {
+        pending_gap = e.gap;
+      }
       continue;
     }
     const GyroSample& s = e.sample;

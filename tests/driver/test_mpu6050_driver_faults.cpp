@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <numeric>
 
 #include "driver/mock_signal_source.hpp"
@@ -296,6 +297,42 @@ TEST(Mpu6050DriverFaults, StuckDataReadyLineFallsBackToTheWatchdogWithoutLoss) {
     EXPECT_GE(rig.driver.counters().data_ready_missed, 20u);  // 2 s / 88 ms watchdog
     EXPECT_EQ(rig.driver.status().state, DeviceState::Streaming);
   }
+}
+
+TEST(Mpu6050DriverFaults, ChipRestartWhileTheLineIsStuckIsPlacedFromTheReadTime) {
+  // The documented inexact case. After a FIFO restart the first frames are placed on the
+  // sample clock by the newest data-ready edge. If the chip's clock ran on, the old model
+  // places them exactly even without edges; but after a chip restart (here a brown-out)
+  // the phase is new, and with the line stuck there is no edge: after three watchdog
+  // wake-ups the newest frame is put half a period before the read. The gap may then be
+  // off by one slot and timestamps off by up to half a period, until the first edge after
+  // the line recovers re-anchors the model.
+  SinusoidSource source = movingSource();
+  DriverRig rig(source);
+  rig.startStreaming();
+  const std::int64_t now = rig.clock.nowNs() - rig.mock.epochNs();
+  FaultPlan plan;
+  plan.stuck_data_ready.push_back({now + kNsPerSecond, 4 * kNsPerSecond, false});
+  plan.brownouts_ns.push_back(now + 2 * kNsPerSecond + 3 * kNsPerMillisecond);
+  rig.mock.setFaultPlan(plan);
+  rig.runFor(9 * kNsPerSecond);
+  const double p = rig.truePeriodNs();
+  const StreamCheck c = checkStream(rig.recorder, rig.truth, p, {p / 2.0 + 1.0, 1});
+  expectTotals(rig, c);
+  ASSERT_EQ(c.gaps.size(), 1u);
+  EXPECT_EQ(c.gaps[0].gap.cause, GapCause::SilentReset);
+  EXPECT_FALSE(c.gaps[0].chip_ran);
+  EXPECT_EQ(rig.driver.status().state, DeviceState::Streaming);
+  std::printf("[ figures  ] brown-out with INT stuck: gap %llu, hole %llu whole periods, max |t error| %.2f ms\n",
+              static_cast<unsigned long long>(c.gaps[0].gap.count), static_cast<unsigned long long>(c.gaps[0].slots),
+              c.max_abs_time_error_ns / 1e6);
+  EXPECT_GT(c.max_abs_time_error_ns, 1'000.0);  // the read-time placement was used
+  // Once edges are back the timestamps are exact again.
+  const GyroSample& last = rig.recorder.samples.back();
+  const auto it = std::find_if(rig.truth.rbegin(), rig.truth.rend(),
+                               [&](const SampleRecord& r) { return r.gyro == last.raw_gyro; });
+  ASSERT_NE(it, rig.truth.rend());
+  EXPECT_LT(std::llabs(it->time_ns - last.t_ns), 1'000);
 }
 
 TEST(Mpu6050DriverFaults, CloneChipStreamsLikeTheGenuinePart) {
