@@ -243,6 +243,10 @@ TEST(Mpu6050DriverFaults, StalledLoopOverflowsTheFifoNaturally) {
   EXPECT_EQ(rig.recorder.gaps[0].cause, GapCause::FifoOverflow);
   // The gap holds the stall's samples; a late edge is still a data-ready edge, not a miss.
   EXPECT_NEAR(static_cast<double>(rig.recorder.gaps[0].count), 150.0, 2.0);
+  // The 16-edge queue overflowed during the stall, keeping the oldest edges: the driver must
+  // not pair the newest of those with the newest frame (that would be a rejected edge).
+  EXPECT_GT(rig.mock.dataReady().edgesDropped(), 0u);
+  EXPECT_EQ(rig.driver.counters().timestamp_rejections, 0u);
 }
 
 TEST(Mpu6050DriverFaults, ShortStallIsCaughtUpThroughTheBacklogCapWithoutLoss) {
@@ -260,6 +264,10 @@ TEST(Mpu6050DriverFaults, ShortStallIsCaughtUpThroughTheBacklogCapWithoutLoss) {
   EXPECT_TRUE(rig.recorder.gaps.empty());
   EXPECT_GE(rig.driver.counters().backlog_capped, 12u);  // 50 frames, 4 at a time
   EXPECT_EQ(rig.driver.counters().fifo_overflows, 0u);
+  // The 16-edge queue kept the stall's first edges and dropped the rest: the newest queued
+  // edge is 34 samples older than the newest frame and must not be paired with it.
+  EXPECT_GT(rig.mock.dataReady().edgesDropped(), 0u);
+  EXPECT_EQ(rig.driver.counters().timestamp_rejections, 0u);
 }
 
 TEST(Mpu6050DriverFaults, MisalignedStreamIsDetectedByTheTemperatureWordAndReset) {
@@ -295,6 +303,7 @@ TEST(Mpu6050DriverFaults, StuckDataReadyLineFallsBackToTheWatchdogWithoutLoss) {
     EXPECT_TRUE(rig.recorder.gaps.empty());
     EXPECT_GT(rig.mock.counters().data_ready_edges_hidden, 90u);
     EXPECT_GE(rig.driver.counters().data_ready_missed, 20u);  // 2 s / 88 ms watchdog
+    EXPECT_TRUE(rig.logged("no data-ready edge came"));
     EXPECT_EQ(rig.driver.status().state, DeviceState::Streaming);
   }
 }
