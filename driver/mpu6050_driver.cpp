@@ -557,6 +557,13 @@ void Mpu6050Driver::collectEdges(std::int64_t before_ns, std::int64_t after_ns, 
     classify(e);
   }
   stashed_edge_ = later;
+  // A full edge queue drops the newest edges (as the kernel's line-event FIFO does): the
+  // newest edge left is then older than the newest frame and must not be paired with it.
+  const std::uint64_t dropped = data_ready_.edgesDropped();
+  if (dropped != edges_dropped_seen_) {
+    edges_dropped_seen_ = dropped;
+    ambiguous = true;
+  }
 }
 
 void Mpu6050Driver::readFifo(Trigger trigger) {
@@ -601,6 +608,14 @@ void Mpu6050Driver::readFifo(Trigger trigger) {
   }
   if (trigger == Trigger::Watchdog && config_.data_ready_mode == DataReadyMode::InterruptEdges) {
     ++counters_.data_ready_missed;
+    // Once a minute at most: data arrive but no edge announced them.
+    if (last_missed_log_ns_ == INT64_MIN || t0 - last_missed_log_ns_ >= 60 * kNsPerSecond) {
+      last_missed_log_ns_ = t0;
+      log(LogLevel::Warning, "the FIFO of the " + where() +
+                                 " has data but no data-ready edge came for " + ms(watchdog_ns_) +
+                                 ": check the INT wire and the GPIO chip, line and edge settings (reading on a "
+                                 "timer meanwhile)");
+    }
   }
 
   std::optional<std::int64_t> observation;
@@ -722,7 +737,11 @@ bool Mpu6050Driver::determineSegmentBase(std::optional<std::int64_t> observation
   }
   if (phase_broken_ || !sample_clock_.locked()) {
     sample_clock_.breakPhase();
-    (void)sample_clock_.observe(*observation, base + newest_local);
+    if (approximate) {
+      sample_clock_.lockApproximately(*observation, base + newest_local);
+    } else {
+      (void)sample_clock_.observe(*observation, base + newest_local);
+    }
   } else if (!approximate) {
     const auto verdict = sample_clock_.observe(*observation, base + newest_local);
     if (verdict == SampleClock::Verdict::Rejected || verdict == SampleClock::Verdict::Relocked) {

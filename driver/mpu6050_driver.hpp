@@ -145,6 +145,7 @@ class Mpu6050Driver {
   int recovery_attempts_ = 0;
   int failure_score_ = 0;
   bool clone_warned_ = false;
+  std::int64_t last_missed_log_ns_ = INT64_MIN;
 
   // Streaming timers.
   std::int64_t watchdog_due_ = 0;
@@ -166,6 +167,7 @@ class Mpu6050Driver {
   std::uint64_t next_seq_ = 0;
   std::int64_t last_t_ns_ = INT64_MIN;
   std::optional<std::int64_t> stashed_edge_;  // newest edge seen after the last FIFO_COUNT read
+  std::uint64_t edges_dropped_seen_ = 0;
 
   // FIFO bytes: one wake-up's worth at most, allocated once.
   std::array<std::uint8_t, mpu6050::fifo::kSize> fifo_bytes_{};

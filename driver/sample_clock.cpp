@@ -45,12 +45,18 @@ void SampleClock::lock(double t, std::uint64_t n) {
   // new baseline has to be long enough again before it can refine the old estimate.
 }
 
+void SampleClock::lockApproximately(std::int64_t t_ns, std::uint64_t n) {
+  lock(static_cast<double>(t_ns) - config_.observation_bias_ns, n);
+  approximate_ = true;
+}
+
 void SampleClock::breakPhase() { locked_ = false; }
 
 SampleClock::Verdict SampleClock::observe(std::int64_t t_ns, std::uint64_t n) {
   const double t = static_cast<double>(t_ns) - config_.observation_bias_ns;
-  if (!locked_) {
+  if (!locked_ || approximate_) {
     lock(t, n);
+    approximate_ = false;
     return Verdict::Locked;
   }
   const double dn = static_cast<double>(static_cast<std::int64_t>(n - anchor_n_));

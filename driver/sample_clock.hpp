@@ -45,6 +45,11 @@ class SampleClock {
   // bias correction). The first observation, and one after breakPhase(), locks the phase.
   Verdict observe(std::int64_t t_ns, std::uint64_t n);
 
+  // Locks the phase from a rough placement (e.g. a read time when no edge is available):
+  // timestamps follow it, but it is never a period baseline, and the next observe()
+  // re-locks on its observation instead of refining this one.
+  void lockApproximately(std::int64_t t_ns, std::uint64_t n);
+
   // Forget the phase (the chip restarted sampling); the period estimate is kept, since
   // it is the same oscillator.
   void breakPhase();
@@ -69,6 +74,7 @@ class SampleClock {
 
   SampleClockConfig config_;
   bool locked_ = false;
+  bool approximate_ = false;
   double period_ns_;
   double period_uncertainty_;
   double anchor_t_ = 0.0;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <numeric>
 
 #include "driver/mock_signal_source.hpp"
@@ -242,6 +243,10 @@ TEST(Mpu6050DriverFaults, StalledLoopOverflowsTheFifoNaturally) {
   EXPECT_EQ(rig.recorder.gaps[0].cause, GapCause::FifoOverflow);
   // The gap holds the stall's samples; a late edge is still a data-ready edge, not a miss.
   EXPECT_NEAR(static_cast<double>(rig.recorder.gaps[0].count), 150.0, 2.0);
+  // The 16-edge queue overflowed during the stall, keeping the oldest edges: the driver must
+  // not pair the newest of those with the newest frame (that would be a rejected edge).
+  EXPECT_GT(rig.mock.dataReady().edgesDropped(), 0u);
+  EXPECT_EQ(rig.driver.counters().timestamp_rejections, 0u);
 }
 
 TEST(Mpu6050DriverFaults, ShortStallIsCaughtUpThroughTheBacklogCapWithoutLoss) {
@@ -259,6 +264,10 @@ TEST(Mpu6050DriverFaults, ShortStallIsCaughtUpThroughTheBacklogCapWithoutLoss) {
   EXPECT_TRUE(rig.recorder.gaps.empty());
   EXPECT_GE(rig.driver.counters().backlog_capped, 12u);  // 50 frames, 4 at a time
   EXPECT_EQ(rig.driver.counters().fifo_overflows, 0u);
+  // The 16-edge queue kept the stall's first edges and dropped the rest: the newest queued
+  // edge is 34 samples older than the newest frame and must not be paired with it.
+  EXPECT_GT(rig.mock.dataReady().edgesDropped(), 0u);
+  EXPECT_EQ(rig.driver.counters().timestamp_rejections, 0u);
 }
 
 TEST(Mpu6050DriverFaults, MisalignedStreamIsDetectedByTheTemperatureWordAndReset) {
@@ -294,8 +303,45 @@ TEST(Mpu6050DriverFaults, StuckDataReadyLineFallsBackToTheWatchdogWithoutLoss) {
     EXPECT_TRUE(rig.recorder.gaps.empty());
     EXPECT_GT(rig.mock.counters().data_ready_edges_hidden, 90u);
     EXPECT_GE(rig.driver.counters().data_ready_missed, 20u);  // 2 s / 88 ms watchdog
+    EXPECT_TRUE(rig.logged("no data-ready edge came"));
     EXPECT_EQ(rig.driver.status().state, DeviceState::Streaming);
   }
+}
+
+TEST(Mpu6050DriverFaults, ChipRestartWhileTheLineIsStuckIsPlacedFromTheReadTime) {
+  // The documented inexact case. After a FIFO restart the first frames are placed on the
+  // sample clock by the newest data-ready edge. If the chip's clock ran on, the old model
+  // places them exactly even without edges; but after a chip restart (here a brown-out)
+  // the phase is new, and with the line stuck there is no edge: after three watchdog
+  // wake-ups the newest frame is put half a period before the read. The gap may then be
+  // off by one slot and timestamps off by up to half a period, until the first edge after
+  // the line recovers re-anchors the model.
+  SinusoidSource source = movingSource();
+  DriverRig rig(source);
+  rig.startStreaming();
+  const std::int64_t now = rig.clock.nowNs() - rig.mock.epochNs();
+  FaultPlan plan;
+  plan.stuck_data_ready.push_back({now + kNsPerSecond, 4 * kNsPerSecond, false});
+  plan.brownouts_ns.push_back(now + 2 * kNsPerSecond + 3 * kNsPerMillisecond);
+  rig.mock.setFaultPlan(plan);
+  rig.runFor(9 * kNsPerSecond);
+  const double p = rig.truePeriodNs();
+  const StreamCheck c = checkStream(rig.recorder, rig.truth, p, {p / 2.0 + 1.0, 1});
+  expectTotals(rig, c);
+  ASSERT_EQ(c.gaps.size(), 1u);
+  EXPECT_EQ(c.gaps[0].gap.cause, GapCause::SilentReset);
+  EXPECT_FALSE(c.gaps[0].chip_ran);
+  EXPECT_EQ(rig.driver.status().state, DeviceState::Streaming);
+  std::printf("[ figures  ] brown-out with INT stuck: gap %llu, hole %llu whole periods, max |t error| %.2f ms\n",
+              static_cast<unsigned long long>(c.gaps[0].gap.count), static_cast<unsigned long long>(c.gaps[0].slots),
+              c.max_abs_time_error_ns / 1e6);
+  EXPECT_GT(c.max_abs_time_error_ns, 1'000.0);  // the read-time placement was used
+  // Once edges are back the timestamps are exact again.
+  const GyroSample& last = rig.recorder.samples.back();
+  const auto it = std::find_if(rig.truth.rbegin(), rig.truth.rend(),
+                               [&](const SampleRecord& r) { return r.gyro == last.raw_gyro; });
+  ASSERT_NE(it, rig.truth.rend());
+  EXPECT_LT(std::llabs(it->time_ns - last.t_ns), 1'000);
 }
 
 TEST(Mpu6050DriverFaults, CloneChipStreamsLikeTheGenuinePart) {
