@@ -18,5 +18,6 @@ void addAnalyzeCommand(CLI::App& app, CommandRunner& run);
 void addFilterCommand(CLI::App& app, CommandRunner& run);
 void addImportCommand(CLI::App& app, CommandRunner& run);
 void addSimulateCommand(CLI::App& app, CommandRunner& run);
+void addModelCheckCommand(CLI::App& app, CommandRunner& run);
 
 }  // namespace gyrod::gyroctl

@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   addFilterCommand(app, run);
   addImportCommand(app, run);
   addSimulateCommand(app, run);
+  addModelCheckCommand(app, run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
