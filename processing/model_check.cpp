@@ -68,7 +68,7 @@ struct SeriesStats {
   double temp_slope = kNaN;
   double step_stat = kNaN;       // stepStatistic of the low-passed residual
   double gm_improvement = kNaN;
-  std::vector<double> psd;
+  std::vector<double> psd, psd_max;
 };
 
 double temperatureSlope(const std::vector<double>& y, const std::vector<double>& tb) {
@@ -127,7 +127,7 @@ SeriesStats measureSeries(std::span<const double> xd, const Context& c, unsigned
       s.spectral_log_ratio = std::log(peak.ratio);
       s.spectral_bin = peak.bin;
     }
-    if (mask & kStatPsd) s.psd = bandAveragedPsd(p, c.rate, c.psd_edges);
+    if (mask & kStatPsd) s.psd = bandAveragedPsd(p, c.rate, c.psd_edges, &s.psd_max);
   }
   if (mask & (kStatTemperature | kStatSteps)) {
     const std::vector<double> y = lowPassedResidual(xd, c);
@@ -552,6 +552,7 @@ AxisModelCheck checkAxisModel(const AxisModelCheckInput& input, const ModelCheck
   // Plots: spectrum of the measured series and the replicas' median per band.
   {
     out.spectrum_measured = measured.psd;
+    out.spectrum_measured_peak = measured.psd_max;
     for (std::size_t j = 0; j + 1 < c.psd_edges.size(); ++j) {
       out.spectrum_freq_hz.push_back(std::sqrt(c.psd_edges[j] * c.psd_edges[j + 1]));
       std::vector<double> col;

@@ -114,6 +114,7 @@ struct AxisModelCheck {
   // For plots: log-binned power spectral density [(°/s)²/Hz] of the measured series and the
   // median of the base replicas, and the low-passed residual against temperature.
   std::vector<double> spectrum_freq_hz, spectrum_measured, spectrum_base_median;
+  std::vector<double> spectrum_measured_peak;  // largest single-bin PSD in each band (lines)
   std::vector<double> block_temperature_c, block_residual_dps;
   std::size_t ar_order = 0;          // AR order (AIC) of the base Kalman model
   std::size_t replicas_simulated = 0;

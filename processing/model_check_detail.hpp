@@ -59,8 +59,10 @@ struct SpectralPeak {
 };
 SpectralPeak largestSpectralPeak(const std::vector<double>& power, const std::vector<double>& background,
                                  std::size_t k_lo, std::size_t k_hi);
-// One-sided PSD [(unit)²/Hz] averaged over the log-spaced bands [edges_j, edges_{j+1}).
-std::vector<double> bandAveragedPsd(const Periodogram& p, double rate_hz, std::span<const double> edges_hz);
+// One-sided PSD [(unit)²/Hz] averaged over the log-spaced bands [edges_j, edges_{j+1});
+// band_max (optional) gets the largest single-bin PSD of each band (where a line shows).
+std::vector<double> bandAveragedPsd(const Periodogram& p, double rate_hz, std::span<const double> edges_hz,
+                                    std::vector<double>* band_max = nullptr);
 
 // ---- steps ---------------------------------------------------------------------------
 // Haar differences D_W(t) = mean(y[t, t+W)) − mean(y[t−W, t)) for t = W..n−W.

@@ -167,18 +167,24 @@ SpectralPeak largestSpectralPeak(const std::vector<double>& power, const std::ve
   return best;
 }
 
-std::vector<double> bandAveragedPsd(const Periodogram& p, double rate_hz, std::span<const double> edges_hz) {
+std::vector<double> bandAveragedPsd(const Periodogram& p, double rate_hz, std::span<const double> edges_hz,
+                                    std::vector<double>* band_max) {
   std::vector<double> psd;
+  if (band_max) band_max->clear();
   const double df = rate_hz / static_cast<double>(p.nfft);
   // One-sided density: 2|X_k|²/(fs·Σw²) (Hann window, Σw² its power).
   const double scale = 2.0 / (rate_hz * p.window_power);
   for (std::size_t j = 0; j + 1 < edges_hz.size(); ++j) {
     const auto lo = static_cast<std::size_t>(std::ceil(edges_hz[j] / df));
     const auto hi = std::min(p.power.size(), static_cast<std::size_t>(std::ceil(edges_hz[j + 1] / df)));
-    double s = 0.0;
+    double s = 0.0, m = 0.0;
     std::size_t c = 0;
-    for (std::size_t k = std::max<std::size_t>(lo, 1); k < hi; ++k, ++c) s += p.power[k];
+    for (std::size_t k = std::max<std::size_t>(lo, 1); k < hi; ++k, ++c) {
+      s += p.power[k];
+      m = std::max(m, p.power[k]);
+    }
     psd.push_back(c > 0 ? scale * s / static_cast<double>(c) : std::numeric_limits<double>::quiet_NaN());
+    if (band_max) band_max->push_back(c > 0 ? scale * m : std::numeric_limits<double>::quiet_NaN());
   }
   return psd;
 }

@@ -157,16 +157,18 @@ std::vector<std::string> writeAxisPlots(const std::filesystem::path& dir, const 
   }
   {
     std::ostringstream d;
-    d << "# freq_hz psd_measured psd_base_median  [(deg/s)^2/Hz]\n";
+    d << "# freq_hz psd_measured psd_base_median psd_measured_band_peak  [(deg/s)^2/Hz]\n";
     for (std::size_t j = 0; j < r.spectrum_freq_hz.size(); ++j)
       if (std::isfinite(r.spectrum_measured[j]) && std::isfinite(r.spectrum_base_median[j]))
-        d << r.spectrum_freq_hz[j] << ' ' << r.spectrum_measured[j] << ' ' << r.spectrum_base_median[j] << '\n';
+        d << r.spectrum_freq_hz[j] << ' ' << r.spectrum_measured[j] << ' ' << r.spectrum_base_median[j] << ' '
+          << r.spectrum_measured_peak[j] << '\n';
     writeText(dir / ("spectrum_" + name + ".dat"), d.str());
     std::ostringstream g;
     g << "set terminal pngcairo size 900,600\nset output 'spectrum_" << name << ".png'\n"
       << "set logscale xy\nset grid\nset xlabel 'frequency [Hz]'\nset ylabel 'PSD [(deg/s)^2/Hz]'\n"
       << "set title 'Power spectral density (band averages), " << name << "'\n"
-      << "plot 'spectrum_" << name << ".dat' u 1:2 w lp pt 7 ps 0.5 lc rgb 'black' t 'measured', "
+      << "plot 'spectrum_" << name << ".dat' u 1:4 w l lc rgb '#a0a0a0' t 'measured, largest bin of each band', "
+      << "'' u 1:2 w lp pt 7 ps 0.5 lc rgb 'black' t 'measured (band average)', "
       << "'' u 1:3 w l lc rgb 'blue' t 'base model (median of replicas)'\n";
     writeText(dir / ("spectrum_" + name + ".gp"), g.str());
     made.push_back("spectrum_" + name + ".png");
