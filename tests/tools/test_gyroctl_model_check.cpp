@@ -85,3 +85,47 @@ TEST(GyroctlModelCheck, TooShortOrMissingFilesAreUsageErrors) {
   r = runGyroctl("model-check " + csv.string() + " --replicas 2", d.path());
   EXPECT_EQ(r.exit_status, 2);
 }
+
+// ---- the model file's optional [x.extra] tables ------------------------------------------
+
+#include "tools/recording/model_toml.hpp"
+
+TEST(ModelTomlExtra, ExtraEffectsReadBackIdentically) {
+  gyrod::processing::SimulationModel m;
+  auto& e = m.axes[1].extra;
+  e.temperature_coefficient_dps_per_c = -0.0123;
+  e.temperature_reference_c = 31.5;
+  e.gauss_markov_tau_s = 17.25;
+  e.gauss_markov_sigma_dps = 0.0021;
+  e.outlier_count = 7;
+  e.outlier_amplitude_dps = 1.5;
+  e.sinusoids = {{1.08, 0.07, 0.3}, {12.5, 0.01, -2.0}};
+  e.bias_steps = {{600.0, 0.02}};
+  const auto back = gyrod::recording::parseModelToml(gyrod::recording::modelToToml(m), "m.toml");
+  const auto& b = back.axes[1].extra;
+  EXPECT_EQ(b.temperature_coefficient_dps_per_c, e.temperature_coefficient_dps_per_c);
+  EXPECT_EQ(b.temperature_reference_c, e.temperature_reference_c);
+  EXPECT_EQ(b.gauss_markov_tau_s, e.gauss_markov_tau_s);
+  EXPECT_EQ(b.gauss_markov_sigma_dps, e.gauss_markov_sigma_dps);
+  EXPECT_EQ(b.outlier_count, e.outlier_count);
+  EXPECT_EQ(b.outlier_amplitude_dps, e.outlier_amplitude_dps);
+  ASSERT_EQ(b.sinusoids.size(), 2u);
+  EXPECT_EQ(b.sinusoids[1].freq_hz, 12.5);
+  EXPECT_EQ(b.sinusoids[1].phase_rad, -2.0);
+  ASSERT_EQ(b.bias_steps.size(), 1u);
+  EXPECT_EQ(b.bias_steps[0].size_dps, 0.02);
+  EXPECT_TRUE(back.axes[0].extra.empty());
+  // A model without extras writes no [x.extra] table (files stay as they were).
+  EXPECT_EQ(gyrod::recording::modelToToml(gyrod::processing::SimulationModel{}).find("extra"), std::string::npos);
+}
+
+TEST(ModelTomlExtra, BadExtraKeysNameTheLine) {
+  try {
+    gyrod::recording::parseModelToml("[x]\narw_deg_per_sqrt_h = 1.0\n[x.extra]\nsinusoid = []\n", "m.toml");
+    FAIL();
+  } catch (const gyrod::recording::RecordingError& err) {
+    EXPECT_NE(std::string(err.what()).find("m.toml:4"), std::string::npos) << err.what();
+  }
+  EXPECT_THROW(gyrod::recording::parseModelToml("[z.extra]\nsinusoids = [{freq_hz = -1.0}]\n", "m.toml"),
+               gyrod::recording::RecordingError);
+}
