@@ -472,7 +472,9 @@ Context makeContext(const AxisModelCheckInput& in, std::span<const double> xd, s
   // At least 10 cycles in the record, and clear of the lowest bins where the background
   // (random walk, flicker) changes too fast for a local median.
   c.k_lo = std::max<std::size_t>(64, static_cast<std::size_t>(std::ceil(10.0 * static_cast<double>(nfft) / static_cast<double>(c.n))));
-  c.k_hi = nfft / 2 - 2;
+  // Up to 98 % of Nyquist: a line at the very top of the band cannot be told from aliasing,
+  // and there the background has bins on one side only.
+  c.k_hi = nfft / 2 - std::max<std::size_t>(2, nfft / 100);
   const double f_lo = 2.0 / duration, f_hi = 0.5 * in.rate_hz;
   for (std::size_t j = 0; j <= kPsdBands; ++j)
     c.psd_edges.push_back(f_lo * std::pow(f_hi / f_lo, static_cast<double>(j) / static_cast<double>(kPsdBands)));

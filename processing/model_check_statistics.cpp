@@ -128,7 +128,8 @@ std::vector<double> spectralBackground(const std::vector<double>& power) {
   std::size_t k = 1;
   while (k < n) {
     const std::size_t width = std::clamp<std::size_t>(k / 8, 16, 128);
-    const std::size_t end = std::min(n, k + width);
+    std::size_t end = std::min(n, k + width);
+    if (n - end < 16) end = n;  // no short last block: a median of a few bins is too noisy
     scratch.assign(power.begin() + static_cast<std::ptrdiff_t>(k), power.begin() + static_cast<std::ptrdiff_t>(end));
     const auto mid = scratch.begin() + static_cast<std::ptrdiff_t>(scratch.size() / 2);
     std::nth_element(scratch.begin(), mid, scratch.end());

@@ -14,6 +14,12 @@ using gyrod::test::readWholeFile;
 using gyrod::test::runGyroctl;
 using gyrod::test::ScratchDir;
 
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_UNDEFINED__)
+#define SKIP_WHEN_SANITIZED() GTEST_SKIP() << "model-check end to end: minutes under the sanitizers, runs in the optimised build"
+#else
+#define SKIP_WHEN_SANITIZED() (void)0
+#endif
+
 namespace {
 
 std::string recordingCsv(const gyrod::test::GeneratedRecording& g) {
@@ -30,6 +36,7 @@ std::string recordingCsv(const gyrod::test::GeneratedRecording& g) {
 }  // namespace
 
 TEST(GyroctlModelCheck, JsonNamesTheHiddenSinusoidOnItsAxisOnly) {
+  SKIP_WHEN_SANITIZED();
   ScratchDir d;
   const auto g = gyrod::test::HiddenEffectGenerator(7).generate(300.0, 50.0, {gyrod::processing::ModelEffect::Sinusoid});
   const auto csv = d.write("rec.csv", recordingCsv(g));
@@ -57,6 +64,7 @@ TEST(GyroctlModelCheck, JsonNamesTheHiddenSinusoidOnItsAxisOnly) {
 }
 
 TEST(GyroctlModelCheck, ReportFolderHasMarkdownAndPlotScripts) {
+  SKIP_WHEN_SANITIZED();
   ScratchDir d;
   const auto g = gyrod::test::HiddenEffectGenerator(5).generate(200.0, 50.0, {});
   const auto csv = d.write("rec.csv", recordingCsv(g));
