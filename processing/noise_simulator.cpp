@@ -1,5 +1,6 @@
 #include "processing/noise_simulator.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -88,6 +89,28 @@ void validateArComponent(const ArComponent& ar, const std::string& prefix) {
   arStepDown(ar.phi, prefix);
 }
 
+void validateExtraEffects(const AxisExtraEffects& extra, const std::string& prefix) {
+  requireFinite(extra.temperature_coefficient_dps_per_c, prefix + "extra.temperature_coefficient_dps_per_c");
+  requireFinite(extra.temperature_reference_c, prefix + "extra.temperature_reference_c");
+  for (std::size_t i = 0; i < extra.sinusoids.size(); ++i) {
+    const std::string w = prefix + "extra.sinusoid[" + std::to_string(i) + "].";
+    requirePositive(extra.sinusoids[i].freq_hz, w + "freq_hz");
+    requireNonNegative(extra.sinusoids[i].amp_dps, w + "amp_dps");
+    requireFinite(extra.sinusoids[i].phase_rad, w + "phase_rad");
+  }
+  requireNonNegative(extra.gauss_markov_sigma_dps, prefix + "extra.gauss_markov_sigma_dps");
+  if (extra.gauss_markov_sigma_dps > 0.0)
+    requirePositive(extra.gauss_markov_tau_s, prefix + "extra.gauss_markov_tau_s");
+  else
+    requireNonNegative(extra.gauss_markov_tau_s, prefix + "extra.gauss_markov_tau_s");
+  for (std::size_t i = 0; i < extra.bias_steps.size(); ++i) {
+    const std::string w = prefix + "extra.bias_step[" + std::to_string(i) + "].";
+    requireNonNegative(extra.bias_steps[i].time_s, w + "time_s");
+    requireFinite(extra.bias_steps[i].size_dps, w + "size_dps");
+  }
+  requireNonNegative(extra.outlier_amplitude_dps, prefix + "extra.outlier_amplitude_dps");
+}
+
 void validateSimulationModel(const SimulationModel& model) {
   requirePositive(model.rate_hz, "rate_hz");
   if (model.dlpf_cfg) sampleRateDivisor(*model.dlpf_cfg, model.rate_hz);
@@ -98,6 +121,7 @@ void validateSimulationModel(const SimulationModel& model) {
     for (NoiseTerm t : kAllNoiseTerms) requireNonNegative(axis.terms.get(t), prefix + std::string(noiseTermKey(t)));
     requireFinite(axis.bias_dps, prefix + "bias_dps");
     validateArComponent(axis.ar, prefix);
+    validateExtraEffects(axis.extra, prefix);
   }
   const TemperatureModel& temp = model.temperature;
   requireFinite(temp.start_c, "temperature.start_c");
@@ -215,6 +239,83 @@ NoiseSimulator::NoiseSimulator(const SimulationModel& model, double duration_s, 
     axis.q_previous_angle_deg = axis.q_angle_std_deg * axis.q_noise.next();
     initAr(axis, m.ar);
   }
+  initExtras(seed, duration_s);
+}
+
+void NoiseSimulator::initExtras(std::uint64_t seed, double duration_s) {
+  bool any = false;
+  for (const AxisNoiseModel& m : model_.axes) any = any || !m.extra.empty();
+  if (!any) return;  // nothing drawn, nothing stored: the stream is the one without extras
+  // A generator of their own: the golden-ratio constant keeps it apart from `seeder_`'s
+  // sequence, so adding an effect never changes the realisation of the five terms.
+  SplitMix64 extra_seeder(seed ^ 0x9E3779B97F4A7C15ULL);
+  extra_noise_.emplace(extra_seeder);
+  Xoshiro256StarStar positions(extra_seeder);
+  extras_.resize(kSimulatedAxes);
+  for (std::size_t a = 0; a < kSimulatedAxes; ++a) {
+    const AxisExtraEffects& e = model_.axes[a].extra;
+    ExtraState& s = extras_[a];
+    if (e.gauss_markov_sigma_dps > 0.0) {
+      const double h = 1.0 / (model_.rate_hz * e.gauss_markov_tau_s);
+      s.gm_decay = portable::exp(-h);
+      s.gm_innovation_std = e.gauss_markov_sigma_dps * std::sqrt(-portable::expm1(-2.0 * h));
+      s.gm_value = e.gauss_markov_sigma_dps * extra_noise_->next();  // stationary start
+    }
+    if (e.outlier_count > sample_count_)
+      throw std::invalid_argument(axisPrefix(a) + "extra.outlier_count " + std::to_string(e.outlier_count) +
+                                  " is more than the " + std::to_string(sample_count_) + " samples of " +
+                                  formatNumber(duration_s) + " s");
+    // Distinct positions: draw, and draw again on a repeat (count ≪ samples in practice).
+    while (s.outlier_positions.size() < e.outlier_count) {
+      const auto pos = static_cast<std::uint64_t>(positions.uniform() * static_cast<double>(sample_count_));
+      if (std::find(s.outlier_positions.begin(), s.outlier_positions.end(), pos) == s.outlier_positions.end())
+        s.outlier_positions.push_back(pos);
+    }
+    std::sort(s.outlier_positions.begin(), s.outlier_positions.end());
+    for (std::size_t i = 0; i < s.outlier_positions.size(); ++i)
+      s.outlier_values.push_back((positions.next() >> 63) ? -e.outlier_amplitude_dps : e.outlier_amplitude_dps);
+  }
+}
+
+namespace {
+
+// sin x from portable::tan, so that the sinusoid effect is the same bits everywhere:
+// x is reduced to [−π/2, π/2] with sin(π − x) = sin x, then sin x = 2u/(1 + u²), u = tan(x/2)
+// with |x/2| ≤ π/4 inside tan's domain. `cycles` is the phase in turns.
+double portableSinOfCycles(double cycles) {
+  double frac = cycles - std::floor(cycles);  // [0, 1)
+  if (frac >= 0.5) frac -= 1.0;               // [−0.5, 0.5)
+  double x = 2.0 * std::numbers::pi * frac;   // [−π, π)
+  if (x > 0.5 * std::numbers::pi) x = std::numbers::pi - x;
+  if (x < -0.5 * std::numbers::pi) x = -std::numbers::pi - x;
+  const double u = portable::tan(0.5 * x);
+  return 2.0 * u / (1.0 + u * u);
+}
+
+}  // namespace
+
+double NoiseSimulator::extraEffectAt(std::size_t a, std::uint64_t index) {
+  const AxisExtraEffects& e = model_.axes[a].extra;
+  ExtraState& s = extras_[a];
+  const double t = static_cast<double>(index) / model_.rate_hz;
+  double v = 0.0;
+  if (e.temperature_coefficient_dps_per_c != 0.0) {
+    const TemperatureModel& temp = model_.temperature;
+    const double true_temp = temp.final_c + (temp.start_c - temp.final_c) * portable::exp(-t / temp.time_constant_s);
+    v += e.temperature_coefficient_dps_per_c * (true_temp - e.temperature_reference_c);
+  }
+  for (const SinusoidEffect& sin : e.sinusoids)
+    v += sin.amp_dps * portableSinOfCycles(sin.freq_hz * t + sin.phase_rad / (2.0 * std::numbers::pi));
+  if (e.gauss_markov_sigma_dps > 0.0) {
+    v += s.gm_value;
+    s.gm_value = s.gm_decay * s.gm_value + s.gm_innovation_std * extra_noise_->next();
+  }
+  for (const BiasStepEffect& step : e.bias_steps)
+    if (t >= step.time_s) v += step.size_dps;
+  while (s.next_outlier < s.outlier_positions.size() && s.outlier_positions[s.next_outlier] < index) ++s.next_outlier;
+  if (s.next_outlier < s.outlier_positions.size() && s.outlier_positions[s.next_outlier] == index)
+    v += s.outlier_values[s.next_outlier];
+  return v;
 }
 
 void NoiseSimulator::initAr(AxisState& axis, const ArComponent& ar) {
@@ -288,8 +389,10 @@ std::array<double, kSimulatedAxes> NoiseSimulator::nextOutputRateNoise() {
       }
       v += x;
     }
+    if (!extras_.empty()) v += extraEffectAt(a, extra_index_);
     out[a] = v;
   }
+  ++extra_index_;
   return out;
 }
 

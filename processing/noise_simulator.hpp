@@ -32,10 +32,44 @@ struct ArComponent {
   double noise_var = 0.0;  // σa² in (°/s)²
 };
 
+// ---- optional effects beyond the paper's model (the model check's catalogue) --------
+// All are added at the output rate, after the DLPF and before quantisation, in
+// nextOutputRateNoise(); with none set the stream is bit for bit what it was without them
+// (their random numbers come from a generator of their own, seeded apart from the rest).
+struct SinusoidEffect {
+  double freq_hz = 0.0;    // > 0
+  double amp_dps = 0.0;    // ≥ 0, amplitude (half the peak-to-peak)
+  double phase_rad = 0.0;  // amp·sin(2π·f·t + phase)
+};
+struct BiasStepEffect {
+  double time_s = 0.0;    // the bias changes by size_dps from this time on
+  double size_dps = 0.0;
+};
+struct AxisExtraEffects {
+  // rate += k·(T_model(t) − reference), T_model the noise-free temperature curve.
+  double temperature_coefficient_dps_per_c = 0.0;
+  double temperature_reference_c = 25.0;
+  std::vector<SinusoidEffect> sinusoids;
+  // One first-order Gauss–Markov process of correlation time tau_s and stationary std
+  // sigma_dps, simulated exactly at the output rate (0 = none).
+  double gauss_markov_tau_s = 0.0;
+  double gauss_markov_sigma_dps = 0.0;
+  std::vector<BiasStepEffect> bias_steps;
+  // `outlier_count` samples, at distinct positions drawn uniformly over sampleCount(),
+  // get ±outlier_amplitude_dps added (sign at random).
+  std::size_t outlier_count = 0;
+  double outlier_amplitude_dps = 0.0;
+  bool empty() const {
+    return temperature_coefficient_dps_per_c == 0.0 && sinusoids.empty() && gauss_markov_sigma_dps == 0.0 &&
+           bias_steps.empty() && outlier_count == 0;
+  }
+};
+
 struct AxisNoiseModel {
   NoiseTerms terms;     // paper units (µrad, °/√h, °/h, °/h^1.5, °/h²), each ≥ 0
   double bias_dps = 0.0;
   ArComponent ar;
+  AxisExtraEffects extra;  // none by default
 };
 
 // T(t) = final + (start − final)·e^{−t/time_constant} + white noise of std noise_std.
@@ -66,6 +100,10 @@ void validateSimulationModel(const SimulationModel& model);
 // (finite φ, σa² ≥ 0, stationary; messages start with `what`).
 std::size_t sampleRateDivisor(int dlpf_cfg, double rate_hz);
 void validateArComponent(const ArComponent& ar, const std::string& what = "");
+// The extra effects of one axis: finite values, frequencies and a set Gauss–Markov's
+// correlation time > 0, amplitudes ≥ 0 (messages start with `what`). The outlier count
+// is checked against the recording length when the simulator is built.
+void validateExtraEffects(const AxisExtraEffects& extra, const std::string& what = "");
 
 // ---- bias instability (flicker) as a bank of Gauss–Markov processes ----------------
 // One first-order Gauss–Markov process x' = −x/T + w, stationary variance `variance`,
@@ -106,14 +144,15 @@ class NoiseSimulator {
 
   // The next output sample at rate_hz: analog rate at the internal rate → DLPF (if on;
   // started in steady state at the first value) → every D-th sample (t = n/rate_hz,
-  // n = 0, 1, …) → + output-rate terms (Q, AR) → quantised to 1/sensitivity °/s and
+  // n = 0, 1, …) → + output-rate terms (Q, AR, extra effects) → quantised to 1/sensitivity °/s and
   // saturated (if FS_SEL is set; temperature then also to 1/340 °C).
   SimulatedSample next();
 
   // For the mock device, which applies the DLPF, decimation and quantisation itself:
   // the analog rate at the internal rate (bias + ARW + bias instability + RRW + ramp)
   // and temperature, one internal sample per call (t = i/internal rate), and the terms
-  // defined at the output rate (quantisation noise Q, AR), one output sample per call.
+  // defined at the output rate (quantisation noise Q, AR, the extra effects), one output
+  // sample per call.
   // next() is exactly these two composed as described above; use either next() or
   // these two on one instance, not both.
   SimulatedSample nextAnalog();
@@ -153,6 +192,16 @@ class NoiseSimulator {
 
   void initAr(AxisState& axis, const ArComponent& ar);
 
+  // State of the extra effects of one axis (empty when the axis has none).
+  struct ExtraState {
+    double gm_decay = 0.0, gm_innovation_std = 0.0, gm_value = 0.0;
+    std::vector<std::uint64_t> outlier_positions;  // sorted output-sample indices
+    std::vector<double> outlier_values;            // signed, same order
+    std::size_t next_outlier = 0;
+  };
+  void initExtras(std::uint64_t seed, double duration_s);
+  double extraEffectAt(std::size_t axis, std::uint64_t index);
+
   SimulationModel model_;
   SplitMix64 seeder_;  // expands the seed into one xoshiro stream per term and axis
   NormalGenerator temperature_noise_;
@@ -164,6 +213,9 @@ class NoiseSimulator {
   std::vector<DigitalLowPassFilter> dlpf_;
   std::uint64_t analog_index_ = 0;
   std::uint64_t output_index_ = 0;
+  std::vector<ExtraState> extras_;   // empty when no axis has extra effects
+  std::optional<NormalGenerator> extra_noise_;
+  std::uint64_t extra_index_ = 0;    // output samples produced by nextOutputRateNoise()
 };
 
 }  // namespace gyrod::processing

@@ -20,5 +20,6 @@ void addImportCommand(CLI::App& app, CommandRunner& run);
 void addSimulateCommand(CLI::App& app, CommandRunner& run);
 // watch, allan, status: talk to a running gyrod over its socket.
 void addClientCommands(CLI::App& app, CommandRunner& run);
+void addModelCheckCommand(CLI::App& app, CommandRunner& run);
 
 }  // namespace gyrod::gyroctl

@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   addImportCommand(app, run);
   addSimulateCommand(app, run);
   addClientCommands(app, run);
+  addModelCheckCommand(app, run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

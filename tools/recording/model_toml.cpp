@@ -126,10 +126,67 @@ class ModelReader {
         out.bias_dps = number(node, key, where);
       } else if (k == "ar") {
         readAr(table(node, key), axis, out.ar);
+      } else if (k == "extra") {
+        readExtra(table(node, key), axis, out.extra);
       } else {
         fail(key.source(), "unknown key '" + k + "' in [" + axis +
-                               "] (expected the five noise-term keys of noise_terms.hpp, bias_dps, [" + axis + ".ar])");
+                               "] (expected the five noise-term keys of noise_terms.hpp, bias_dps, [" + axis + ".ar], [" +
+                               axis + ".extra])");
       }
+    }
+  }
+
+  // [x.extra]: the optional effects of the model check (processing::AxisExtraEffects).
+  //   temperature_coefficient_dps_per_c, temperature_reference_c, gauss_markov_tau_s,
+  //   gauss_markov_sigma_dps, outlier_count, outlier_amplitude_dps,
+  //   sinusoids = [{freq_hz = 1.0, amp_dps = 0.05, phase_rad = 0.0}, ...],
+  //   bias_steps = [{time_s = 60.0, size_dps = 0.02}, ...]
+  void readExtra(const toml::table& t, const std::string& axis, processing::AxisExtraEffects& e) const {
+    const std::string where = axis + ".extra.";
+    for (auto&& [key, node] : t) {
+      const std::string k(key.str());
+      if (k == "temperature_coefficient_dps_per_c") e.temperature_coefficient_dps_per_c = number(node, key, where);
+      else if (k == "temperature_reference_c") e.temperature_reference_c = number(node, key, where);
+      else if (k == "gauss_markov_tau_s") e.gauss_markov_tau_s = nonNegative(node, key, where);
+      else if (k == "gauss_markov_sigma_dps") e.gauss_markov_sigma_dps = nonNegative(node, key, where);
+      else if (k == "outlier_amplitude_dps") e.outlier_amplitude_dps = nonNegative(node, key, where);
+      else if (k == "outlier_count") e.outlier_count = static_cast<std::size_t>(integerIn(node, key, 0, 1000000000));
+      else if (k == "sinusoids" || k == "bias_steps") {
+        if (!node.is_array()) fail(key.source(), where + k + " must be an array of inline tables, got " + typeName(node));
+        for (const toml::node& element : *node.as_array()) {
+          if (!element.is_table()) fail(key.source(), where + k + " must contain inline tables only, found " + typeName(element));
+          if (k == "sinusoids") {
+            processing::SinusoidEffect sin;
+            for (auto&& [ek, ev] : *element.as_table()) {
+              const std::string n(ek.str());
+              if (n == "freq_hz") sin.freq_hz = positive(ev, ek, where + "sinusoids.");
+              else if (n == "amp_dps") sin.amp_dps = nonNegative(ev, ek, where + "sinusoids.");
+              else if (n == "phase_rad") sin.phase_rad = number(ev, ek, where + "sinusoids.");
+              else fail(ek.source(), "unknown key '" + n + "' in " + where + "sinusoids (expected freq_hz, amp_dps, phase_rad)");
+            }
+            e.sinusoids.push_back(sin);
+          } else {
+            processing::BiasStepEffect step;
+            for (auto&& [ek, ev] : *element.as_table()) {
+              const std::string n(ek.str());
+              if (n == "time_s") step.time_s = nonNegative(ev, ek, where + "bias_steps.");
+              else if (n == "size_dps") step.size_dps = number(ev, ek, where + "bias_steps.");
+              else fail(ek.source(), "unknown key '" + n + "' in " + where + "bias_steps (expected time_s, size_dps)");
+            }
+            e.bias_steps.push_back(step);
+          }
+        }
+      } else {
+        fail(key.source(), "unknown key '" + k + "' in [" + axis +
+                               ".extra] (expected temperature_coefficient_dps_per_c, temperature_reference_c, "
+                               "gauss_markov_tau_s, gauss_markov_sigma_dps, outlier_count, outlier_amplitude_dps, "
+                               "sinusoids, bias_steps)");
+      }
+    }
+    try {
+      processing::validateExtraEffects(e, axis + ".");
+    } catch (const std::invalid_argument& ex) {
+      throw RecordingError(source_ + ": " + ex.what());
     }
   }
 
@@ -229,6 +286,30 @@ std::string modelToToml(const processing::SimulationModel& model) {
       }
       out += "]\n";
       appendKeyValue(out, "noise_var", axis.ar.noise_var);
+    }
+    const processing::AxisExtraEffects& e = axis.extra;
+    if (!e.empty()) {
+      out += std::string("\n[") + names[a] + ".extra]\n";
+      appendKeyValue(out, "temperature_coefficient_dps_per_c", e.temperature_coefficient_dps_per_c);
+      appendKeyValue(out, "temperature_reference_c", e.temperature_reference_c);
+      appendKeyValue(out, "gauss_markov_tau_s", e.gauss_markov_tau_s);
+      appendKeyValue(out, "gauss_markov_sigma_dps", e.gauss_markov_sigma_dps);
+      out += "outlier_count = " + std::to_string(e.outlier_count) + "\n";
+      appendKeyValue(out, "outlier_amplitude_dps", e.outlier_amplitude_dps);
+      char buf[160];
+      out += "sinusoids = [";
+      for (std::size_t i = 0; i < e.sinusoids.size(); ++i) {
+        std::snprintf(buf, sizeof buf, "%s{freq_hz = %.17g, amp_dps = %.17g, phase_rad = %.17g}", i ? ", " : "",
+                      e.sinusoids[i].freq_hz, e.sinusoids[i].amp_dps, e.sinusoids[i].phase_rad);
+        out += buf;
+      }
+      out += "]\nbias_steps = [";
+      for (std::size_t i = 0; i < e.bias_steps.size(); ++i) {
+        std::snprintf(buf, sizeof buf, "%s{time_s = %.17g, size_dps = %.17g}", i ? ", " : "", e.bias_steps[i].time_s,
+                      e.bias_steps[i].size_dps);
+        out += buf;
+      }
+      out += "]\n";
     }
   }
   return out;

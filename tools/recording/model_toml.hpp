@@ -19,6 +19,15 @@
 //   [x.ar]                  # optional AR(p) at the output rate
 //   phi = [-0.2855]
 //   noise_var = 0.0577      # σa² [(°/s)²]
+//   [x.extra]               # optional effects beyond the paper's model (AxisExtraEffects)
+//   temperature_coefficient_dps_per_c = 0.01
+//   temperature_reference_c = 25.0
+//   gauss_markov_tau_s = 20.0
+//   gauss_markov_sigma_dps = 0.002
+//   outlier_count = 5
+//   outlier_amplitude_dps = 1.0
+//   sinusoids = [{freq_hz = 1.08, amp_dps = 0.07, phase_rad = 0.0}]
+//   bias_steps = [{time_s = 600.0, size_dps = 0.02}]
 //
 // The noise-term keys are NoiseTerms' field names (noise_terms.hpp). Any other key, a
 // wrong type or a bad value is an error "FILE:LINE: ..." naming the key.

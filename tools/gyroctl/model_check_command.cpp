@@ -1,0 +1,310 @@
+// gyroctl model-check: where the paper's model fails on a recording, the named cause, and
+// the gain of the extended model (processing/model_check.hpp, docs/model-check.md).
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "processing/model_check.hpp"
+#include "processing/noise_terms.hpp"
+#include "tools/gyroctl/commands.hpp"
+#include "tools/gyroctl/input.hpp"
+
+namespace gyrod::gyroctl {
+namespace {
+
+using namespace gyrod::processing;
+using nlohmann::json;
+
+struct ModelCheckCliOptions {
+  std::string file;
+  std::optional<double> rate_hz;
+  std::string axis = "all";
+  bool json = false;
+  std::string report_dir;
+  std::uint64_t seed = 1;
+  std::size_t replicas = 40;
+  std::size_t threads = 0;
+};
+
+std::string fmt(const char* f, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+
+json effectParams(const DetectedEffect& e) {
+  switch (e.effect) {
+    case ModelEffect::TemperatureBias: return {{"k_dps_per_c", e.k_dps_per_c}};
+    case ModelEffect::Sinusoid: return {{"freq_hz", e.freq_hz}, {"amp_dps", e.amp_dps}};
+    case ModelEffect::GaussMarkov: return {{"tau_s", e.tau_s}, {"sigma_dps", e.sigma_dps}};
+    case ModelEffect::BiasSteps: return {{"count", e.count}, {"times_s", e.times_s}};
+    case ModelEffect::Outliers: return {{"count", e.count}};
+    case ModelEffect::SampleGaps: return {{"count", e.count}, {"lost", e.lost}};
+    case ModelEffect::Unexplained:
+      return {{"where", "tau " + fmt("%.4g", e.where_lo) + " to " + fmt("%.4g", e.where_hi) + " s"},
+              {"tau_lo_s", e.where_lo},
+              {"tau_hi_s", e.where_hi}};
+  }
+  return json::object();
+}
+
+std::string paramsText(const DetectedEffect& e) {
+  std::string s;
+  const json params = effectParams(e);
+  for (const auto& [k, v] : params.items()) {
+    if (!s.empty()) s += ", ";
+    s += k + " = " + (v.is_string() ? v.get<std::string>() : v.dump());
+  }
+  return s;
+}
+
+json termsJson(const NoiseTerms& t) {
+  json j = json::object();
+  for (NoiseTerm term : kAllNoiseTerms) j[std::string(noiseTermKey(term))] = t.get(term);
+  return j;
+}
+
+json gainJson(const ModelCheckGain& g) {
+  return {{"adev_log_error_base", g.adev_log_error_base},
+          {"adev_log_error_extended", g.adev_log_error_extended},
+          {"innovation_var_base", g.innovation_var_base},
+          {"innovation_var_extended", g.innovation_var_extended},
+          {"ljung_box_p_base", g.ljung_box_p_base},
+          {"ljung_box_p_extended", g.ljung_box_p_extended},
+          {"in_band_base", g.in_band_base},
+          {"in_band_extended", g.in_band_extended}};
+}
+
+json axisJson(const AxisModelCheck& r) {
+  json effects = json::array();
+  for (const DetectedEffect& e : r.effects)
+    effects.push_back({{"effect", std::string(modelEffectName(e.effect))}, {"params", effectParams(e)}, {"evidence", e.evidence}});
+  json stats = json::array();
+  for (const CheckStatistic& s : r.statistics)
+    stats.push_back({{"name", s.name}, {"value", s.value}, {"null_median", s.null_median}, {"threshold", s.threshold},
+                     {"fired", s.fired}});
+  return {{"effects", effects},
+          {"gain", gainJson(r.gain)},
+          {"samples", r.samples},
+          {"base_terms", termsJson(r.base_fit.value)},
+          {"extended_terms", termsJson(r.extended_fit.value)},
+          {"ar_order", r.ar_order},
+          {"replicas_simulated", r.replicas_simulated},
+          {"statistics", stats}};
+}
+
+void printAxisText(std::ostream& o, const std::string& name, const AxisModelCheck& r) {
+  o << "\n== " << name << " ==\n";
+  if (r.effects.empty()) o << "  the base model holds: no effect\n";
+  for (const DetectedEffect& e : r.effects)
+    o << "  " << modelEffectName(e.effect) << " (" << paramsText(e) << ")\n      " << e.evidence << '\n';
+  const ModelCheckGain& g = r.gain;
+  char line[256];
+  o << "  gain                    base        extended\n";
+  std::snprintf(line, sizeof line, "  adev log error    %12.4g    %12.4g\n", g.adev_log_error_base, g.adev_log_error_extended);
+  o << line;
+  std::snprintf(line, sizeof line, "  innovation var    %12.4g    %12.4g\n", g.innovation_var_base, g.innovation_var_extended);
+  o << line;
+  std::snprintf(line, sizeof line, "  Ljung-Box p       %12.4g    %12.4g\n", g.ljung_box_p_base, g.ljung_box_p_extended);
+  o << line;
+  std::snprintf(line, sizeof line, "  in 90%% band       %12.3f    %12.3f\n", g.in_band_base, g.in_band_extended);
+  o << line;
+}
+
+// ---- report ----------------------------------------------------------------------------
+
+void writeText(const std::filesystem::path& p, const std::string& text) { writeFileAtomically(p.string(), text); }
+
+bool gnuplotInstalled() { return std::system("command -v gnuplot >/dev/null 2>&1") == 0; }
+
+std::string shellQuoted(const std::filesystem::path& p) {
+  std::string s = "'";
+  for (char ch : p.string()) s += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+  return s + "'";
+}
+
+// Data files and gnuplot scripts for one axis; returns the plots made (file names).
+std::vector<std::string> writeAxisPlots(const std::filesystem::path& dir, const std::string& name, const AxisModelCheck& r,
+                                        bool run_gnuplot) {
+  std::vector<std::string> made;
+  {
+    std::ostringstream d;
+    d << "# tau_s measured base_median base_lo base_hi extended_median extended_lo extended_hi\n";
+    for (std::size_t j = 0; j < r.allan_base.tau_s.size(); ++j)
+      d << r.allan_base.tau_s[j] << ' ' << r.allan_base.measured[j] << ' ' << r.allan_base.median[j] << ' '
+        << r.allan_base.lo[j] << ' ' << r.allan_base.hi[j] << ' ' << r.allan_extended.median[j] << ' '
+        << r.allan_extended.lo[j] << ' ' << r.allan_extended.hi[j] << '\n';
+    writeText(dir / ("allan_" + name + ".dat"), d.str());
+    std::ostringstream g;
+    g << "set terminal pngcairo size 900,600\nset output 'allan_" << name << ".png'\n"
+      << "set logscale xy\nset grid\nset xlabel 'tau [s]'\nset ylabel 'Allan deviation [deg/s]'\n"
+      << "set title 'Allan deviation, " << name << ": measured against 90 % bands of the replicas'\n"
+      << "plot 'allan_" << name << ".dat' u 1:4:5 w filledcurves lc rgb '#c0c0ff' fs transparent solid 0.5 t 'base 90 %', "
+      << "'' u 1:7:8 w filledcurves lc rgb '#ffc080' fs transparent solid 0.5 t 'extended 90 %', "
+      << "'' u 1:3 w l lc rgb 'blue' dt 2 t 'base median', '' u 1:6 w l lc rgb '#d06000' dt 2 t 'extended median', "
+      << "'' u 1:2 w lp pt 7 ps 0.6 lc rgb 'black' t 'measured'\n";
+    writeText(dir / ("allan_" + name + ".gp"), g.str());
+    made.push_back("allan_" + name + ".png");
+  }
+  {
+    std::ostringstream d;
+    d << "# freq_hz psd_measured psd_base_median psd_measured_band_peak  [(deg/s)^2/Hz]\n";
+    for (std::size_t j = 0; j < r.spectrum_freq_hz.size(); ++j)
+      if (std::isfinite(r.spectrum_measured[j]) && std::isfinite(r.spectrum_base_median[j]))
+        d << r.spectrum_freq_hz[j] << ' ' << r.spectrum_measured[j] << ' ' << r.spectrum_base_median[j] << ' '
+          << r.spectrum_measured_peak[j] << '\n';
+    writeText(dir / ("spectrum_" + name + ".dat"), d.str());
+    std::ostringstream g;
+    g << "set terminal pngcairo size 900,600\nset output 'spectrum_" << name << ".png'\n"
+      << "set logscale xy\nset grid\nset xlabel 'frequency [Hz]'\nset ylabel 'PSD [(deg/s)^2/Hz]'\n"
+      << "set title 'Power spectral density (band averages), " << name << "'\n"
+      << "plot 'spectrum_" << name << ".dat' u 1:4 w l lc rgb '#a0a0a0' t 'measured, largest bin of each band', "
+      << "'' u 1:2 w lp pt 7 ps 0.5 lc rgb 'black' t 'measured (band average)', "
+      << "'' u 1:3 w l lc rgb 'blue' t 'base model (median of replicas)'\n";
+    writeText(dir / ("spectrum_" + name + ".gp"), g.str());
+    made.push_back("spectrum_" + name + ".png");
+  }
+  if (!r.block_temperature_c.empty()) {
+    std::ostringstream d;
+    d << "# temperature_c low_passed_residual_dps (block means)\n";
+    for (std::size_t j = 0; j < r.block_temperature_c.size(); ++j)
+      d << r.block_temperature_c[j] << ' ' << r.block_residual_dps[j] << '\n';
+    writeText(dir / ("temperature_" + name + ".dat"), d.str());
+    std::ostringstream g;
+    g << "set terminal pngcairo size 900,600\nset output 'temperature_" << name << ".png'\n"
+      << "set grid\nset xlabel 'temperature [C]'\nset ylabel 'low-passed residual [deg/s]'\n"
+      << "set title 'Residual (detrended, block means) against temperature, " << name << "'\n"
+      << "plot 'temperature_" << name << ".dat' u 1:2 w p pt 7 ps 0.3 lc rgb 'black' notitle\n";
+    writeText(dir / ("temperature_" + name + ".gp"), g.str());
+    made.push_back("temperature_" + name + ".png");
+  }
+  if (run_gnuplot) {
+    for (const std::string& png : made) {
+      const std::string script = png.substr(0, png.size() - 4) + ".gp";
+      const std::string cmd = "cd " + shellQuoted(dir) + " && gnuplot " + shellQuoted(script) + " >/dev/null 2>&1";
+      if (std::system(cmd.c_str()) != 0) throw std::runtime_error("gnuplot failed on " + (dir / script).string());
+    }
+  }
+  return made;
+}
+
+void writeReport(const std::string& dir_text, const ModelCheckCliOptions& opt, const LoadedInput& in,
+                 const std::vector<std::pair<std::string, AxisModelCheck>>& results, double seconds) {
+  const std::filesystem::path dir(dir_text);
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw std::runtime_error(dir_text + ": cannot create the report folder: " + ec.message());
+  const bool plots = gnuplotInstalled();
+  std::ostringstream md;
+  md << "# Model check: " << opt.file << "\n\n"
+     << in.recording.size() << " samples at " << in.rate_hz << " Hz (" << in.rate_source << "), "
+     << fmt("%.1f", static_cast<double>(in.recording.size()) / in.rate_hz) << " s; "
+     << (in.recording.temp.empty() ? "no temperature channel" : "temperature channel present") << "; "
+     << (in.recording.t.empty() ? "no t column" : "t column present") << ". Replicas per round: " << opt.replicas
+     << ", seed " << opt.seed << "; checked in " << fmt("%.2f", seconds) << " s.\n\n"
+     << "The base model is the paper's (five Allan terms fitted to the Allan deviation, AR(p) by AIC for the "
+        "Kalman filter). Every threshold comes from replicas simulated from the fitted model; see docs/model-check.md.\n";
+  if (!plots) md << "\n(gnuplot is not installed: the plot data and scripts are written, the pictures are not.)\n";
+  for (const auto& [name, r] : results) {
+    md << "\n## " << name << "\n\n";
+    if (r.effects.empty()) md << "The base model holds: no effect found.\n";
+    else {
+      md << "| effect | parameters | evidence |\n|---|---|---|\n";
+      for (const DetectedEffect& e : r.effects)
+        md << "| `" << modelEffectName(e.effect) << "` | " << paramsText(e) << " | " << e.evidence << " |\n";
+    }
+    const ModelCheckGain& g = r.gain;
+    md << "\n| figure | base | extended |\n|---|---|---|\n"
+       << "| mean \\|log10(measured/median simulated ADEV)\\| | " << fmt("%.4g", g.adev_log_error_base) << " | "
+       << fmt("%.4g", g.adev_log_error_extended) << " |\n"
+       << "| Kalman innovation variance [(deg/s)^2] | " << fmt("%.4g", g.innovation_var_base) << " | "
+       << fmt("%.4g", g.innovation_var_extended) << " |\n"
+       << "| Ljung-Box p of the innovations | " << fmt("%.3g", g.ljung_box_p_base) << " | "
+       << fmt("%.3g", g.ljung_box_p_extended) << " |\n"
+       << "| fraction of tau inside the 90 % band | " << fmt("%.3f", g.in_band_base) << " | "
+       << fmt("%.3f", g.in_band_extended) << " |\n";
+    md << "\nStatistics (value, median of the null, threshold):\n\n";
+    for (const CheckStatistic& s : r.statistics)
+      md << "- " << s.name << ": " << fmt("%.4g", s.value) << " (null median " << fmt("%.4g", s.null_median)
+         << ", threshold " << fmt("%.4g", s.threshold) << ")" << (s.fired ? " **fired**" : "") << "\n";
+    md << "\n";
+    for (const std::string& png : writeAxisPlots(dir, name, r, plots)) md << "![" << png << "](" << png << ")\n";
+  }
+  writeText(dir / "report.md", md.str());
+}
+
+int runModelCheck(const ModelCheckCliOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  const LoadedInput in = loadInput(opt.file, opt.rate_hz, opt.axis);
+  const auto& rec = in.recording;
+  if (rec.size() < kModelCheckMinSamples) {
+    std::ostringstream s;
+    s << opt.file << ": " << rec.size() << " samples are too few for the model check (need at least "
+      << kModelCheckMinSamples << ")";
+    throw recording::RecordingError(s.str());
+  }
+  ModelCheckOptions options;
+  options.seed = opt.seed;
+  options.replicas = opt.replicas;
+  options.threads = opt.threads;
+  std::vector<std::pair<std::string, AxisModelCheck>> results;
+  for (std::size_t idx : in.axis_indices) {
+    AxisModelCheckInput axis{rec.axes[idx], in.rate_hz, rec.temp, rec.t};
+    results.emplace_back(rec.axis_names[idx], checkAxisModel(axis, options));
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (opt.json) {
+    json doc;
+    doc["file"] = opt.file;
+    doc["rate_hz"] = in.rate_hz;
+    doc["samples"] = rec.size();
+    doc["seed"] = opt.seed;
+    doc["replicas"] = opt.replicas;
+    doc["elapsed_s"] = seconds;
+    doc["axes"] = json::object();
+    for (const auto& [name, r] : results) doc["axes"][name] = axisJson(r);
+    std::cout << doc.dump(1) << '\n';
+  } else {
+    std::printf("gyroctl model-check %s: %zu samples at %g Hz (%s), %.1f s; %zu replicas per round, seed %llu\n",
+                opt.file.c_str(), rec.size(), in.rate_hz, in.rate_source.c_str(),
+                static_cast<double>(rec.size()) / in.rate_hz, opt.replicas, static_cast<unsigned long long>(opt.seed));
+    for (const auto& [name, r] : results) printAxisText(std::cout, name, r);
+    std::printf("\nchecked in %.2f s\n", seconds);
+  }
+  if (!opt.report_dir.empty()) {
+    writeReport(opt.report_dir, opt, in, results, seconds);
+    if (!opt.json) std::printf("report written to %s/report.md\n", opt.report_dir.c_str());
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void addModelCheckCommand(CLI::App& app, CommandRunner& run) {
+  auto opt = std::make_shared<ModelCheckCliOptions>();
+  auto* sub = app.add_subcommand("model-check",
+                                 "Where the paper's noise model fails on a recording, the named cause "
+                                 "(temperature_bias, sinusoid, gauss_markov, bias_steps, outliers, sample_gaps, "
+                                 "or unexplained), and the gain of the extended model");
+  sub->add_option("FILE", opt->file, "CSV with header t,gx,gy,gz,temp (any subset), as analyze reads")->required();
+  sub->add_option("--rate", opt->rate_hz, "sample rate [Hz] (default: from t, else 50)");
+  sub->add_option("--axis", opt->axis, "gx, gy, gz or all")->default_val("all");
+  sub->add_flag("--json", opt->json, "one JSON document on stdout");
+  sub->add_option("--report", opt->report_dir, "write report.md with plots (gnuplot, when installed) into this folder");
+  sub->add_option("--seed", opt->seed, "seed of the replicas")->default_val(1);
+  sub->add_option("--replicas", opt->replicas, "replicas per round (the null distributions)")
+      ->default_val(40)->check(CLI::Range(std::size_t{8}, std::size_t{10000}));
+  sub->add_option("--threads", opt->threads, "threads for the replicas (0: all cores)")->default_val(0);
+  sub->callback([&run, opt] { run = [opt] { return runModelCheck(*opt); }; });
+}
+
+}  // namespace gyrod::gyroctl
