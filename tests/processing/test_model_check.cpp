@@ -202,11 +202,11 @@ TEST(ModelCheck, AResonanceIsUnexplainedNotForcedIntoTheCatalogue) {
   const double r = 0.97, theta = std::numbers::pi / 5.0;
   m.axes[0].ar.phi = {2.0 * r * std::cos(theta), -r * r};
   m.axes[0].ar.noise_var = 1e-4;
-  NoiseSimulator sim(m, 200.0, 41);  // short: this one also runs under the sanitizers
+  NoiseSimulator sim(m, 150.0, 41);  // short: this one also runs under the sanitizers
   std::vector<double> x(sim.sampleCount());
   for (double& v : x) v = sim.next().rate_dps[0];
   ModelCheckOptions o = testOptions(41);
-  o.replicas = 10;
+  o.replicas = 8;
   const AxisModelCheck res = checkAxisModel({x, kRate, {}, {}}, o);
   const DetectedEffect* u = find(res, ModelEffect::Unexplained);
   ASSERT_NE(u, nullptr) << describe(res);
