@@ -1,5 +1,6 @@
 #include "daemon/gyrod.hpp"
 
+#include <sched.h>
 #include <spdlog/spdlog.h>
 #include <sys/timerfd.h>
 #include <systemd/sd-daemon.h>
@@ -53,6 +54,21 @@ spdlog::level::level_enum spdlogLevel(driver::LogLevel level) {
     case driver::LogLevel::Error: return spdlog::level::err;
   }
   return spdlog::level::info;
+}
+
+// How soon a data-ready wake-up runs on a busy CPU depends on the loop's policy: SCHED_OTHER
+// lets the running task finish its slice, often until the next scheduler tick (4 ms at
+// HZ=250); SCHED_FIFO preempts it at once (docs/driver.md "Latency").
+std::string loopSchedulingNote() {
+  const int policy = ::sched_getscheduler(0);
+  if (policy == SCHED_FIFO || policy == SCHED_RR) {
+    sched_param param{};
+    ::sched_getparam(0, &param);
+    return std::string(policy == SCHED_FIFO ? "SCHED_FIFO" : "SCHED_RR") + " priority " +
+           std::to_string(param.sched_priority);
+  }
+  return "SCHED_OTHER: when the CPUs are busy a sample can reach clients a scheduler tick late (1-10 ms); "
+         "run gyrod SCHED_FIFO for sub-millisecond delivery (the systemd unit does; by hand: chrt -f 10 gyrod ...)";
 }
 
 Vec3 modelBias(const std::string& path) {
@@ -155,6 +171,7 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
                config_.device.rate_hz, config_.device.dlpf, config_.device.full_scale_dps, server_->socketPath().empty()
                    ? std::string("(socket activation)") : server_->socketPath(),
                recorder_ ? ", recording to " + recorder_->currentFile() : std::string());
+  if (!device_.virtual_clock) spdlog::info("event loop scheduling: {}", loopSchedulingNote());
   if (pipeline_.phase() == PipelinePhase::Estimating)
     spdlog::info("keep the sensor still: estimating {} over the first {:.1f} s",
                  config_.bias.source == BiasSource::Estimate ? "the bias and the filter" : "the filter",

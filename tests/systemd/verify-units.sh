@@ -33,6 +33,13 @@ if [ -n "$problems" ]; then
   echo "FAIL: systemd-analyze verify complained"
   exit 1
 fi
+# The event loop must run SCHED_FIFO: under SCHED_OTHER a busy CPU delays data-ready
+# wake-ups by a scheduler tick (docs/driver.md "Latency").
+if ! grep -qx 'CPUSchedulingPolicy=fifo' "$work/gyrod.service" ||
+  ! grep -qxE 'CPUSchedulingPriority=[1-9][0-9]?' "$work/gyrod.service"; then
+  echo "FAIL: gyrod.service must set CPUSchedulingPolicy=fifo and CPUSchedulingPriority=1..99"
+  exit 1
+fi
 # The sysusers.d entry: a dry run parses it and prints what it would create.
 if command -v systemd-sysusers >/dev/null 2>&1; then
   if ! systemd-sysusers --dry-run "$src/systemd/gyrod.sysusers" >"$work/sysusers.log" 2>&1 ||
