@@ -1,5 +1,8 @@
 #include "daemon/recorder.hpp"
 
+#include <pthread.h>
+#include <sched.h>
+
 #include <fcntl.h>
 #include <spdlog/spdlog.h>
 #include <sys/stat.h>
@@ -219,6 +222,10 @@ std::vector<std::string> Recorder::files() const {
 }
 
 void Recorder::writerLoop() {
+  // gyrod's event loop may run SCHED_FIFO (systemd/gyrod.service.in); this thread inherits
+  // the policy, and formatting and writing lines must never compete with the loop for a CPU.
+  const sched_param normal{};
+  ::pthread_setschedparam(::pthread_self(), SCHED_OTHER, &normal);
   const auto interval = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
       std::chrono::duration<double>(options_.flush_interval_s));
   auto next = std::chrono::steady_clock::now() + interval;
