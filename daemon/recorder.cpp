@@ -134,6 +134,10 @@ bool Recorder::pushSample(double t_s, double gx_dps, double gy_dps, double gz_dp
   r.gy_dps = gy_dps;
   r.gz_dps = gz_dps;
   r.temp_c = temp_c;
+  return pushRecord(r);
+}
+
+bool Recorder::pushRecord(const RecorderRecord& r) noexcept {
   if (!ring_.tryPush(r)) {
     ++pending_drops_;
     dropped_.store(dropped_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
@@ -159,14 +163,7 @@ bool Recorder::pushGap(std::uint64_t seq, double t_s, std::uint32_t count, std::
     r.gap_reason[i] = plain ? c : '_';
   }
   r.gap_reason[n] = '\0';
-  if (!ring_.tryPush(r)) {
-    ++pending_drops_;
-    dropped_.store(dropped_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
-    return false;
-  }
-  pending_drops_ = 0;
-  pushed_.store(pushed_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
-  return true;
+  return pushRecord(r);
 }
 
 void Recorder::flush() {

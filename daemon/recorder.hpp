@@ -115,6 +115,8 @@ class Recorder {
   std::vector<std::string> files() const;
 
  private:
+  // Producer side: into the ring, or counted as dropped.
+  bool pushRecord(const RecorderRecord& r) noexcept;
   void writerLoop();
   void flushOnce(bool final_flush);
   void appendLine(std::string_view line, bool is_record);

@@ -52,6 +52,13 @@ Stream readRates(LineClient& c, std::size_t count) {
   return s;
 }
 
+// Connects a client to `sock`, takes its VERSION line and turns watching on.
+void startWatching(LineClient& c) {
+  ASSERT_TRUE(c.connected());
+  ASSERT_TRUE(c.readLine());
+  ASSERT_TRUE(c.send("{\"cmd\":\"watch\"}\n"));
+}
+
 std::string onlyRecordingFile(const std::filesystem::path& dir) {
   std::vector<std::string> files;
   for (const auto& e : std::filesystem::directory_iterator(dir))
@@ -270,9 +277,8 @@ TEST(Gyrod, SighupReloadsTheFilterWithoutLosingTheStream) {
   const auto cfg = d.write("gyrod.toml", mockConfig(d.path(), 20.0));
   GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt");
   LineClient w((d.path() / "gyrod.sock").string());
-  ASSERT_TRUE(w.connected());
-  ASSERT_TRUE(w.readLine());
-  w.send("{\"cmd\":\"watch\"}\n");
+  startWatching(w);
+  if (HasFatalFailure()) return;
   Stream before = readRates(w, 200);
   ASSERT_EQ(before.rates.size(), 200u);
   std::string text = readWholeFile(cfg);
@@ -295,9 +301,8 @@ TEST(Gyrod, RecordingReadsCleanlyAfterKillDashNine) {
   const auto cfg = d.write("gyrod.toml", mockConfig(d.path(), 20.0));
   GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt");
   LineClient w((d.path() / "gyrod.sock").string());
-  ASSERT_TRUE(w.connected());
-  ASSERT_TRUE(w.readLine());
-  w.send("{\"cmd\":\"watch\"}\n");
+  startWatching(w);
+  if (HasFatalFailure()) return;
   const Stream s = readRates(w, 1500);
   ASSERT_EQ(s.rates.size(), 1500u);
   const auto seen = s.rates.back()["seq"].get<std::uint64_t>();
