@@ -142,24 +142,27 @@ void SamplePipeline::discontinuity() {
 
 void SamplePipeline::reloadFilter(std::size_t mean_window, double mean_threshold_dps,
                                   const processing::KalmanOverrides& kalman) {
-  processing::GrossErrorMeanFilter probe(mean_window, mean_threshold_dps);  // validates
+  // Everything is validated on copies first, so that a bad reload changes nothing.
+  processing::GrossErrorMeanFilter probe(mean_window, mean_threshold_dps);
   (void)probe;
-  settings_.mean_window = mean_window;
-  settings_.mean_threshold_dps = mean_threshold_dps;
-  if (kalman.a) settings_.kalman.a = kalman.a;
-  if (kalman.q) settings_.kalman.q = kalman.q;
-  if (kalman.r) settings_.kalman.r = kalman.r;
-  for (auto& p : params_) {
+  processing::ScalarKalmanFilter given({kalman.a.value_or(0.0), kalman.q.value_or(0.0), kalman.r.value_or(1.0), 0.0, {}});
+  (void)given;
+  std::array<processing::FilterChainParameters, kAxes> params = params_;
+  for (auto& p : params) {
     p.mean_window = mean_window;
     p.mean_threshold_dps = mean_threshold_dps;
     if (kalman.a) p.kalman.a = *kalman.a;
     if (kalman.q) p.kalman.q = *kalman.q;
     if (kalman.r) p.kalman.r = *kalman.r;
+    if (phase_ == PipelinePhase::Running) processing::ScalarKalmanFilter check(p.kalman);
   }
-  if (phase_ == PipelinePhase::Running) {
-    for (auto& p : params_) processing::ScalarKalmanFilter check(p.kalman);  // validates before replacing
-    startFilters();
-  }
+  settings_.mean_window = mean_window;
+  settings_.mean_threshold_dps = mean_threshold_dps;
+  if (kalman.a) settings_.kalman.a = kalman.a;
+  if (kalman.q) settings_.kalman.q = kalman.q;
+  if (kalman.r) settings_.kalman.r = kalman.r;
+  params_ = params;
+  if (phase_ == PipelinePhase::Running) startFilters();
 }
 
 AllanStreams SamplePipeline::allanSnapshot() const {

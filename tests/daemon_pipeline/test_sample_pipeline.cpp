@@ -192,3 +192,15 @@ TEST(SamplePipeline, SettingsThatCannotWorkAreRefused) {
   p.mean_window = 0;
   EXPECT_THROW(SamplePipeline{p}, std::invalid_argument);
 }
+
+TEST(SamplePipeline, ABadKalmanReloadChangesNothing) {
+  PipelineSettings p = baseSettings();
+  p.bias_origin = BiasOrigin::Config;
+  p.kalman = {0.9, 0.001, 0.1};
+  SamplePipeline pipeline(p);
+  for (int i = 0; i < 50; ++i) pipeline.process(i, i / 50.0, {0.1, 0.2, 0.3}, 25.0);
+  EXPECT_THROW(pipeline.reloadFilter(5, 0.5, {0.5, std::nullopt, -1.0}), std::invalid_argument);
+  EXPECT_EQ(pipeline.filterParameters()[0].mean_window, 20u);
+  EXPECT_EQ(pipeline.filterParameters()[0].kalman.a, 0.9);
+  EXPECT_EQ(pipeline.filterParameters()[0].kalman.r, 0.1);
+}
