@@ -59,6 +59,12 @@ void startWatching(LineClient& c) {
   ASSERT_TRUE(c.send("{\"cmd\":\"watch\"}\n"));
 }
 
+// Consecutive RATE lines carry consecutive sequence numbers.
+void expectContiguous(const std::vector<json>& rates) {
+  for (std::size_t i = 1; i < rates.size(); ++i)
+    ASSERT_EQ(rates[i]["seq"].get<std::uint64_t>(), rates[i - 1]["seq"].get<std::uint64_t>() + 1) << "line " << i;
+}
+
 std::string onlyRecordingFile(const std::filesystem::path& dir) {
   std::vector<std::string> files;
   for (const auto& e : std::filesystem::directory_iterator(dir))
@@ -80,8 +86,7 @@ TEST(Gyrod, StreamFilterAndAllanAgreeWithTheOfflineToolsOnItsOwnRecording) {
   const Stream s = readRates(watcher, 2500);
   ASSERT_EQ(s.rates.size(), 2500u);
   EXPECT_TRUE(s.gaps.empty());
-  for (std::size_t i = 1; i < s.rates.size(); ++i)
-    ASSERT_EQ(s.rates[i]["seq"].get<std::uint64_t>(), s.rates[i - 1]["seq"].get<std::uint64_t>() + 1);
+  expectContiguous(s.rates);
 
   LineClient asker((d.path() / "gyrod.sock").string());
   ASSERT_TRUE(asker.readLine());  // VERSION
@@ -216,8 +221,7 @@ TEST(Gyrod, StalledClientIsDroppedAndTheOthersReceiveEverything) {
   for (auto& t : readers) t.join();
   for (const Stream& s : streams) {
     ASSERT_EQ(s.rates.size(), 2000u) << readWholeFile(d.path() / "log.txt");
-    for (std::size_t i = 1; i < s.rates.size(); ++i)
-      ASSERT_EQ(s.rates[i]["seq"].get<std::uint64_t>(), s.rates[i - 1]["seq"].get<std::uint64_t>() + 1);
+    expectContiguous(s.rates);
   }
   LineClient asker(sock);
   ASSERT_TRUE(asker.readLine());
@@ -289,8 +293,7 @@ TEST(Gyrod, SighupReloadsTheFilterWithoutLosingTheStream) {
   ASSERT_EQ(after.rates.size(), 1000u);
   EXPECT_TRUE(after.gaps.empty());
   EXPECT_EQ(after.rates.front()["seq"].get<std::uint64_t>(), before.rates.back()["seq"].get<std::uint64_t>() + 1);
-  for (std::size_t i = 1; i < after.rates.size(); ++i)
-    ASSERT_EQ(after.rates[i]["seq"].get<std::uint64_t>(), after.rates[i - 1]["seq"].get<std::uint64_t>() + 1);
+  expectContiguous(after.rates);
   EXPECT_NE(readWholeFile(d.path() / "log.txt").find("filter reloaded"), std::string::npos);
   gyrod.signal(SIGTERM);
   EXPECT_EQ(gyrod.waitExit(1000ms), std::optional<int>(0));
