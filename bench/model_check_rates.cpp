@@ -42,6 +42,25 @@ double quantile(std::vector<double> v, double q) {  // linear interpolation betw
 }
 double median(std::vector<double> v) { return quantile(std::move(v), 0.5); }
 
+std::string describeHidden(const test::HiddenEffect& h) {
+  char buf[160];
+  switch (h.effect) {
+    case ModelEffect::TemperatureBias: std::snprintf(buf, sizeof buf, " k=%.3g", h.k_dps_per_c); break;
+    case ModelEffect::Sinusoid: std::snprintf(buf, sizeof buf, " f=%.4g amp=%.3g", h.freq_hz, h.amp_dps); break;
+    case ModelEffect::GaussMarkov: std::snprintf(buf, sizeof buf, " tau=%.3g sigma=%.3g", h.tau_s, h.sigma_dps); break;
+    case ModelEffect::BiasSteps: {
+      std::string s = " steps";
+      for (std::size_t j = 0; j < h.times_s.size(); ++j) {
+        std::snprintf(buf, sizeof buf, " %.1f s:%.3g", h.times_s[j], h.sizes_dps[j]);
+        s += buf;
+      }
+      return s;
+    }
+    default: return "";
+  }
+  return buf;
+}
+
 void recordErrors(Tally& t, const test::HiddenEffect& h, const processing::DetectedEffect& d) {
   auto rel = [](double est, double truth) { return std::fabs(est - truth) / std::fabs(truth); };
   switch (h.effect) {
@@ -157,9 +176,16 @@ int main(int argc, char** argv) {
       if (verbose) {
         std::printf("seed %zu axis %zu:", s, a);
         for (const test::HiddenEffect& h : rec.hidden)
-          if (h.axis == a) std::printf(" [hidden %s]", std::string(processing::modelEffectName(h.effect)).c_str());
+          if (h.axis == a) std::printf(" [hidden %s%s]", std::string(processing::modelEffectName(h.effect)).c_str(),
+                                       describeHidden(h).c_str());
         for (const auto& e : r.effects) std::printf(" %s", std::string(processing::modelEffectName(e.effect)).c_str());
         std::printf("\n");
+        bool hidden_here = false;
+        for (const test::HiddenEffect& h : rec.hidden) hidden_here = hidden_here || h.axis == a;
+        if (hidden_here)
+          for (const auto& st : r.statistics)
+            std::printf("    %-40s %11.4g  median %11.4g  threshold %11.4g%s\n", st.name.c_str(), st.value, st.null_median,
+                        st.threshold, st.fired ? "  FIRED" : "");
         if (false_here > 0)
           for (const auto& e : r.effects) std::printf("    %s: %s\n", std::string(processing::modelEffectName(e.effect)).c_str(), e.evidence.c_str());
       }
