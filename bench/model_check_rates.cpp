@@ -30,7 +30,37 @@ namespace {
 struct Tally {
   std::size_t hidden = 0, detected = 0;
   std::map<std::string, std::vector<double>> errors;  // relative (or absolute, see name)
+  // Detection against the size of the hidden effect (effectSizes), one entry per hidden effect.
+  std::map<std::string, std::vector<std::pair<double, bool>>> by_size;
 };
+
+// How large a hidden effect is against the noise of its axis, in the generator's own terms
+// (tests/model_check/hidden_effect_generator.hpp draws each of these uniformly in a range):
+// what the detection rate depends on. Computed from the truth after the fact, for the table only.
+std::vector<std::pair<std::string, double>> effectSizes(const test::HiddenEffect& h, const test::GeneratedRecording& rec,
+                                                        double duration) {
+  const processing::NoiseTerms& terms = rec.terms[h.axis];
+  const double white_std = terms.arw_deg_per_sqrt_h / 60.0 * std::sqrt(rec.rate_hz);
+  switch (h.effect) {
+    case ModelEffect::GaussMarkov: {
+      double peak = 0.0;
+      for (double tau = h.tau_s / 10.0; tau < h.tau_s * 10.0; tau *= 1.05)
+        peak = std::max(peak, processing::gaussMarkovAllanVariance(tau, h.tau_s, h.sigma_dps) /
+                                  processing::allanVarianceOfTerms(terms, tau));
+      return {{"peak ADEV ratio (GM / base)", std::sqrt(peak)}, {"T / duration", h.tau_s / duration}};
+    }
+    case ModelEffect::BiasSteps: {
+      double floor_adev = 1e300;
+      for (double tau = 2.0; tau <= 128.0; tau *= 2.0)
+        floor_adev = std::min(floor_adev, std::sqrt(processing::allanVarianceOfTerms(terms, tau)));
+      double smallest = 1e300;
+      for (double d : h.sizes_dps) smallest = std::min(smallest, std::fabs(d));
+      return {{"smallest |step| / ADEV floor", smallest / floor_adev}};
+    }
+    case ModelEffect::Sinusoid: return {{"amplitude / white sd", h.amp_dps / white_std}};
+    default: return {};
+  }
+}
 
 double quantile(std::vector<double> v, double q) {  // linear interpolation between order statistics
   if (v.empty()) return NAN;
@@ -155,15 +185,19 @@ int main(int argc, char** argv) {
         if (h.axis != a && h.effect != ModelEffect::SampleGaps) continue;
         Tally& t = tallies[std::string(processing::modelEffectName(h.effect))];
         if (a == h.axis) ++t.hidden;
+        bool found = false;
         for (std::size_t j = 0; j < r.effects.size(); ++j) {
           if (r.effects[j].effect != h.effect || used[j]) continue;
           used[j] = true;
           if (a == h.axis) {
             ++t.detected;
+            found = true;
             recordErrors(t, h, r.effects[j]);
           }
           break;
         }
+        if (a == h.axis)
+          for (const auto& [what, size] : effectSizes(h, rec, duration)) t.by_size[what].push_back({size, found});
       }
       std::size_t false_here = 0;
       for (std::size_t j = 0; j < r.effects.size(); ++j) {
@@ -200,6 +234,20 @@ int main(int argc, char** argv) {
     for (const auto& [pname, v] : t.errors) std::printf("%s %.3g / %.3g;  ", pname.c_str(), median(v), quantile(v, 0.9));
     std::printf("\n");
   }
+  // Detection by size: each effect's hidden cases in three equal-count groups of its size.
+  for (const auto& [name, t] : tallies)
+    for (auto [what, cases] : t.by_size) {
+      if (cases.size() < 6) continue;
+      std::sort(cases.begin(), cases.end());
+      std::printf("%-17s by %s:", name.c_str(), what.c_str());
+      for (std::size_t g = 0; g < 3; ++g) {
+        const std::size_t lo = g * cases.size() / 3, hi = (g + 1) * cases.size() / 3;
+        std::size_t found = 0;
+        for (std::size_t i = lo; i < hi; ++i) found += cases[i].second ? 1 : 0;
+        std::printf("  %.3g..%.3g: %zu/%zu", cases[lo].first, cases[hi - 1].first, found, hi - lo);
+      }
+      std::printf("\n");
+    }
   std::printf("false discoveries: %zu on %zu of %zu axes (%.2f%% of axes)", false_total, axes_with_false, axes_checked,
               100.0 * static_cast<double>(axes_with_false) / static_cast<double>(axes_checked));
   for (const auto& [name, c] : false_by_name) std::printf("; %s %zu", name.c_str(), c);
