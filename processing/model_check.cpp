@@ -28,6 +28,7 @@ using namespace model_check_detail;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr std::size_t kMaxSinusoids = 3;
+constexpr double kSameLineBins = 3.0;  // peaks closer than this (periodogram bins) are one line
 constexpr std::size_t kMaxSteps = 8;
 constexpr std::size_t kOutlierHalfWindow = 10;
 constexpr std::size_t kMaxBlocks = 8192;
@@ -640,6 +641,24 @@ AxisModelCheck checkAxisModel(const AxisModelCheckInput& input, const ModelCheck
       const double w = 2.0 * std::numbers::pi * fit.freq_hz / rate;
       for (std::size_t i = 0; i < xc.size(); ++i) xc[i] -= fit.amp_dps * std::sin(w * static_cast<double>(i) + fit.phase_rad);
       removal.sinusoids.push_back(fit);
+      // A second peak within a few bins of one already named is the same line: a fixed
+      // sinusoid did not take it out because its amplitude or phase wanders over the record
+      // (or gaps in the record shifted its phase). Both components stay in the extended model;
+      // the report names one line, its frequency power-weighted and its amplitude the rms sum.
+      DetectedEffect* same_line = nullptr;
+      for (DetectedEffect& prev : out.effects)
+        if (prev.effect == ModelEffect::Sinusoid && std::fabs(prev.freq_hz - fit.freq_hz) <= kSameLineBins * df)
+          same_line = &prev;
+      if (same_line) {
+        const double p0 = same_line->amp_dps * same_line->amp_dps, p1 = fit.amp_dps * fit.amp_dps;
+        same_line->evidence += "; a second component " + formatValue("%.3g", fit.amp_dps) + " deg/s at " +
+                               formatValue("%.5g", fit.freq_hz) + " Hz remains once it is removed (peak " +
+                               formatValue("%.3g", peak.ratio) + " x the background): the line's amplitude or phase " +
+                               "wanders over the record";
+        same_line->freq_hz = (p0 * same_line->freq_hz + p1 * fit.freq_hz) / (p0 + p1);
+        same_line->amp_dps = std::sqrt(p0 + p1);
+        continue;
+      }
       DetectedEffect e;
       e.effect = ModelEffect::Sinusoid;
       e.freq_hz = fit.freq_hz;
