@@ -360,7 +360,10 @@ SimulatedSample NoiseSimulator::nextAnalog() {
     out.rate_dps[a] = v;
   }
   const TemperatureModel& temp = model_.temperature;
-  out.temperature_c = temp.final_c + (temp.start_c - temp.final_c) * portable::exp(-t / temp.time_constant_s);
+  // Without a warm-up the curve is final + (+0)·e^{…} = final + 0.0 bit for bit: skip the
+  // exponential (it was 8 % of a model check's time, which simulates that case).
+  const double warmup = temp.start_c - temp.final_c;
+  out.temperature_c = warmup == 0.0 ? temp.final_c + 0.0 : temp.final_c + warmup * portable::exp(-t / temp.time_constant_s);
   if (temp.noise_std_c > 0.0) out.temperature_c += temp.noise_std_c * temperature_noise_.next();
   ++analog_index_;
   return out;

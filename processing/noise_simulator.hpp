@@ -186,7 +186,7 @@ class NoiseSimulator {
     double ar_innovation_std = 0.0;
     std::vector<double> ar_history;  // ring buffer of the last p values
     std::size_t ar_newest = 0;
-    NormalGenerator arw_noise, rrw_noise, flicker_noise, q_noise, ar_noise;
+    ZigguratNormalGenerator arw_noise, rrw_noise, flicker_noise, q_noise, ar_noise;
     explicit AxisState(SplitMix64& seeder);
   };
 
@@ -204,7 +204,7 @@ class NoiseSimulator {
 
   SimulationModel model_;
   SplitMix64 seeder_;  // expands the seed into one xoshiro stream per term and axis
-  NormalGenerator temperature_noise_;
+  ZigguratNormalGenerator temperature_noise_;
   double internal_rate_hz_ = 0.0;
   std::size_t decimation_ = 1;
   std::size_t sample_count_ = 0;
@@ -214,7 +214,7 @@ class NoiseSimulator {
   std::uint64_t analog_index_ = 0;
   std::uint64_t output_index_ = 0;
   std::vector<ExtraState> extras_;   // empty when no axis has extra effects
-  std::optional<NormalGenerator> extra_noise_;
+  std::optional<ZigguratNormalGenerator> extra_noise_;
   std::uint64_t extra_index_ = 0;    // output samples produced by nextOutputRateNoise()
 };
 

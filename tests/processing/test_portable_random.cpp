@@ -1,13 +1,18 @@
 // The simulator's portable building blocks: splitmix64 and xoshiro256** against the
-// authors' published outputs, the normal generator's distribution, and the elementary
+// authors' published outputs, the normal generators' distributions (polar method and
+// ziggurat, against Φ and the truncated-normal tail), and the elementary
 // functions against libm (which is accurate to about an ulp on the build machine).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
+#include <vector>
 
 #include "processing/distributions.hpp"
 #include "processing/portable_math.hpp"
@@ -58,13 +63,16 @@ TEST(Xoshiro256StarStar, UniformIsTopBitsTimesTwoToMinus53) {
   }
 }
 
-TEST(NormalGenerator, MomentsAndCdfOfStandardNormal) {
-  // n = 400 000 draws: sample mean SE 1/√n, variance SE √(2/n), P(Z ≤ z) SE √(p(1−p)/n);
-  // each checked at 5 SE (independent truth: Φ from Boost via distributions.hpp).
+namespace {
+
+// n = 400 000 draws: sample mean SE 1/√n, variance SE √(2/n), P(Z ≤ z) SE √(p(1−p)/n);
+// each checked at 5 SE (independent truth: Φ from Boost via distributions.hpp).
+template <class Generator>
+void expectMomentsAndCdfOfStandardNormal() {
   const int n = 400000;
   const double points[] = {-2.5, -1.0, -0.3, 0.0, 0.7, 1.5, 3.0};
   for (std::uint64_t seed : {1ULL, 2ULL, 99ULL}) {
-    NormalGenerator g(seed);
+    Generator g(seed);
     double sum = 0.0, sum2 = 0.0, sum4 = 0.0;
     std::array<int, 7> below{};
     for (int i = 0; i < n; ++i) {
@@ -85,6 +93,10 @@ TEST(NormalGenerator, MomentsAndCdfOfStandardNormal) {
   }
 }
 
+}  // namespace
+
+TEST(NormalGenerator, MomentsAndCdfOfStandardNormal) { expectMomentsAndCdfOfStandardNormal<NormalGenerator>(); }
+
 TEST(NormalGenerator, ConsecutiveDrawsUncorrelated) {
   // The polar method returns its pair in turn; lag-1 correlation must still be 0 (SE 1/√n).
   NormalGenerator g(5);
@@ -96,6 +108,120 @@ TEST(NormalGenerator, ConsecutiveDrawsUncorrelated) {
     prev = z;
   }
   EXPECT_NEAR(sum / n, 0.0, 5.0 / std::sqrt(n));
+}
+
+// ---- the ziggurat -----------------------------------------------------------------------
+
+TEST(ZigguratNormalGenerator, TablesAreMarsagliaTsangs256Layers) {
+  const NormalZigguratLayers& z = normalZigguratLayers();
+  const int n = NormalZigguratLayers::kLayers;
+  // Marsaglia & Tsang (2000), 256 layers: r = 3.6541528853610088, v = 4.92867323399e-3
+  // (for f = e^{−x²/2}); the bisection lands on the same double. Their v is given to 12
+  // digits and its last differs by 2 from r·f(r) + tail at that r (4.9286732339747e-3).
+  EXPECT_EQ(z.r, 3.6541528853610088);
+  EXPECT_NEAR(z.v, 4.92867323399e-3, 3e-14);
+  // v is the base layer's area r·f(r) + ∫_r^∞ f = r·f(r) + √(π/2)·erfc(r/√2) (libm).
+  const double tail = std::sqrt(std::numbers::pi / 2.0) * std::erfc(z.r / std::numbers::sqrt2);
+  EXPECT_NEAR(z.v / (z.r * std::exp(-0.5 * z.r * z.r) + tail), 1.0, 1e-14);
+  EXPECT_NEAR(z.x[0], z.v / std::exp(-0.5 * z.r * z.r), 1e-14 * z.x[0]);
+  EXPECT_EQ(z.x[1], z.r);
+  EXPECT_EQ(z.x[n], 0.0);
+  EXPECT_EQ(z.f[n], 1.0);
+  for (int i = 1; i < n; ++i) {
+    ASSERT_LT(z.x[i + 1], z.x[i]) << i;
+    // f[i] = e^{−x[i]²/2} and every layer's rectangle x[i]·(f[i+1] − f[i]) has area v;
+    // the top one too, which is what fixes r.
+    EXPECT_NEAR(z.f[i], std::exp(-0.5 * z.x[i] * z.x[i]), 1e-14) << i;
+    EXPECT_NEAR(z.x[i] * (z.f[i + 1] - z.f[i]) / z.v, 1.0, 1e-12) << i;
+  }
+}
+
+TEST(ZigguratNormalGenerator, MomentsAndCdfOfStandardNormal) {
+  expectMomentsAndCdfOfStandardNormal<ZigguratNormalGenerator>();
+}
+
+TEST(ZigguratNormalGenerator, ChiSquareOverLayerAndEquiprobableBins) {
+  // Two binnings, n = 1 000 000 draws each, three seeds; χ² against its quantile at
+  // 1 − 1e-6 (a false alarm once in a million runs):
+  //  (a) |z| in the ziggurat's own layers (x[i+1], x[i]] and the tail (r, ∞) — the places
+  //      a wrong table or a wrong wedge test would show — with P = 2(Φ(x[i]) − Φ(x[i+1]));
+  //  (b) z in 100 bins of probability 1/100 each, edges Φ⁻¹(k/100) (both signs).
+  const NormalZigguratLayers& z = normalZigguratLayers();
+  const int layers = NormalZigguratLayers::kLayers;
+  const int n = 1000000;
+  std::vector<double> eq_edges;
+  for (int k = 1; k < 100; ++k) eq_edges.push_back(normalQuantile(k / 100.0));
+  for (std::uint64_t seed : {3ULL, 4ULL, 5ULL}) {
+    ZigguratNormalGenerator g(seed);
+    std::vector<int> layer_count(layers, 0), eq_count(100, 0);  // layer bin 0: the tail
+    for (int k = 0; k < n; ++k) {
+      const double v = g.next();
+      const double a = std::fabs(v);
+      // bin i ≥ 1 holds (x[i+1], x[i]]; x is decreasing, so find the first x[j] < a.
+      const auto first_below = std::upper_bound(z.x.begin() + 1, z.x.end(), a, std::greater<double>());
+      int bin = static_cast<int>(first_below - z.x.begin()) - 1;  // x[bin+1] < a ≤ x[bin]
+      if (a > z.r) bin = 0;
+      if (a == 0.0) bin = layers - 1;
+      ++layer_count[static_cast<std::size_t>(bin)];
+      ++eq_count[static_cast<std::size_t>(std::upper_bound(eq_edges.begin(), eq_edges.end(), v) - eq_edges.begin())];
+    }
+    double chi2_layers = 0.0;
+    for (int i = 0; i < layers; ++i) {
+      const double p = i == 0 ? 2.0 * (1.0 - normalCdf(z.r)) : 2.0 * (normalCdf(z.x[i]) - normalCdf(z.x[i + 1]));
+      const double expected = p * n;
+      chi2_layers += (layer_count[i] - expected) * (layer_count[i] - expected) / expected;
+    }
+    double chi2_eq = 0.0;
+    for (int c : eq_count) chi2_eq += (c - n / 100.0) * (c - n / 100.0) / (n / 100.0);
+    EXPECT_LT(chi2_layers, chiSquareQuantile(1.0 - 1e-6, layers - 1)) << "seed " << seed;
+    EXPECT_LT(chi2_eq, chiSquareQuantile(1.0 - 1e-6, 99)) << "seed " << seed;
+  }
+}
+
+TEST(ZigguratNormalGenerator, TailBeyondRHasTheTruncatedNormalShape) {
+  // The tail (|z| > r, about 1 draw in 3900) comes from a separate sampler. n = 4 000 000
+  // per seed: P(|Z| > r) and P(|Z| > 4.5) at 5 binomial SE, and given |Z| > r the mean of
+  // |Z| − r at 5 SE: for a normal truncated at r, with λ = φ(r)/Q(r), E = λ − r and
+  // Var = 1 + r·λ − λ².
+  const double r = normalZigguratLayers().r;
+  const int n = 4000000;
+  const double q_r = 1.0 - normalCdf(r), q_45 = 1.0 - normalCdf(4.5);
+  const double lambda = std::exp(-0.5 * r * r) / std::sqrt(2.0 * std::numbers::pi) / q_r;
+  const double mean_excess = lambda - r, var_excess = 1.0 + r * lambda - lambda * lambda;
+  for (std::uint64_t seed : {6ULL, 7ULL, 8ULL}) {
+    ZigguratNormalGenerator g(seed);
+    int beyond_r = 0, beyond_45 = 0;
+    double sum_excess = 0.0;
+    for (int k = 0; k < n; ++k) {
+      const double a = std::fabs(g.next());
+      if (a > r) {
+        ++beyond_r;
+        sum_excess += a - r;
+      }
+      beyond_45 += a > 4.5;
+    }
+    EXPECT_NEAR(beyond_r, n * 2.0 * q_r, 5.0 * std::sqrt(n * 2.0 * q_r)) << "seed " << seed;
+    EXPECT_NEAR(beyond_45, n * 2.0 * q_45, 5.0 * std::sqrt(n * 2.0 * q_45)) << "seed " << seed;
+    ASSERT_GT(beyond_r, 0);
+    EXPECT_NEAR(sum_excess / beyond_r, mean_excess, 5.0 * std::sqrt(var_excess / beyond_r)) << "seed " << seed;
+  }
+}
+
+TEST(ZigguratNormalGenerator, ConsecutiveDrawsAndTheirSizesUncorrelated) {
+  // One word gives layer, sign and U: z_k·z_{k+1} and |z_k|·|z_{k+1}| must be
+  // uncorrelated (lag-1 correlation SE 1/√n, 5 SE).
+  ZigguratNormalGenerator g(9);
+  const int n = 400000;
+  const double mean_abs = std::sqrt(2.0 / std::numbers::pi), var_abs = 1.0 - 2.0 / std::numbers::pi;
+  double prev = g.next(), sum = 0.0, sum_abs = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double z = g.next();
+    sum += prev * z;
+    sum_abs += (std::fabs(prev) - mean_abs) * (std::fabs(z) - mean_abs) / var_abs;
+    prev = z;
+  }
+  EXPECT_NEAR(sum / n, 0.0, 5.0 / std::sqrt(n));
+  EXPECT_NEAR(sum_abs / n, 0.0, 5.0 / std::sqrt(n));
 }
 
 namespace {
