@@ -263,7 +263,8 @@ void requireWritableTarget(const std::string& path) {
   if (std::filesystem::is_directory(p, ec)) throw std::runtime_error(path + ": cannot write the model: it is a folder");
   const std::filesystem::path folder = p.parent_path().empty() ? std::filesystem::path(".") : p.parent_path();
   if (!std::filesystem::is_directory(folder, ec))
-    throw std::runtime_error(path + ": cannot write the model: folder " + folder.string() + " does not exist");
+    throw std::runtime_error(path + ": cannot write the model: " + folder.string() +
+                             (std::filesystem::exists(folder, ec) ? " is not a folder" : ": folder does not exist"));
   if (::access(folder.c_str(), W_OK) != 0)
     throw std::runtime_error(path + ": cannot write the model in " + folder.string() + ": " + std::strerror(errno));
 }
