@@ -1,22 +1,32 @@
 // gyroctl model-check: where the paper's model fails on a recording, the named cause, and
 // the gain of the extended model (processing/model_check.hpp, docs/model-check.md).
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <span>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "processing/model_check.hpp"
 #include "processing/noise_terms.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
+#include "tools/recording/model_toml.hpp"
 
 namespace gyrod::gyroctl {
 namespace {
@@ -33,6 +43,7 @@ struct ModelCheckCliOptions {
   std::uint64_t seed = 1;
   std::size_t replicas = 40;
   std::size_t threads = 0;
+  std::string write_model;
 };
 
 std::string fmt(const char* f, double v) {
@@ -242,8 +253,212 @@ void writeReport(const std::string& dir_text, const ModelCheckCliOptions& opt, c
   writeText(dir / "report.md", md.str());
 }
 
+// ---- --write-model: the extended model as a simulation model file -----------------------
+
+// Fails before the check runs (it can take minutes) when OUT cannot be written; the
+// file itself is written atomically at the end.
+void requireWritableTarget(const std::string& path) {
+  const std::filesystem::path p(path);
+  std::error_code ec;
+  if (std::filesystem::is_directory(p, ec)) throw std::runtime_error(path + ": cannot write the model: it is a folder");
+  const std::filesystem::path folder = p.parent_path().empty() ? std::filesystem::path(".") : p.parent_path();
+  if (!std::filesystem::is_directory(folder, ec))
+    throw std::runtime_error(path + ": cannot write the model: " + folder.string() +
+                             (std::filesystem::exists(folder, ec) ? " is not a folder" : ": folder does not exist"));
+  if (::access(folder.c_str(), W_OK) != 0)
+    throw std::runtime_error(path + ": cannot write the model in " + folder.string() + ": " + std::strerror(errno));
+}
+
+std::optional<std::size_t> simulatorAxisFor(const std::string& column) {
+  if (column == "gx" || column == "x") return 0;
+  if (column == "gy") return 1;
+  if (column == "gz") return 2;
+  return std::nullopt;
+}
+
+// Seconds from the first sample for each sample: from t when present, else i/rate.
+std::vector<double> secondsFromStart(const recording::Recording& rec, double rate_hz) {
+  std::vector<double> s(rec.size());
+  for (std::size_t i = 0; i < s.size(); ++i) s[i] = rec.t.empty() ? static_cast<double>(i) / rate_hz : rec.t[i] - rec.t[0];
+  return s;
+}
+
+// Least squares of T(t) = final + (start − final)·e^{−t/T} (the simulator's warm-up curve):
+// for a fixed time constant T the model is linear in (final, start − final); T by a
+// log-spaced scan from duration/100 to 10·duration, refined by golden section on ln T.
+// The white-noise std from first differences (√(mean Δ²/2)), so slow wiggles of the room
+// do not count as noise. A flat channel gives start = final = its mean.
+TemperatureModel fitWarmUpCurve(std::span<const double> secs, std::span<const double> temp) {
+  TemperatureModel m;
+  const std::size_t n = temp.size();
+  long double sum = 0.0L;
+  for (double v : temp) sum += v;
+  const double mean = static_cast<double>(sum / static_cast<long double>(n));
+  double ss = 0.0, d2 = 0.0;
+  for (std::size_t i = 0; i < n; ++i) ss += (temp[i] - mean) * (temp[i] - mean);
+  for (std::size_t i = 1; i < n; ++i) d2 += (temp[i] - temp[i - 1]) * (temp[i] - temp[i - 1]);
+  m.noise_std_c = n > 1 ? std::sqrt(d2 / (2.0 * static_cast<double>(n - 1))) : 0.0;
+  m.start_c = m.final_c = mean;
+  const double duration = secs.back() - secs.front();
+  if (ss == 0.0 || !(duration > 0.0)) return m;
+  m.time_constant_s = duration;
+  struct Fit {
+    double sse = std::numeric_limits<double>::infinity(), final_c = 0.0, delta_c = 0.0;
+  };
+  std::vector<double> decay(n);
+  const auto fitAt = [&](double log_tau) {
+    const double tau = std::exp(log_tau);
+    double se = 0.0, see = 0.0, sy = 0.0, sey = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double e = decay[i] = std::exp(-secs[i] / tau);
+      se += e;
+      see += e * e;
+      sy += temp[i] - mean;  // centred for conditioning
+      sey += e * (temp[i] - mean);
+    }
+    const double nn = static_cast<double>(n), det = nn * see - se * se;
+    Fit f;
+    if (!(det > 1e-12 * nn * see)) return f;  // e^{−t/T} nearly constant: no information
+    f.delta_c = (nn * sey - se * sy) / det;
+    const double c0 = (sy - f.delta_c * se) / nn;
+    f.final_c = mean + c0;
+    double sse = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double r = temp[i] - mean - c0 - f.delta_c * decay[i];
+      sse += r * r;
+    }
+    f.sse = sse;
+    return f;
+  };
+  const double lo = std::log(duration / 100.0), hi = std::log(10.0 * duration);
+  constexpr int kScan = 31;
+  int best = 0;
+  double best_sse = std::numeric_limits<double>::infinity();
+  for (int j = 0; j < kScan; ++j) {
+    const double s = fitAt(lo + (hi - lo) * j / (kScan - 1)).sse;
+    if (s < best_sse) {
+      best_sse = s;
+      best = j;
+    }
+  }
+  if (!std::isfinite(best_sse)) return m;
+  const double step = (hi - lo) / (kScan - 1);
+  double a = lo + step * std::max(best - 1, 0), b = lo + step * std::min(best + 1, kScan - 1);
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  double x1 = b - g * (b - a), x2 = a + g * (b - a), f1 = fitAt(x1).sse, f2 = fitAt(x2).sse;
+  for (int it = 0; it < 30; ++it) {
+    if (f1 < f2) {
+      b = x2; x2 = x1; f2 = f1; x1 = b - g * (b - a); f1 = fitAt(x1).sse;
+    } else {
+      a = x1; x1 = x2; f1 = f2; x2 = a + g * (b - a); f2 = fitAt(x2).sse;
+    }
+  }
+  const double log_tau = 0.5 * (a + b);
+  const Fit f = fitAt(log_tau);
+  if (!std::isfinite(f.sse)) return m;
+  m.time_constant_s = std::exp(log_tau);
+  m.final_c = f.final_c;
+  m.start_c = f.final_c + f.delta_c;
+  return m;
+}
+
+// Mean of the noise-free curve over the recording's times: the temperature term's
+// reference, so that k·(T − reference) averages to zero and bias_dps stays the mean rate.
+double meanOfCurve(const TemperatureModel& m, std::span<const double> secs) {
+  double s = 0.0;
+  for (double t : secs) s += m.final_c + (m.start_c - m.final_c) * std::exp(-t / m.time_constant_s);
+  return s / static_cast<double>(secs.size());
+}
+
+// One axis's extended model: the refitted five terms plus each named effect as the
+// simulator's AxisExtraEffects (times and phases from the first sample, as the check fits
+// them); the effects without a simulator counterpart go into `notes`.
+AxisNoiseModel extendedAxisModel(const AxisModelCheck& r, std::span<const double> rate_dps, const recording::Recording& rec,
+                                 double rate_hz, double temperature_reference_c, const std::string& name,
+                                 std::vector<std::string>& notes) {
+  AxisNoiseModel m;
+  m.terms = r.extended_fit.value;
+  long double sum = 0.0L;
+  for (double v : rate_dps) sum += v;
+  double bias = static_cast<double>(sum / static_cast<long double>(rate_dps.size()));
+  const double n = static_cast<double>(rate_dps.size());
+  AxisExtraEffects& x = m.extra;
+  for (const DetectedEffect& e : r.effects) {
+    switch (e.effect) {
+      case ModelEffect::TemperatureBias:
+        x.temperature_coefficient_dps_per_c = e.k_dps_per_c;
+        x.temperature_reference_c = temperature_reference_c;
+        break;
+      case ModelEffect::Sinusoid: x.sinusoids.push_back({e.freq_hz, e.amp_dps, e.phase_rad}); break;
+      case ModelEffect::GaussMarkov:
+        x.gauss_markov_tau_s = e.tau_s;
+        x.gauss_markov_sigma_dps = e.sigma_dps;
+        break;
+      case ModelEffect::BiasSteps:
+        for (std::size_t j = 0; j < e.times_s.size() && j < e.sizes_dps.size(); ++j) {
+          // The check reports the step's time from t (when present); the simulator counts
+          // samples from 0 at the nominal rate, so use the sample index.
+          const std::size_t i =
+              rec.t.empty() ? static_cast<std::size_t>(std::llround(e.times_s[j] * rate_hz))
+                            : static_cast<std::size_t>(std::lower_bound(rec.t.begin(), rec.t.end(), e.times_s[j]) - rec.t.begin());
+          x.bias_steps.push_back({static_cast<double>(i) / rate_hz, e.sizes_dps[j]});
+          bias -= e.sizes_dps[j] * (n - static_cast<double>(std::min<std::size_t>(i, rate_dps.size()))) / n;
+        }
+        break;
+      case ModelEffect::Outliers:
+        x.outlier_count = e.count;
+        x.outlier_amplitude_dps = e.outlier_median_amplitude_dps;
+        break;
+      case ModelEffect::SampleGaps:
+        notes.push_back(name + ": sample_gaps found (" + std::to_string(e.count) + " gaps, " + std::to_string(e.lost) +
+                        " samples lost): not modelled, the simulator delivers every sample");
+        break;
+      case ModelEffect::Unexplained:
+        notes.push_back(name + ": unexplained mismatch at tau " + fmt("%.4g", e.where_lo) + " to " + fmt("%.4g", e.where_hi) +
+                        " s: not modelled, no catalogue effect explains it");
+        break;
+    }
+  }
+  m.bias_dps = bias;
+  return m;
+}
+
+std::string extendedModelToml(const ModelCheckCliOptions& opt, const LoadedInput& in,
+                              const std::vector<std::pair<std::string, AxisModelCheck>>& results) {
+  const recording::Recording& rec = in.recording;
+  SimulationModel model;
+  model.rate_hz = in.rate_hz;
+  const std::vector<double> secs = secondsFromStart(rec, in.rate_hz);
+  double reference_c = model.temperature.start_c;
+  if (!rec.temp.empty()) {
+    model.temperature = fitWarmUpCurve(secs, rec.temp);
+    reference_c = meanOfCurve(model.temperature, secs);
+  }
+  std::vector<std::string> notes, axes_written;
+  for (std::size_t k = 0; k < results.size(); ++k) {
+    const auto& [name, r] = results[k];
+    const auto slot = simulatorAxisFor(name);
+    if (!slot) continue;
+    model.axes[*slot] = extendedAxisModel(r, rec.axes[in.axis_indices[k]], rec, in.rate_hz, reference_c, name, notes);
+    axes_written.push_back(name);
+  }
+  validateSimulationModel(model);
+  std::string head = "# Extended model of " + opt.file + " from gyroctl model-check (seed " + std::to_string(opt.seed) +
+                     ", " + std::to_string(opt.replicas) + " replicas): the five terms refitted with the named\n"
+                     "# effects removed, plus those effects as [axis.extra] tables (docs/model-check.md).\n"
+                     "# Axes checked:";
+  for (const std::string& a : axes_written) head += " " + a;
+  head += ".\n";
+  if (!rec.temp.empty())
+    head += "# [temperature] is a warm-up curve fitted to the recording's temperature; the recording's own\n"
+            "# temperature (room cycles, steps) is not reproduced, only the temperature coefficient.\n";
+  for (const std::string& note : notes) head += "# " + note + "\n";
+  return head + recording::modelToToml(model);
+}
+
 int runModelCheck(const ModelCheckCliOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
+  if (!opt.write_model.empty()) requireWritableTarget(opt.write_model);
   const LoadedInput in = loadInput(opt.file, opt.rate_hz, opt.axis);
   const auto& rec = in.recording;
   if (rec.size() < kModelCheckMinSamples) {
@@ -284,6 +499,10 @@ int runModelCheck(const ModelCheckCliOptions& opt) {
     writeReport(opt.report_dir, opt, in, results, seconds);
     if (!opt.json) std::printf("report written to %s/report.md\n", opt.report_dir.c_str());
   }
+  if (!opt.write_model.empty()) {
+    writeFileAtomically(opt.write_model, extendedModelToml(opt, in, results));
+    if (!opt.json) std::printf("extended model written to %s\n", opt.write_model.c_str());
+  }
   return kExitOk;
 }
 
@@ -304,6 +523,8 @@ void addModelCheckCommand(CLI::App& app, CommandRunner& run) {
   sub->add_option("--replicas", opt->replicas, "replicas per round (the null distributions)")
       ->default_val(40)->check(CLI::Range(std::size_t{8}, std::size_t{10000}));
   sub->add_option("--threads", opt->threads, "threads for the replicas (0: all cores)")->default_val(0);
+  sub->add_option("--write-model", opt->write_model,
+                  "write the extended model of every axis (terms and named effects) as TOML for gyroctl simulate --model");
   sub->callback([&run, opt] { run = [opt] { return runModelCheck(*opt); }; });
 }
 
