@@ -53,6 +53,12 @@ class HiddenEffectGenerator {
  public:
   explicit HiddenEffectGenerator(std::uint64_t seed) : rng_(seed) {}
 
+  // Size range of a hidden bias step, in multiples of the axis's smallest Allan deviation
+  // over τ = 2–128 s. The default is the rates script's range, which reaches down to where
+  // detection stops being certain (docs/model-check.md, detection by size); a unit test that
+  // asserts the exact count and times of *clear* steps asks for larger ones.
+  double step_size_lo = 10.0, step_size_hi = 20.0;
+
   double uniform(double lo, double hi) { return lo + (hi - lo) * rng_.uniform(); }
   double logUniform(double lo, double hi) { return std::exp(uniform(std::log(lo), std::log(hi))); }
   std::size_t integer(std::size_t lo, std::size_t hi) {  // inclusive
@@ -141,7 +147,7 @@ class HiddenEffectGenerator {
           }
           std::sort(h.times_s.begin(), h.times_s.end());
           for (double t : h.times_s) {
-            h.sizes_dps.push_back((rng_.uniform() < 0.5 ? -1.0 : 1.0) * uniform(10.0, 20.0) * floor_adev);
+            h.sizes_dps.push_back((rng_.uniform() < 0.5 ? -1.0 : 1.0) * uniform(step_size_lo, step_size_hi) * floor_adev);
             extra.bias_steps.push_back({t, h.sizes_dps.back()});
           }
           break;
