@@ -58,6 +58,10 @@ class HiddenEffectGenerator {
   // detection stops being certain (docs/model-check.md, detection by size); a unit test that
   // asserts the exact count and times of *clear* steps asks for larger ones.
   double step_size_lo = 10.0, step_size_hi = 20.0;
+  // A hidden Gauss–Markov process: T log-uniform from 1 s to duration × gm_tau_hi_fraction,
+  // σ such that its Allan-deviation peak is gm_peak_lo..gm_peak_hi × the base model's there.
+  double gm_tau_hi_fraction = 1.0 / 40.0;
+  double gm_peak_lo = 1.5, gm_peak_hi = 3.0;
 
   double uniform(double lo, double hi) { return lo + (hi - lo) * rng_.uniform(); }
   double logUniform(double lo, double hi) { return std::exp(uniform(std::log(lo), std::log(hi))); }
@@ -115,7 +119,7 @@ class HiddenEffectGenerator {
           extra.sinusoids.push_back({h.freq_hz, h.amp_dps, uniform(0.0, 6.283)});
           break;
         case ModelEffect::GaussMarkov: {
-          h.tau_s = logUniform(1.0, duration_s / 40.0);
+          h.tau_s = logUniform(1.0, duration_s * gm_tau_hi_fraction);
           // Peak of its Allan deviation 1.5..3 × the base model's there.
           double peak_ratio = 0.0, at = 0.0;
           for (double tau = h.tau_s / 10.0; tau < h.tau_s * 10.0; tau *= 1.05) {
@@ -127,7 +131,7 @@ class HiddenEffectGenerator {
             }
           }
           (void)at;
-          h.sigma_dps = uniform(1.5, 3.0) / std::sqrt(peak_ratio);
+          h.sigma_dps = uniform(gm_peak_lo, gm_peak_hi) / std::sqrt(peak_ratio);
           extra.gauss_markov_tau_s = h.tau_s;
           extra.gauss_markov_sigma_dps = h.sigma_dps;
           break;

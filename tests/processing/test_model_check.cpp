@@ -155,7 +155,14 @@ TEST(ModelCheck, FindsBiasStepsAndWhen) {
 }
 
 TEST(ModelCheck, FindsAGaussMarkovProcess) {
-  const GeneratedRecording g = generate(23, {ModelEffect::GaussMarkov});
+  // A clear one: T from 1 s to duration/300 and an Allan peak 2.5–3.5 × the base model's.
+  // Longer T (to duration/40) and smaller peaks (from 1.5×) are found less often: the rates
+  // script measures by how much (docs/model-check.md, detection by size).
+  HiddenEffectGenerator gen(23);
+  gen.gm_tau_hi_fraction = 1.0 / 300.0;
+  gen.gm_peak_lo = 2.5;
+  gen.gm_peak_hi = 3.5;
+  const GeneratedRecording g = gen.generate(kDuration, kRate, {ModelEffect::GaussMarkov});
   const HiddenEffect& h = g.hidden[0];
   const AxisModelCheck r = check(g, h.axis);
   expectExactlyTheHidden(g, h.axis, r);
