@@ -68,7 +68,7 @@ struct SeriesStats {
   std::size_t spectral_bin = 0;
   double temp_slope = kNaN;
   double step_stat = kNaN;       // stepStatistic of the low-passed residual
-  double gm_improvement = kNaN;
+  double gm_statistic = kNaN;
   std::vector<double> psd, psd_max;
 };
 
@@ -119,7 +119,7 @@ SeriesStats measureSeries(std::span<const double> xd, const Context& c, unsigned
     const std::vector<double> v = overlappingAllanVariances(xd, c.ms);
     s.log_adev.resize(v.size());
     for (std::size_t j = 0; j < v.size(); ++j) s.log_adev[j] = 0.5 * std::log(v[j]);
-    if (mask & kStatGaussMarkov) s.gm_improvement = gaussMarkovStatistic(fitGaussMarkovToAllan(c.taus, v, c.edf, c.t_grid));
+    if (mask & kStatGaussMarkov) s.gm_statistic = gaussMarkovStatistic(fitGaussMarkovToAllan(c.taus, v, c.edf, c.t_grid));
   }
   if (mask & kStatOutliers) {
     const std::vector<double> z = localOutlierScores(xd, kOutlierHalfWindow);
@@ -867,9 +867,9 @@ AxisModelCheck checkAxisModel(const AxisModelCheckInput& input, const ModelCheck
     // The null of a model fitted to the cleaned series (the base fit also carried the effects).
     const std::vector<SeriesStats> reps = runReplicas(pureModel(rate, clean_fit.value), statisticalUncertainty(clean_fit), c, {}, o, 2, kStatGaussMarkov);
     out.replicas_simulated += o.replicas;
-    gm_null_values = column(reps, &SeriesStats::gm_improvement);
+    gm_null_values = column(reps, &SeriesStats::gm_statistic);
   } else {
-    gm_null_values = column(base_reps, &SeriesStats::gm_improvement);
+    gm_null_values = column(base_reps, &SeriesStats::gm_statistic);
   }
   const NullSummary gm_null = summarizeNull(gm_null_values, o.false_alarm, false);
   const double gm_stat = gaussMarkovStatistic(gm_fit);
