@@ -270,7 +270,7 @@ void requireWritableTarget(const std::string& path) {
 }
 
 std::optional<std::size_t> simulatorAxisFor(const std::string& column) {
-  if (column == "gx" || column == "x") return 0;
+  if (column == "gx") return 0;
   if (column == "gy") return 1;
   if (column == "gz") return 2;
   return std::nullopt;
