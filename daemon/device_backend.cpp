@@ -6,6 +6,7 @@
 
 #include "driver/gpio_data_ready.hpp"
 #include "driver/linux_i2c_bus.hpp"
+#include "driver/mpu6050_config.hpp"
 #include "driver/polling_data_ready.hpp"
 #include "driver/simulator_signal_source.hpp"
 #include "tools/recording/model_toml.hpp"
