@@ -14,6 +14,8 @@
 #include <limits>
 #include <sstream>
 
+#include "driver/mpu6050_config.hpp"
+
 
 #ifndef GYROD_VERSION
 #define GYROD_VERSION "unknown"
@@ -221,15 +223,6 @@ bool isAllDigits(std::string_view s) {
   return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
 }
 
-// A sample rate the chip can produce: internal rate / (1 + SMPLRT_DIV), SMPLRT_DIV 0..255
-// (Register Map rev 4.2, §4.2). Returns SMPLRT_DIV, or nullopt if `rate_hz` is not one.
-std::optional<int> sampleRateDivider(double internal_rate_hz, double rate_hz) {
-  const double ratio = internal_rate_hz / rate_hz;
-  const double n = std::round(ratio);
-  if (n < 1.0 || n > 256.0 || std::abs(ratio - n) > 1e-9 * n) return std::nullopt;
-  return static_cast<int>(n) - 1;
-}
-
 void readDevice(const Section& s, DeviceConfig& d) {
   if (auto b = s.choice("backend", kBackendNames)) d.backend = *b == 0 ? DeviceBackend::I2c : DeviceBackend::Mock;
   if (const auto* n = s.node("bus")) {
@@ -261,9 +254,9 @@ void readDevice(const Section& s, DeviceConfig& d) {
   }
   if (auto v = s.number("rate_hz")) d.rate_hz = *v;
   // Checked even when rate_hz keeps its default, since dlpf changes the internal rate.
-  // Gyro output rate before SMPLRT_DIV (Register Map rev 4.2 §4.2): 8 kHz with DLPF_CFG 0, else 1 kHz.
-  const double internal = d.dlpf == 0 ? 8000.0 : 1000.0;
-  if (!(d.rate_hz > 0.0) || !sampleRateDivider(internal, d.rate_hz)) {
+  // The chip's rule (driver/mpu6050_config.hpp): gyro output rate / (1 + SMPLRT_DIV).
+  const double internal = driver::mpu6050::gyroOutputRateHz(d.dlpf);
+  if (!driver::smplrtDivFor(d.dlpf, d.rate_hz)) {
     std::ostringstream req;
     req << "must be " << shortest(internal) << " Hz / N for a whole N in 1..256 (the chip's rate with dlpf "
         << d.dlpf << ")";

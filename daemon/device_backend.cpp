@@ -6,6 +6,7 @@
 
 #include "driver/gpio_data_ready.hpp"
 #include "driver/linux_i2c_bus.hpp"
+#include "driver/mpu6050_config.hpp"
 #include "driver/polling_data_ready.hpp"
 #include "driver/simulator_signal_source.hpp"
 #include "tools/recording/model_toml.hpp"
@@ -124,6 +125,7 @@ DeviceParts makeDeviceParts(const GyrodConfig& config) {
     b.data_ready = &mock->dataReady();
     b.bus = std::move(mock);
     dc.data_ready_mode = driver::DataReadyMode::InterruptEdges;
+    dc.bus_name = "the mock bus";
     std::ostringstream d;
     d << "mock MPU6050 (" << toString(mc.source) << ", seed " << mc.seed << ", ";
     if (mc.speed == 1.0)
@@ -136,6 +138,7 @@ DeviceParts makeDeviceParts(const GyrodConfig& config) {
 
   b.clock = std::make_unique<driver::MonotonicClock>();
   b.bus = std::make_unique<driver::LinuxI2cBus>(config.device.bus);
+  dc.bus_name = config.device.bus;
   if (!config.gpio.chip.empty()) {
     driver::GpioLineConfig line;
     line.chip = config.gpio.chip;

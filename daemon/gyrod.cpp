@@ -33,19 +33,6 @@ std::int64_t monotonicNowNs() {
   return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
 
-// GAP reasons on the socket are [a-z0-9_] tokens (docs/protocol.md).
-std::string_view protocolGapReason(driver::GapCause cause) {
-  switch (cause) {
-    case driver::GapCause::FifoOverflow: return "fifo_overflow";
-    case driver::GapCause::MisalignedFrames: return "misaligned_frames";
-    case driver::GapCause::TransferError: return "transfer_error";
-    case driver::GapCause::DeviceUnreachable: return "device_unreachable";
-    case driver::GapCause::SilentReset: return "silent_reset";
-    case driver::GapCause::Reinitialised: return "reinitialised";
-  }
-  return "unknown";
-}
-
 spdlog::level::level_enum spdlogLevel(driver::LogLevel level) {
   switch (level) {
     case driver::LogLevel::Debug: return spdlog::level::debug;
@@ -263,7 +250,7 @@ void Gyrod::onGap(const driver::SampleGap& gap) {
   pipeline_.discontinuity();
   ++gaps_;
   missing_samples_ += gap.count;
-  const std::string_view reason = protocolGapReason(gap.cause);
+  const std::string_view reason = driver::gapCauseName(gap.cause);  // a [a-z0-9_] token (docs/protocol.md)
   server_->publishGap({gap.first_seq, gap.count, reason});
   if (recorder_) {
     const double t = last_t_s_ ? *last_t_s_ + 1.0 / config_.device.rate_hz : 0.0;

@@ -31,7 +31,10 @@ std::string describeTransferError(int negative_errno) {
       return "ETIMEDOUT (the adapter gave up: SCL held low or the device stretched the clock too long; "
              "if it persists, power-cycle the sensor)";
     case ENODEV:
-      return "ENODEV (the I2C adapter is gone)";
+      // i2c-dev passes on what the adapter driver returns: several report an address that
+      // nobody acknowledges as ENODEV; a removed adapter gives it too.
+      return "ENODEV (no device answered at this address, or the I2C adapter is gone. Check power "
+             "(3.3 V on VCC), SDA/SCL wiring, the AD0 pin (low = 0x68, high = 0x69) and run `i2cdetect -y 1`)";
     case EBUSY:
       return "EBUSY (the bus stayed busy too long: another master, or SDA/SCL held low)";
     case EINVAL:

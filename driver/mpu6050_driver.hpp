@@ -11,7 +11,9 @@
 //   Backoff ◄──── repeated errors, device gone ◄──────────────  error)
 //                 silent reset (table lost) ──► Reset
 //
-// Every path and its gap accounting is described in docs/driver.md.
+// Every path and its gap accounting is described in docs/driver.md. The config rules and the
+// register table are in mpu6050_config.*, FIFO frame decoding in fifo_frame.*; the states
+// before streaming are in mpu6050_driver.cpp, streaming in mpu6050_driver_streaming.cpp.
 //
 // Usage (the daemon):
 //   Mpu6050Driver drv(bus, data_ready, clock, sink, config, log);
@@ -28,24 +30,12 @@
 #include "driver/clock.hpp"
 #include "driver/data_ready.hpp"
 #include "driver/i2c_bus.hpp"
+#include "driver/mpu6050_config.hpp"
 #include "driver/mpu6050_registers.hpp"
 #include "driver/mpu6050_types.hpp"
 #include "driver/sample_clock.hpp"
 
 namespace gyrod::driver {
-
-// One line of the register table: after configuration, (value & set) == set and
-// (value & clear) == 0. Configure writes `set`; the read-back checks both masks.
-struct RegisterSetting {
-  mpu6050::Register reg;
-  std::uint8_t set;
-  std::uint8_t clear;
-};
-inline constexpr std::size_t kRegisterTableSize = 9;
-
-// The table for a configuration (exposed for tests and for `gyroctl` diagnostics).
-// Throws std::invalid_argument for an invalid config.
-std::array<RegisterSetting, kRegisterTableSize> registerTableFor(const Mpu6050Config& config);
 
 class Mpu6050Driver {
  public:
@@ -90,6 +80,14 @@ class Mpu6050Driver {
 
   // Streaming.
   void readFifo(Trigger trigger);
+  // Every way a FIFO read can fail ends here: count it, say why, end the segment (its gap
+  // is counted when the next one starts) and restart the FIFO. `error` (a failed transfer)
+  // also counts towards recovery, which may take the driver out of Streaming instead.
+  void abandonSegment(GapCause cause, std::uint64_t& counter, const std::string& message, int error = 0);
+  void noteMissedDataReady(std::int64_t now);
+  void observeNewestFrame(std::int64_t observation_ns, std::size_t frames_available);
+  bool readFrames(std::size_t frames);      // false: abandoned
+  bool framesAligned(std::size_t frames);   // false: abandoned
   void collectEdges(std::int64_t before_ns, std::int64_t after_ns, std::optional<std::int64_t>& newest,
                     bool& ambiguous);
   bool determineSegmentBase(std::optional<std::int64_t> observation_ns, std::size_t frames_available,
@@ -110,13 +108,13 @@ class Mpu6050Driver {
   int readWord(mpu6050::Register reg, std::uint16_t& value);
   template <typename Op>
   int withRetries(Op&& op);
-  bool registerMatches(std::size_t index, std::uint8_t value) const;
 
   // State and messages.
   void setState(DeviceState state, std::string reason = {}, bool retrying = true);
   void log(LogLevel level, const std::string& message) const;
   void goTo(Step step, std::int64_t at_ns);
   std::string where() const;
+  static std::string ms(std::int64_t ns);
 
   I2cBus& bus_;
   DataReadySource& data_ready_;

@@ -34,6 +34,7 @@ enum class GapCause : std::uint8_t {
   SilentReset,        // the chip lost its configuration (brown-out); re-initialised
   Reinitialised,      // the driver reset the chip after repeated errors
 };
+// The cause's token, e.g. "fifo_overflow": what the daemon publishes and the driver logs.
 const char* gapCauseName(GapCause cause);
 
 // Samples the driver could not deliver: sequence numbers first_seq .. first_seq+count−1.
@@ -140,27 +141,10 @@ struct Mpu6050Config {
   int recovery_attempts_before_failed = 5;   // then DeviceState::Failed (still retrying)
   std::int64_t reset_wait_ns = 100'000'000;  // after DEVICE_RESET (PX4 waits 100 ms)
   std::int64_t settle_ns = 50'000'000;       // after waking: gyro start-up is ~30 ms
-  std::string bus_name = "I2C bus";          // for messages, e.g. "/dev/i2c-1"
+  std::string bus_name = "I2C bus";          // for messages: the device path, e.g. "/dev/i2c-1"
 };
 
-// Throws std::invalid_argument naming the field and value when a config is unusable.
-void validateConfig(const Mpu6050Config& config);
-
-// SMPLRT_DIV for the configured rate: internal rate / (1 + div) = rate exactly.
-std::uint8_t sampleRateDivider(const Mpu6050Config& config);
-
-// Nominal sample period in ns.
-double nominalSamplePeriodNs(const Mpu6050Config& config);
-
-// A poll period for DataReadyMode::Polling that cannot lose samples: a quarter of the time
-// the FIFO (the smaller capacity of clones assumed) takes to fill at the fastest plausible
-// chip clock, at most 100 ms and at least 1 ms; and short enough that one wake-up's
-// backlog cap drains more than a poll period brings.
-std::int64_t pollingPeriodNs(const Mpu6050Config& config);
-
-// WHO_AM_I values the driver accepts: the genuine part, and those the clones sold as
-// MPU6050 are known to answer (accepted with a warning).
-bool isGenuineWhoAmI(std::uint8_t value);
-bool isKnownCloneWhoAmI(std::uint8_t value);
+// The rules about a config (validation, SMPLRT_DIV, periods, the register table) are in
+// driver/mpu6050_config.hpp.
 
 }  // namespace gyrod::driver

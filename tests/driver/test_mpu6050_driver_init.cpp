@@ -4,6 +4,8 @@
 
 #include <cerrno>
 #include <cstdio>
+#include <limits>
+#include <optional>
 #include <vector>
 
 #include "driver/mock_signal_source.hpp"
@@ -255,6 +257,19 @@ TEST(Mpu6050DriverInit, SampleRateDividerAndPollingPeriod) {
   p.sample_rate_hz = 1000.0;
   p.dlpf_cfg = 1;
   EXPECT_NEAR(static_cast<double>(pollingPeriodNs(p)), 64.0 * (1e6 / 1.1) / 4.0, 1.0);
+}
+
+TEST(Mpu6050DriverInit, TheSampleRateRuleTheDaemonConfigSharesAcceptsOnlyWholeDivisors) {
+  EXPECT_EQ(smplrtDivFor(4, 50.0), std::optional<std::uint8_t>(19));
+  EXPECT_EQ(smplrtDivFor(0, 500.0), std::optional<std::uint8_t>(15));  // 8 kHz / 16
+  EXPECT_EQ(smplrtDivFor(1, 1000.0 / 256.0), std::optional<std::uint8_t>(255));
+  EXPECT_EQ(smplrtDivFor(1, 300.0), std::nullopt);   // 1000 / 300 is not whole
+  EXPECT_EQ(smplrtDivFor(1, 2000.0), std::nullopt);  // faster than the output rate
+  EXPECT_EQ(smplrtDivFor(1, 1000.0 / 257.0), std::nullopt);
+  EXPECT_EQ(smplrtDivFor(1, 0.0), std::nullopt);
+  EXPECT_EQ(smplrtDivFor(1, -50.0), std::nullopt);
+  EXPECT_EQ(smplrtDivFor(1, std::numeric_limits<double>::infinity()), std::nullopt);
+  EXPECT_EQ(smplrtDivFor(1, std::numeric_limits<double>::quiet_NaN()), std::nullopt);
 }
 
 }  // namespace
