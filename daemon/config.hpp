@@ -13,6 +13,8 @@
 #include <string_view>
 #include <vector>
 
+#include "protocol/socket_path.hpp"
+
 namespace gyrod::daemon {
 
 class ConfigError : public std::runtime_error {
@@ -77,7 +79,7 @@ struct AllanConfig {
 };
 
 struct SocketConfig {
-  std::string path = "/run/gyrod/gyrod.sock";
+  std::string path = protocol::kDefaultSocketPath;
   unsigned mode = 0660;             // permission bits of the socket file
   std::string group;                // group of the socket file; empty = the daemon's group
   std::size_t client_buffer_kib = 256;  // per-client output queue before dropping

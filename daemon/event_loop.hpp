@@ -9,7 +9,7 @@
 // Level-triggered throughout. Callbacks may add or remove any source, including their own,
 // while the loop is dispatching: an event for a source removed earlier in the same batch is
 // not delivered. The loop owns the timerfds and signalfds it creates; it never owns an fd
-// passed to addFd (that stays with the caller's daemon::Fd).
+// passed to addFd (that stays with the caller's protocol::Fd).
 // Exceptions thrown by a callback propagate out of run()/runOnce(): sources that must not
 // stop the daemon (clients) handle their own errors.
 #include <sys/epoll.h>
@@ -21,9 +21,13 @@
 #include <unordered_map>
 #include <vector>
 
-#include "daemon/fd.hpp"
+#include "protocol/fd.hpp"
 
 namespace gyrod::daemon {
+
+// The daemon's descriptors are the protocol's owned Fd (shared with the driver and gyroctl).
+using protocol::errnoError;
+using protocol::Fd;
 
 class EventLoop {
  public:

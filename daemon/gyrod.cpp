@@ -14,6 +14,7 @@
 #include <sstream>
 #include <system_error>
 
+#include "driver/counter_names.hpp"
 #include "tools/recording/model_toml.hpp"
 
 namespace gyrod::daemon {
@@ -325,7 +326,12 @@ StatusReport Gyrod::statusReport() {
   const auto& c = driver_->counters();
   r.bus_errors = c.transfers_failed;
   r.resets = c.device_resets + c.fifo_resets;
-  r.device_state = driver::deviceStateName(driver_->status().state);
+  const driver::DeviceStatus& device_status = driver_->status();
+  r.device_state = driver::deviceStateName(device_status.state);
+  r.device_reason = device_status.reason;
+  r.device_retrying = device_status.retrying;
+  for (const auto& counter : driver::kDriverCounterNames)
+    r.device_counters.push_back({std::string(counter.name), c.*counter.member});
   r.device = device_.description;
   r.nominal_rate_hz = config_.device.rate_hz;
   if (samples_published_ > 0) r.rate_hz = driver_->estimatedSampleRateHz();

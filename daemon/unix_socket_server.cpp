@@ -17,6 +17,9 @@
 #include <stdexcept>
 
 namespace gyrod::daemon {
+
+// The server side of the protocol: its requests, replies and limits are used throughout.
+using namespace protocol;
 namespace {
 
 constexpr int kListenBacklog = 64;

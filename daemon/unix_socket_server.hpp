@@ -1,6 +1,6 @@
 #pragma once
 // The client side of gyrod: a Unix stream socket, many non-blocking clients, the protocol
-// of daemon/protocol.hpp, and a bounded output buffer per client.
+// of protocol/protocol.hpp, and a bounded output buffer per client.
 //
 // Backpressure policy (gpsd's weakness to avoid: slow clients silently losing data): each
 // client has a preallocated output buffer of ServerOptions::client_buffer_bytes. A line
@@ -20,17 +20,25 @@
 #include <vector>
 
 #include "daemon/event_loop.hpp"
-#include "daemon/fd.hpp"
-#include "daemon/protocol.hpp"
+#include "protocol/fd.hpp"
+#include "protocol/protocol.hpp"
+#include "protocol/socket_path.hpp"
 
 namespace gyrod::daemon {
 
-inline constexpr const char* kDefaultSocketPath = "/run/gyrod/gyrod.sock";
+// The server speaks in the protocol's types.
+using protocol::AllanReport;
+using protocol::ClientStatus;
+using protocol::GapEvent;
+using protocol::RateSample;
+using protocol::ServerStatus;
+using protocol::StatusReport;
+
 // FileDescriptorName= of the socket unit that gyrod takes when systemd passes several.
 inline constexpr const char* kActivatedSocketName = "gyrod";
 
 struct SocketOptions {
-  std::string path = kDefaultSocketPath;
+  std::string path = protocol::kDefaultSocketPath;
   mode_t mode = 0660;                // permission bits of the socket file (connect needs w)
   std::optional<std::string> group;  // group owning the socket file (name); none: keep ours
 };

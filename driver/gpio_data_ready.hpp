@@ -63,7 +63,7 @@ class GpioDataReady final : public DataReadySource {
  private:
   gpiod_chip* chip_ = nullptr;
   gpiod_line* line_ = nullptr;
-  int fd_ = -1;
+  int fd_ = -1;  // owned by libgpiod and closed with chip_, so not a protocol::Fd
   std::uint64_t timestamps_replaced_ = 0;
 };
 

@@ -71,14 +71,13 @@ LinuxI2cBus::LinuxI2cBus(int bus_number) : LinuxI2cBus("/dev/i2c-" + std::to_str
 }
 
 LinuxI2cBus::LinuxI2cBus(const std::string& device_path) : path_(device_path) {
-  fd_ = ::open(path_.c_str(), O_RDWR | O_CLOEXEC);
-  if (fd_ < 0) {
+  fd_.reset(::open(path_.c_str(), O_RDWR | O_CLOEXEC));
+  if (!fd_) {
     const int e = errno;
     throw I2cBusError(describeOpenError(e, path_), e);
   }
-  if (::ioctl(fd_, I2C_FUNCS, &funcs_) < 0) {
+  if (::ioctl(fd_.get(), I2C_FUNCS, &funcs_) < 0) {
     const int e = errno;
-    ::close(fd_);
     throw I2cBusError(describeFunctionalityError(e, path_), e);
   }
   rdwr_ = (funcs_ & I2C_FUNC_I2C) != 0;
@@ -88,36 +87,33 @@ LinuxI2cBus::LinuxI2cBus(const std::string& device_path) : path_(device_path) {
   if (!rdwr_ && !(funcs_ & I2C_FUNC_SMBUS_READ_WORD_DATA)) missing += " SMBus read word data (or plain I2C);";
   if (!rdwr_ && !(funcs_ & I2C_FUNC_SMBUS_READ_I2C_BLOCK)) missing += " SMBus I2C block read (or plain I2C);";
   if (!missing.empty()) {
-    ::close(fd_);
     throw I2cBusError("the adapter " + path_ + " lacks transfers the MPU6050 needs:" + missing +
                           " use another I2C bus (on a Pi, bus 1 on header pins 3 and 5).",
                       EOPNOTSUPP);
   }
 }
 
-LinuxI2cBus::~LinuxI2cBus() {
-  if (fd_ >= 0) ::close(fd_);
-}
+LinuxI2cBus::~LinuxI2cBus() = default;
 
 int LinuxI2cBus::selectDevice(std::uint8_t address) {
   if (address > 0x7F) return -EINVAL;
   // I2C_SLAVE fails with EBUSY when a kernel driver is bound to the address. Deliberately
   // not I2C_SLAVE_FORCE: two drivers on one chip corrupt each other's configuration.
-  if (::ioctl(fd_, I2C_SLAVE, static_cast<unsigned long>(address)) < 0) return -errno;
+  if (::ioctl(fd_.get(), I2C_SLAVE, static_cast<unsigned long>(address)) < 0) return -errno;
   selected_ = address;
   return 0;
 }
 
 int LinuxI2cBus::readByte(std::uint8_t reg, std::uint8_t& value) {
   // libi2c (i2c-tools ≥ 4.0) returns the byte or −errno.
-  const __s32 r = i2c_smbus_read_byte_data(fd_, reg);
+  const __s32 r = i2c_smbus_read_byte_data(fd_.get(), reg);
   if (r < 0) return r;
   value = static_cast<std::uint8_t>(r & 0xFF);
   return 0;
 }
 
 int LinuxI2cBus::writeByte(std::uint8_t reg, std::uint8_t value) {
-  const __s32 r = i2c_smbus_write_byte_data(fd_, reg, value);
+  const __s32 r = i2c_smbus_write_byte_data(fd_.get(), reg, value);
   return r < 0 ? r : 0;
 }
 
@@ -127,7 +123,7 @@ int LinuxI2cBus::rdwrRead(std::uint8_t reg, std::span<std::uint8_t> out) {
   i2c_rdwr_ioctl_data data{};
   data.msgs = msgs.data();
   data.nmsgs = static_cast<__u32>(msgs.size());
-  const int r = ::ioctl(fd_, I2C_RDWR, &data);
+  const int r = ::ioctl(fd_.get(), I2C_RDWR, &data);
   if (r < 0) return -errno;
   if (r != static_cast<int>(msgs.size())) {
     ++short_reads_;  // the adapter stopped after the first message
@@ -146,7 +142,7 @@ int LinuxI2cBus::readWordBigEndian(std::uint8_t reg, std::uint16_t& value) {
   }
   // SMBus words are little-endian on the wire (first byte = low byte); the MPU6050 sends
   // the high byte first, so swap.
-  const __s32 r = i2c_smbus_read_word_data(fd_, reg);
+  const __s32 r = i2c_smbus_read_word_data(fd_.get(), reg);
   if (r < 0) return r;
   const auto w = static_cast<std::uint16_t>(r & 0xFFFF);
   value = static_cast<std::uint16_t>((w << 8) | (w >> 8));
@@ -156,7 +152,7 @@ int LinuxI2cBus::readWordBigEndian(std::uint8_t reg, std::uint16_t& value) {
 int LinuxI2cBus::readBlock(std::uint8_t reg, std::span<std::uint8_t> out) {
   if (out.empty() || out.size() > maxBurstLength()) return -EINVAL;
   if (rdwr_) return rdwrRead(reg, out);
-  const __s32 r = i2c_smbus_read_i2c_block_data(fd_, reg, static_cast<__u8>(out.size()), out.data());
+  const __s32 r = i2c_smbus_read_i2c_block_data(fd_.get(), reg, static_cast<__u8>(out.size()), out.data());
   if (r < 0) return r;
   if (static_cast<std::size_t>(r) != out.size()) {
     ++short_reads_;

@@ -17,6 +17,7 @@
 #include <string>
 
 #include "driver/i2c_bus.hpp"
+#include "protocol/fd.hpp"
 
 namespace gyrod::driver {
 
@@ -75,7 +76,7 @@ class LinuxI2cBus final : public I2cBus {
   int rdwrRead(std::uint8_t reg, std::span<std::uint8_t> out);
 
   std::string path_;
-  int fd_ = -1;
+  protocol::Fd fd_;
   unsigned long funcs_ = 0;
   bool rdwr_ = false;
   std::uint8_t selected_ = 0;

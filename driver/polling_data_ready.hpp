@@ -11,6 +11,7 @@
 
 #include "driver/clock.hpp"
 #include "driver/data_ready.hpp"
+#include "protocol/fd.hpp"
 
 namespace gyrod::driver {
 
@@ -23,7 +24,7 @@ class PollingDataReady final : public DataReadySource {
   PollingDataReady(const PollingDataReady&) = delete;
   PollingDataReady& operator=(const PollingDataReady&) = delete;
 
-  int fd() const override { return fd_; }
+  int fd() const override { return fd_.get(); }
   // 0 with the current time when at least one period has elapsed since the last poll
   // (several elapsed periods are one poll: the FIFO holds the data), else -EAGAIN.
   [[nodiscard]] int consumeEdge(std::int64_t& timestamp_ns) override;
@@ -38,7 +39,7 @@ class PollingDataReady final : public DataReadySource {
   const Clock& clock_;
   std::int64_t period_ns_;
   std::int64_t next_poll_ns_;
-  int fd_ = -1;
+  protocol::Fd fd_;
 };
 
 }  // namespace gyrod::driver

@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "daemon/event_loop.hpp"
-#include "daemon/fd.hpp"
-#include "daemon/protocol.hpp"
+#include "protocol/fd.hpp"
+#include "protocol/protocol.hpp"
 #include "daemon/unix_socket_server.hpp"
 #include "tools/run_command.hpp"
 
@@ -33,9 +33,9 @@ inline constexpr auto kHangGuard = 5s;
 
 // A synthetic sample whose every field is a plain function of k, with values chosen to
 // need all 17 significant digits (thirds, sevenths, tiny and huge magnitudes, negatives).
-inline daemon::RateSample syntheticSample(std::uint64_t k) {
+inline protocol::RateSample syntheticSample(std::uint64_t k) {
   const double x = static_cast<double>(k);
-  daemon::RateSample s;
+  protocol::RateSample s;
   s.seq = 1000 + k;
   s.t_s = 12345.678 + x / 50.0;
   s.temp_c = 25.0 + x / 3.0;
@@ -53,7 +53,7 @@ class TestClient {
     addr.sun_family = AF_UNIX;
     std::memcpy(addr.sun_path, path.data(), path.size());
     if (::connect(fd_.get(), reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0)
-      throw daemon::errnoError("test client connect(" + path + ")");
+      throw protocol::errnoError("test client connect(" + path + ")");
   }
   int fd() const { return fd_.get(); }
   void close() { fd_.reset(); }
@@ -62,7 +62,7 @@ class TestClient {
     std::size_t done = 0;
     while (done < text.size()) {
       const ssize_t n = ::send(fd_.get(), text.data() + done, text.size() - done, MSG_NOSIGNAL);
-      if (n < 0) throw daemon::errnoError("test client send");
+      if (n < 0) throw protocol::errnoError("test client send");
       done += static_cast<std::size_t>(n);
     }
   }
@@ -141,7 +141,7 @@ class TestClient {
   }
 
  private:
-  daemon::Fd fd_;
+  protocol::Fd fd_;
   std::string pending_;
   std::vector<std::string> got_;
   bool closed_ = false;
@@ -164,14 +164,14 @@ inline void collectConcurrently(EventLoop& loop, const std::vector<TestClient*>&
 
 // ALLAN/STATUS content with values set by the test.
 struct FakeContent : daemon::ServerContent {
-  daemon::AllanReport allan;
-  daemon::StatusReport status;
+  protocol::AllanReport allan;
+  protocol::StatusReport status;
   bool fail = false;
-  daemon::AllanReport allanReport() override {
+  protocol::AllanReport allanReport() override {
     if (fail) throw std::runtime_error("statistics not available");
     return allan;
   }
-  daemon::StatusReport statusReport() override {
+  protocol::StatusReport statusReport() override {
     if (fail) throw std::runtime_error("status not available");
     return status;
   }
@@ -233,7 +233,7 @@ class ServerFixture : public ::testing::Test {
 };
 
 // Checks a RATE line against the sample it must carry, value by value, exactly.
-inline void expectRateLineCarries(const std::string& line, const daemon::RateSample& s) {
+inline void expectRateLineCarries(const std::string& line, const protocol::RateSample& s) {
   const json j = json::parse(line);
   ASSERT_EQ(j.value("class", ""), "RATE") << line;
   EXPECT_EQ(j["seq"].get<std::uint64_t>(), s.seq);

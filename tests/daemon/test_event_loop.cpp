@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "daemon/event_loop.hpp"
-#include "daemon/fd.hpp"
+#include "protocol/fd.hpp"
 
 using namespace gyrod::daemon;
 using namespace std::chrono_literals;

@@ -47,8 +47,8 @@ class GyroctlTest : public ServerFixture {
                     std::optional<uid_t> as_user = std::nullopt) {
     const auto out_path = dir_.path() / "out.txt";
     const auto err_path = dir_.path() / "err.txt";
-    const daemon::Fd out(::open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666));
-    const daemon::Fd err(::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666));
+    const protocol::Fd out(::open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666));
+    const protocol::Fd err(::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666));
     const std::string exe = std::string(GYROD_BIN_DIR) + "/gyroctl";
     std::vector<std::string> argv_s{exe};
     argv_s.insert(argv_s.end(), args.begin(), args.end());
@@ -123,8 +123,8 @@ TEST_F(GyroctlTest, WatchJsonPassesLinesThroughUnchangedAndStopsAtCount) {
   EXPECT_EQ(json::parse(lines[0])["class"], "VERSION");
   EXPECT_EQ(json::parse(lines[1]), json::parse(R"({"class":"WATCH","enable":true,"decimate":1})"));
   for (std::size_t k = 0; k < 5; ++k) {
-    std::array<char, daemon::kMaxRateLineBytes> expected;
-    const std::size_t n = daemon::formatRateLine(syntheticSample(k), expected);
+    std::array<char, protocol::kMaxRateLineBytes> expected;
+    const std::size_t n = protocol::formatRateLine(syntheticSample(k), expected);
     EXPECT_EQ(lines[2 + k] + "\n", std::string(expected.data(), n));  // byte for byte
     expectRateLineCarries(lines[2 + k], syntheticSample(k));
   }
@@ -145,7 +145,7 @@ TEST_F(GyroctlTest, WatchShowsRawAndKalmanPerAxisAndGaps) {
   EXPECT_EQ(lines[2], "--- gap: 2 sample(s) missing from seq 1002 (fifo_overflow)");
   const std::size_t rows[] = {1, 3, 4};
   for (std::size_t i = 0; i < 3; ++i) {
-    const daemon::RateSample s = syntheticSample(2 * i);  // decimate 2: samples 0, 2, 4
+    const protocol::RateSample s = syntheticSample(2 * i);  // decimate 2: samples 0, 2, 4
     const auto w = words(lines[rows[i]]);
     ASSERT_EQ(w.size(), 8u) << lines[rows[i]];
     EXPECT_EQ(w[0], std::to_string(s.seq));
@@ -182,10 +182,35 @@ TEST_F(GyroctlTest, StatusHumanAndJson) {
   EXPECT_NE(h.out.find("(this gyroctl)"), std::string::npos) << h.out;
 }
 
+TEST_F(GyroctlTest, StatusShowsTheDeviceReasonAndEveryDriverCounter) {
+  content_.status.device_state = "failed";
+  content_.status.device_reason = "WHO_AM_I reads 0x00: no MPU6050 at 0x68";
+  content_.status.device_retrying = false;
+  content_.status.device_counters = {{"transfers_failed", 12}, {"recoveries", 3}, {"data_ready_missed", 7}};
+  startServer();
+  const CommandResult h = run({"status", "--socket", socketPath()});
+  ASSERT_EQ(h.exit_status, 0) << h.err;
+  EXPECT_NE(h.out.find("device_state:    failed\ndevice_reason:   WHO_AM_I reads 0x00: no MPU6050 at 0x68\n"
+                       "device_retrying: no\n"),
+            std::string::npos)
+      << h.out;
+  EXPECT_NE(h.out.find("driver counters:\n  transfers_failed:      12\n  recoveries:            3\n"
+                       "  data_ready_missed:     7\n"),
+            std::string::npos)
+      << h.out;
+
+  const CommandResult j = run({"status", "--socket", socketPath(), "--json"});
+  ASSERT_EQ(j.exit_status, 0) << j.err;
+  const json s = json::parse(j.out);
+  EXPECT_EQ(s["device_reason"], content_.status.device_reason);
+  EXPECT_EQ(s["device_retrying"], false);
+  EXPECT_EQ(s["counters"], json::parse(R"({"transfers_failed":12,"recoveries":3,"data_ready_missed":7})"));
+}
+
 namespace {
 
-daemon::AllanReport exampleAllan() {
-  daemon::AllanReport a;
+protocol::AllanReport exampleAllan() {
+  protocol::AllanReport a;
   a.window_s = 600.0;
   a.samples = 30000;
   a.tau0_s = 0.02;
@@ -230,7 +255,7 @@ TEST_F(GyroctlTest, AllanTableJsonAndPlot) {
 
   const CommandResult j = run({"allan", "--socket", socketPath(), "--json"});
   ASSERT_EQ(j.exit_status, 0) << j.err;
-  EXPECT_EQ(j.out, daemon::allanLine(content_.allan));
+  EXPECT_EQ(j.out, protocol::allanLine(content_.allan));
 
   const auto png = dir_.path() / "adev.png";
   const CommandResult p = run({"allan", "--socket", socketPath(), "--plot", png.string()});

@@ -67,7 +67,7 @@ TEST_F(ServerFixture, PublishingAllocatesNothing) {
   std::size_t fast_lines = 0, decimated_lines = 0, slow_lines = 0;
   std::size_t max_slow_buffered = 0;
   for (std::uint64_t k = 0; k < n; ++k) {
-    const daemon::RateSample s = syntheticSample(k);  // built outside the counted window
+    const protocol::RateSample s = syntheticSample(k);  // built outside the counted window
     {
       CountAllocations c;
       server_->publishRate(s);

@@ -12,7 +12,7 @@
 
 using namespace gyrod;
 using namespace gyrod::test;
-using daemon::ErrorCode;
+using protocol::ErrorCode;
 
 namespace {
 
@@ -195,8 +195,8 @@ TEST_F(ServerTest, LineOfExactlyTheLimitIsServed) {
   startServer();
   auto c = connect();
   std::string line = "{\"cmd\":\"status\"}";
-  line += std::string(daemon::kMaxRequestLineBytes - line.size(), ' ');
-  ASSERT_EQ(line.size(), daemon::kMaxRequestLineBytes);
+  line += std::string(protocol::kMaxRequestLineBytes - line.size(), ' ');
+  ASSERT_EQ(line.size(), protocol::kMaxRequestLineBytes);
   c->send(line + "\r\n");
   EXPECT_EQ(c->readObject(loop_)["class"], "STATUS");
 }
@@ -213,7 +213,7 @@ TEST_F(ServerTest, OverlongLineGetsAnErrorThenDisconnectAndTheServerLivesOn) {
   EXPECT_TRUE(pumpUntil(loop_, [&] { return server_->clientCount() == 1; }));
   // One byte over the limit without any newline is refused the same way.
   auto c2 = connect();
-  c2->send(std::string(daemon::kMaxRequestLineBytes + 3, '{'));
+  c2->send(std::string(protocol::kMaxRequestLineBytes + 3, '{'));
   const auto lines2 = c2->readUntilClosed(loop_);
   ASSERT_EQ(lines2.size(), 1u);
   EXPECT_EQ(parse(lines2[0])["code"], "line_too_long");
@@ -265,7 +265,7 @@ TEST_F(ServerTest, StalledClientIsDroppedWhileTheOthersReceiveEveryLine) {
   for (std::size_t k = 0; k < n; ++k) expectRateLineCarries(la[k], syntheticSample(k));
   for (std::size_t k = 0; k < n / 2; ++k) expectRateLineCarries(lb[k], syntheticSample(2 * k));
   EXPECT_EQ(server_->clientCount(), 2u);
-  const daemon::ServerStatus st = server_->serverStatus();
+  const protocol::ServerStatus st = server_->serverStatus();
   EXPECT_EQ(st.clients_dropped, 1u);
   EXPECT_GT(st.lines_dropped, 0u);
 
@@ -277,8 +277,8 @@ TEST_F(ServerTest, StalledClientIsDroppedWhileTheOthersReceiveEveryLine) {
   ASSERT_TRUE(dropped_at.has_value());
   ASSERT_LE(got.size(), *dropped_at);
   for (std::size_t k = 0; k < got.size(); ++k) expectRateLineCarries(got[k], syntheticSample(k));
-  std::array<char, daemon::kMaxRateLineBytes> next_line;
-  const std::size_t next_size = daemon::formatRateLine(syntheticSample(got.size()), next_line);
+  std::array<char, protocol::kMaxRateLineBytes> next_line;
+  const std::size_t next_size = protocol::formatRateLine(syntheticSample(got.size()), next_line);
   EXPECT_EQ(std::string(next_line.data(), next_size).substr(0, stalled->partial().size()), stalled->partial());
   // Counted exactly what it missed up to and including the sample that did not fit.
   EXPECT_EQ(got.size() + st.lines_dropped, *dropped_at + 1);
@@ -460,7 +460,7 @@ TEST(ListeningSocket, SocketActivationTakesTheFdNamedGyrod) {
   daemon::SocketOptions so;
   so.path = path;
   daemon::ListeningSocket ls = daemon::bindListeningSocket(so);
-  const daemon::Fd other(::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0));
+  const protocol::Fd other(::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0));
   const pid_t pid = ::fork();
   ASSERT_GE(pid, 0);
   if (pid == 0) {

@@ -7,40 +7,35 @@
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <variant>
 #include <vector>
 
-#include "daemon/protocol.hpp"
 #include "processing/noise_terms.hpp"
+#include "protocol/protocol.hpp"
+#include "protocol/socket_path.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/daemon_client.hpp"
 
 namespace gyrod::gyroctl {
 namespace {
 
-using nlohmann::json;
 using namespace std::chrono_literals;
 
-constexpr const char* kDefaultSocket = "/run/gyrod/gyrod.sock";
 // allan and status are answered at once by a healthy daemon; a stuck one is reported.
 constexpr auto kReplyTimeout = 10s;
 
 struct CommonOptions {
-  std::string socket = kDefaultSocket;
+  std::string socket = protocol::kDefaultSocketPath;
   bool json = false;
 };
 
 void addCommonOptions(CLI::App* sub, CommonOptions& opt) {
-  sub->add_option("--socket", opt.socket, "gyrod's socket")->envname("GYROD_SOCKET")->default_val(kDefaultSocket);
-}
-
-std::optional<double> numberAt(const json& j, const char* key) {
-  const auto it = j.find(key);
-  if (it == j.end() || !it->is_number()) return std::nullopt;
-  return it->get<double>();
+  sub->add_option("--socket", opt.socket, "gyrod's socket")
+      ->envname("GYROD_SOCKET")
+      ->default_val(protocol::kDefaultSocketPath);
 }
 
 // ---- watch ---------------------------------------------------------------------------------
@@ -56,55 +51,54 @@ void printRateHeader() {
               "kalman y", "kalman z");
 }
 
-void printAxisTriple(const json& j, const char* key) {
-  const auto it = j.find(key);
-  for (std::size_t i = 0; i < 3; ++i) {
-    if (it != j.end() && it->is_array() && it->size() == 3 && (*it)[i].is_number())
-      std::printf(" %10.5f", (*it)[i].get<double>());
+// A value the line left out comes back from the parser as NaN and shows as "-".
+void printAxisTriple(const std::array<double, 3>& v) {
+  for (const double x : v) {
+    if (std::isfinite(x))
+      std::printf(" %10.5f", x);
     else
       std::printf(" %10s", "-");
   }
 }
 
-void printRate(const json& j) {
-  const auto t = numberAt(j, "t");
-  std::printf("%10llu ", static_cast<unsigned long long>(j.value("seq", std::uint64_t{0})));
-  if (t)
-    std::printf("%12.3f ", *t);
+void printRate(const protocol::RateSample& r) {
+  std::printf("%10llu ", static_cast<unsigned long long>(r.seq));
+  if (std::isfinite(r.t_s))
+    std::printf("%12.3f ", r.t_s);
   else
     std::printf("%12s ", "-");
-  printAxisTriple(j, "raw");
+  printAxisTriple(r.raw_dps);
   std::printf(" ");
-  printAxisTriple(j, "kalman");
+  printAxisTriple(r.kalman_dps);
   std::printf("\n");
 }
 
-void printGap(const json& j) {
-  std::printf("--- gap: %llu sample(s) missing from seq %llu (%s)\n", static_cast<unsigned long long>(j.value("count", std::uint64_t{0})),
-              static_cast<unsigned long long>(j.value("seq", std::uint64_t{0})), j.value("reason", std::string("?")).c_str());
+void printGap(const protocol::GapNotice& g) {
+  std::printf("--- gap: %llu sample(s) missing from seq %llu (%s)\n", static_cast<unsigned long long>(g.count),
+              static_cast<unsigned long long>(g.first_missing_seq), g.reason.c_str());
 }
 
 int runWatch(const WatchOptions& opt) {
   if (opt.count && *opt.count == 0) throw std::invalid_argument("--count must be >= 1");
   DaemonConnection conn = DaemonConnection::open(opt.common.socket, kReplyTimeout);
   if (opt.common.json) std::printf("%s\n", conn.versionLine().c_str());
-  conn.sendLine(json({{"cmd", "watch"}, {"enable", true}, {"decimate", opt.decimate}}).dump());
+  conn.sendLine(protocol::requestLine(protocol::WatchRequest{true, opt.decimate}));
   std::uint64_t rates = 0;
   bool header_printed = false;
   while (!opt.count || rates < *opt.count) {
     const std::string line = conn.readLine(std::nullopt);
-    const json j = parseServerLine(line);
-    const std::string& cls = j["class"].get_ref<const std::string&>();
-    if (cls == "ERROR") throw DaemonConnectionError("gyrod: " + j.value("message", std::string("error")));
-    if (cls == "RATE") ++rates;
+    const protocol::ServerMessage message = parseServerLine(line);
+    throwIfError(message);
+    const auto* rate = std::get_if<protocol::RateSample>(&message);
+    if (rate) ++rates;
     if (opt.common.json) {
       std::printf("%s\n", line.c_str());
-    } else if (cls == "RATE") {
+    } else if (rate) {
       if (!header_printed) printRateHeader();
       header_printed = true;
-      printRate(j);
-    } else if (cls == "GAP") {
-      printGap(j);
+      printRate(*rate);
+    } else if (const auto* gap = std::get_if<protocol::GapNotice>(&message)) {
+      printGap(*gap);
     }
     std::fflush(stdout);
   }
@@ -123,30 +117,47 @@ struct Curve {
   std::vector<double> adev;
 };
 
-std::vector<Curve> curvesOf(const json& j, std::size_t n_tau) {
+// The computed curves in axis-then-stream order (the parser has checked their lengths).
+std::vector<Curve> curvesOf(const protocol::AllanReport& report) {
   std::vector<Curve> curves;
-  const json adev = j.value("adev", json::object());
-  for (const auto axis : daemon::kAxisNames) {
-    const auto a = adev.find(std::string(axis));
-    if (a == adev.end() || !a->is_object()) continue;
-    for (const auto stream : daemon::kStreamNames) {
-      const auto s = a->find(std::string(stream));
-      if (s == a->end()) continue;
-      if (!s->is_array() || s->size() != n_tau)
-        throw DaemonConnectionError("gyrod's ALLAN curve " + std::string(axis) + "/" + std::string(stream) + " does not match its tau list");
-      Curve c{std::string(axis) + " " + std::string(stream), {}};
-      for (const auto& v : *s) c.adev.push_back(v.get<double>());
-      curves.push_back(std::move(c));
+  for (std::size_t a = 0; a < protocol::kAxisNames.size(); ++a)
+    for (std::size_t s = 0; s < protocol::kStreamNames.size(); ++s) {
+      const auto& adev = report.curves[a][s].adev_dps;
+      if (adev.empty()) continue;
+      curves.push_back({std::string(protocol::kAxisNames[a]) + " " + std::string(protocol::kStreamNames[s]), adev});
     }
-  }
   return curves;
 }
 
-void printAllanTable(const json& j, const std::vector<double>& tau, const std::vector<Curve>& curves) {
+void printNoiseTerms(const protocol::AllanReport& report) {
+  bool any = false;
+  for (const auto& axis : report.curves)
+    for (const auto& curve : axis) any = any || curve.noise.has_value();
+  if (!any) return;
+  std::printf("\nnoise terms (IEEE Std 952)\n");
+  for (std::size_t a = 0; a < protocol::kAxisNames.size(); ++a)
+    for (std::size_t s = 0; s < protocol::kStreamNames.size(); ++s) {
+      const auto& noise = report.curves[a][s].noise;
+      if (!noise) continue;
+      std::printf("  %s %s:", std::string(protocol::kAxisNames[a]).c_str(),
+                  std::string(protocol::kStreamNames[s]).c_str());
+      const char* sep = " ";
+      for (const auto t : processing::kAllNoiseTerms) {
+        const double v = noise->get(t);
+        if (!std::isfinite(v)) continue;  // not estimated: left out of the line
+        std::printf("%s%s = %.4g", sep, std::string(processing::noiseTermLabel(t)).c_str(), v);
+        sep = ", ";
+      }
+      std::printf("\n");
+    }
+}
+
+void printAllanTable(const protocol::AllanReport& report, const std::vector<Curve>& curves) {
+  const std::vector<double>& tau = report.tau_s;
   std::printf("Allan deviation [deg/s]");
-  if (const auto w = numberAt(j, "window")) std::printf(", window %.6g s", *w);
-  std::printf(" (%llu samples", static_cast<unsigned long long>(j.value("samples", std::uint64_t{0})));
-  if (const auto t0 = numberAt(j, "tau0")) std::printf(", tau0 %.6g s", *t0);
+  if (std::isfinite(report.window_s)) std::printf(", window %.6g s", report.window_s);
+  std::printf(" (%llu samples", static_cast<unsigned long long>(report.samples));
+  if (std::isfinite(report.tau0_s)) std::printf(", tau0 %.6g s", report.tau0_s);
   std::printf(")\n");
   if (tau.empty()) {
     std::printf("not enough samples in the window for an Allan deviation yet\n");
@@ -160,26 +171,7 @@ void printAllanTable(const json& j, const std::vector<double>& tau, const std::v
     for (const auto& c : curves) std::printf(" %11.4e", c.adev[i]);
     std::printf("\n");
   }
-  const json noise = j.value("noise", json::object());
-  if (noise.empty()) return;
-  std::printf("\nnoise terms (IEEE Std 952)\n");
-  for (const auto axis : daemon::kAxisNames) {
-    const auto a = noise.find(std::string(axis));
-    if (a == noise.end() || !a->is_object()) continue;
-    for (const auto stream : daemon::kStreamNames) {
-      const auto s = a->find(std::string(stream));
-      if (s == a->end() || !s->is_object()) continue;
-      std::printf("  %s %s:", std::string(axis).c_str(), std::string(stream).c_str());
-      const char* sep = " ";
-      for (const auto t : processing::kAllNoiseTerms) {
-        const auto v = s->find(std::string(processing::noiseTermKey(t)));
-        if (v == s->end() || !v->is_number()) continue;
-        std::printf("%s%s = %.4g", sep, std::string(processing::noiseTermLabel(t)).c_str(), v->get<double>());
-        sep = ", ";
-      }
-      std::printf("\n");
-    }
-  }
+  printNoiseTerms(report);
 }
 
 std::optional<std::string> findOnPath(const std::string& program) {
@@ -251,71 +243,97 @@ void plotAllan(const std::string& file, const std::vector<double>& tau, const st
 int runAllan(const AllanOptions& opt) {
   if (!opt.plot.empty()) gnuplotTerminal(opt.plot);  // a bad extension is reported before connecting
   DaemonConnection conn = DaemonConnection::open(opt.common.socket, kReplyTimeout);
-  conn.sendLine(R"({"cmd":"allan"})");
+  conn.sendLine(protocol::requestLine(protocol::AllanRequest{}));
   std::string raw;
-  const json j = conn.readObjectOfClass("ALLAN", kReplyTimeout, &raw);
-  std::vector<double> tau;
-  for (const auto& v : j.value("tau", json::array())) tau.push_back(v.get<double>());
-  const std::vector<Curve> curves = curvesOf(j, tau.size());
+  const auto report = conn.readReply<protocol::AllanReport>(kReplyTimeout, &raw);
+  const std::vector<Curve> curves = curvesOf(report);
   if (opt.common.json)
     std::printf("%s\n", raw.c_str());
   else
-    printAllanTable(j, tau, curves);
+    printAllanTable(report, curves);
   std::fflush(stdout);
-  if (!opt.plot.empty()) plotAllan(opt.plot, tau, curves);
+  if (!opt.plot.empty()) plotAllan(opt.plot, report.tau_s, curves);
   return kExitOk;
 }
 
 // ---- status --------------------------------------------------------------------------------
 
-std::string scalarText(const json& v) {
-  if (v.is_string()) return v.get<std::string>();
-  if (v.is_number_float()) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.6g", v.get<double>());
-    return buf;
+std::string realText(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+void printField(const std::string& key, const std::string& value, const std::string& unit = "") {
+  std::printf("%-16s %s%s%s\n", (key + ":").c_str(), value.c_str(), unit.empty() ? "" : " ", unit.c_str());
+}
+
+void printField(const std::string& key, const std::optional<double>& value, const std::string& unit) {
+  if (value && std::isfinite(*value)) printField(key, realText(*value), unit);
+}
+
+void printField(const std::string& key, const std::optional<std::string>& value) {
+  if (value) printField(key, *value);
+}
+
+// The fields this gyroctl knows, in a fixed order with units; then whatever a newer gyrod
+// added; then the driver's counters and the clients.
+void printStatus(const protocol::StatusReply& status) {
+  const protocol::StatusReport& d = status.daemon;
+  const protocol::ServerStatus& s = status.server;
+  const auto count = [](std::uint64_t v) { return std::to_string(v); };
+  printField("device_state", d.device_state);
+  if (!d.device_reason.empty()) printField("device_reason", d.device_reason);
+  if (d.device_retrying) printField("device_retrying", std::string(*d.device_retrying ? "yes" : "no"));
+  printField("device", d.device);
+  printField("uptime", d.uptime_s, "s");
+  printField("samples", count(d.samples));
+  printField("rate", d.rate_hz, "Hz");
+  printField("nominal_rate", d.nominal_rate_hz, "Hz");
+  printField("temp", d.temp_c, "degC");
+  printField("gaps", count(d.gaps));
+  printField("missing", count(d.missing_samples), "samples");
+  printField("bus_errors", count(d.bus_errors));
+  printField("resets", count(d.resets));
+  printField("bias_source", d.bias_source);
+  printField("recording", d.recording);
+  printField("clients", count(s.clients));
+  printField("clients_total", count(s.clients_total));
+  printField("clients_dropped", count(s.clients_dropped));
+  printField("lines_dropped", count(s.lines_dropped));
+  printField("client_buffer", count(s.client_buffer_bytes), "bytes");
+  for (const protocol::OtherField& f : status.other_fields)
+    printField(f.key, f.text ? *f.text : f.real ? realText(*f.real) : f.json);
+  if (!d.device_counters.empty()) {
+    std::printf("driver counters:\n");
+    for (const protocol::NamedCount& c : d.device_counters)
+      std::printf("  %-22s %llu\n", (c.name + ":").c_str(), static_cast<unsigned long long>(c.value));
   }
-  return v.dump();
+  if (s.client_list.empty()) return;
+  std::printf("%6s %8s %6s %8s %12s %12s %10s\n", "client", "pid", "watch", "decimate", "lines sent", "lines queued",
+              "buffered");
+  for (const protocol::ClientStatus& c : s.client_list) {
+    std::printf("%6llu %8s %6s %8u %12llu %12llu %10llu%s\n", static_cast<unsigned long long>(c.id),
+                c.pid ? std::to_string(*c.pid).c_str() : "-", c.watch ? "yes" : "no", c.decimate,
+                static_cast<unsigned long long>(c.lines_sent), static_cast<unsigned long long>(c.lines_queued),
+                static_cast<unsigned long long>(c.buffered_bytes), c.self ? "  (this gyroctl)" : "");
+  }
 }
 
 int runStatus(const CommonOptions& opt) {
   DaemonConnection conn = DaemonConnection::open(opt.socket, kReplyTimeout);
-  conn.sendLine(R"({"cmd":"status"})");
+  conn.sendLine(protocol::requestLine(protocol::StatusRequest{}));
   std::string raw;
-  const json j = conn.readObjectOfClass("STATUS", kReplyTimeout, &raw);
+  const auto status = conn.readReply<protocol::StatusReply>(kReplyTimeout, &raw);
   if (opt.json) {
     std::printf("%s\n", raw.c_str());
     return kExitOk;
   }
-  std::printf("gyrod %s (protocol %d.%d)\n", conn.version().value("release", std::string("?")).c_str(),
-              conn.version().value("proto_major", 0), conn.version().value("proto_minor", 0));
-  // Known fields in a fixed order with units, then whatever a newer gyrod added.
-  const std::vector<std::pair<std::string, std::string>> known = {
-      {"device_state", ""}, {"device", ""},        {"uptime", "s"},        {"samples", ""},        {"rate", "Hz"},
-      {"nominal_rate", "Hz"}, {"temp", "degC"},    {"gaps", ""},           {"missing", "samples"}, {"bus_errors", ""},
-      {"resets", ""},       {"bias_source", ""},   {"recording", ""},      {"clients", ""},        {"clients_total", ""},
-      {"clients_dropped", ""}, {"lines_dropped", ""}, {"client_buffer", "bytes"}};
-  for (const auto& [key, unit] : known) {
-    const auto it = j.find(key);
-    if (it == j.end()) continue;
-    std::printf("%-16s %s%s%s\n", (key + ":").c_str(), scalarText(*it).c_str(), unit.empty() ? "" : " ", unit.c_str());
-  }
-  for (auto it = j.begin(); it != j.end(); ++it) {
-    const bool listed = it.key() == "class" || it.key() == "client_list" ||
-                        std::any_of(known.begin(), known.end(), [&](const auto& k) { return k.first == it.key(); });
-    if (!listed) std::printf("%-16s %s\n", (it.key() + ":").c_str(), scalarText(*it).c_str());
-  }
-  const json list = j.value("client_list", json::array());
-  if (!list.empty()) {
-    std::printf("%6s %8s %6s %8s %12s %12s %10s\n", "client", "pid", "watch", "decimate", "lines sent", "lines queued", "buffered");
-    for (const auto& c : list) {
-      std::printf("%6llu %8s %6s %8u %12llu %12llu %10llu%s\n", static_cast<unsigned long long>(c.value("id", 0ULL)),
-                  c.contains("pid") ? std::to_string(c["pid"].get<long long>()).c_str() : "-", c.value("watch", false) ? "yes" : "no",
-                  c.value("decimate", 1u), static_cast<unsigned long long>(c.value("lines_sent", 0ULL)),
-                  static_cast<unsigned long long>(c.value("lines_queued", 0ULL)),
-                  static_cast<unsigned long long>(c.value("buffered", 0ULL)), c.value("self", false) ? "  (this gyroctl)" : "");
-    }
-  }
+  const protocol::VersionReply& version = conn.version();
+  std::printf("gyrod %s (protocol %lld.%lld)\n", version.release.empty() ? "?" : version.release.c_str(),
+              static_cast<long long>(version.proto_major.value_or(0)),
+              static_cast<long long>(version.proto_minor.value_or(0)));
+  printStatus(status);
   return kExitOk;
 }
 
@@ -328,7 +346,7 @@ void addClientCommands(CLI::App& app, CommandRunner& run) {
     addCommonOptions(sub, opt->common);
     sub->add_flag("--json", opt->common.json, "print gyrod's lines unchanged (one JSON object per line)");
     sub->add_option("--decimate", opt->decimate, "receive every N-th sample")
-        ->check(CLI::Range(std::uint32_t{1}, daemon::kMaxDecimate));
+        ->check(CLI::Range(std::uint32_t{1}, protocol::kMaxDecimate));
     sub->add_option("--count", opt->count, "stop after N RATE lines");
     sub->callback([&run, opt] { run = [opt] { return runWatch(*opt); }; });
   }

@@ -10,7 +10,6 @@
 #include <cstdio>
 #include <cstring>
 
-#include "daemon/protocol.hpp"
 
 namespace gyrod::gyroctl {
 namespace {
@@ -47,11 +46,18 @@ std::string socketGroupName(const std::string& path) {
 
 }  // namespace
 
-nlohmann::json parseServerLine(const std::string& line) {
-  nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
-  if (j.is_discarded() || !j.is_object() || !j.contains("class") || !j["class"].is_string())
-    throw DaemonConnectionError("gyrod sent a line that is not a protocol object: " + line.substr(0, 200));
-  return j;
+protocol::ServerMessage parseServerLine(const std::string& line) {
+  try {
+    return protocol::parseServerLine(line);
+  } catch (const protocol::MalformedLine& e) {
+    throw DaemonConnectionError("gyrod sent a line that is not a protocol object (" + std::string(e.what()) +
+                                "): " + line.substr(0, 200));
+  }
+}
+
+void throwIfError(const protocol::ServerMessage& message) {
+  if (const auto* error = std::get_if<protocol::ErrorReply>(&message))
+    throw DaemonConnectionError("gyrod: " + error->message.value_or("error"));
 }
 
 DaemonConnection DaemonConnection::open(const std::string& path, std::chrono::milliseconds timeout) {
@@ -60,20 +66,21 @@ DaemonConnection DaemonConnection::open(const std::string& path, std::chrono::mi
   if (path.empty() || path.size() >= sizeof addr.sun_path)
     throw DaemonConnectionError("'" + path + "' cannot be a Unix socket path (1.." + std::to_string(sizeof addr.sun_path - 1) + " bytes)");
   std::memcpy(addr.sun_path, path.data(), path.size());
-  daemon::Fd fd(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0));
+  protocol::Fd fd(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0));
   if (!fd) throw DaemonConnectionError(std::string("socket(AF_UNIX): ") + std::strerror(errno));
   if (::connect(fd.get(), reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0) throwConnectError(path, errno);
   DaemonConnection c(std::move(fd), path);
   c.version_line_ = c.readLine(timeout);
-  c.version_ = parseServerLine(c.version_line_);
-  if (c.version_["class"] == "ERROR")
-    throw DaemonConnectionError("gyrod: " + c.version_.value("message", std::string("refused the connection")));
-  if (c.version_["class"] != "VERSION")
-    throw DaemonConnectionError("gyrod did not start with a VERSION line: " + c.version_line_);
-  const int major = c.version_.value("proto_major", -1);
-  if (major != daemon::kProtocolMajor)
+  const protocol::ServerMessage first = parseServerLine(c.version_line_);
+  if (const auto* error = std::get_if<protocol::ErrorReply>(&first))
+    throw DaemonConnectionError("gyrod: " + error->message.value_or("refused the connection"));
+  const auto* version = std::get_if<protocol::VersionReply>(&first);
+  if (version == nullptr) throw DaemonConnectionError("gyrod did not start with a VERSION line: " + c.version_line_);
+  c.version_ = *version;
+  const std::int64_t major = c.version_.proto_major.value_or(-1);
+  if (major != protocol::kProtocolMajor)
     throw DaemonConnectionError("gyrod speaks protocol " + std::to_string(major) + ".x; this gyroctl speaks " +
-                                std::to_string(daemon::kProtocolMajor) + ".x (update gyroctl or gyrod)");
+                                std::to_string(protocol::kProtocolMajor) + ".x (update gyroctl or gyrod)");
   return c;
 }
 
@@ -120,19 +127,6 @@ std::string DaemonConnection::readLine(std::optional<std::chrono::milliseconds> 
     if (n < 0) throw DaemonConnectionError(path_ + ": reading from gyrod failed: " + std::strerror(errno));
     if (n == 0) throw DaemonConnectionError("gyrod closed the connection");
     pending_.append(buf, static_cast<std::size_t>(n));
-  }
-}
-
-nlohmann::json DaemonConnection::readObjectOfClass(std::string_view wanted, std::chrono::milliseconds timeout, std::string* raw_line) {
-  while (true) {
-    std::string line = readLine(timeout);
-    nlohmann::json j = parseServerLine(line);
-    const std::string& cls = j["class"].get_ref<const std::string&>();
-    if (cls == "ERROR") throw DaemonConnectionError("gyrod: " + j.value("message", std::string("error")));
-    if (cls == wanted) {
-      if (raw_line) *raw_line = std::move(line);
-      return j;
-    }
   }
 }
 

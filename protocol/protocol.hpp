@@ -3,7 +3,8 @@
 // gpsd style: server → client one JSON object per line, each with a "class"; fields that
 // have no value are omitted, never null. Client → server one JSON object per line with a
 // "cmd". This header is the single place where the wire format is written down in code:
-// the server formats with it, gyroctl and the tests read what it writes.
+// the server formats with it, gyroctl parses with it (parseServerLine), and the tests read
+// what it writes.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -17,7 +18,7 @@
 
 #include "processing/noise_terms.hpp"
 
-namespace gyrod::daemon {
+namespace gyrod::protocol {
 
 inline constexpr int kProtocolMajor = 1;  // incompatible changes
 inline constexpr int kProtocolMinor = 0;  // compatible additions (new classes, new fields)
@@ -102,6 +103,13 @@ struct AllanReport {
 // which some computed curve is not finite is left out of every list (no nulls).
 std::string allanLine(const AllanReport& report);
 
+// One of the driver's counters, by the name STATUS publishes it under.
+struct NamedCount {
+  std::string name;  // a token, e.g. "fifo_overflows" (docs/protocol.md lists them)
+  std::uint64_t value = 0;
+  bool operator==(const NamedCount&) const = default;
+};
+
 // What the daemon knows about itself (STATUS); empty optionals are omitted.
 struct StatusReport {
   double uptime_s = 0.0;              // since the daemon started [s]
@@ -111,6 +119,9 @@ struct StatusReport {
   std::uint64_t bus_errors = 0;       // failed bus transfers
   std::uint64_t resets = 0;           // device resets (FIFO overflow, silent reset, errors)
   std::string device_state;           // e.g. "streaming" (docs/protocol.md lists them)
+  std::string device_reason;          // why the device is in that state; empty (omitted) while all is well
+  std::optional<bool> device_retrying;  // whether the driver keeps trying to reach the device
+  std::vector<NamedCount> device_counters;  // every counter of the driver, in its order ("counters")
   std::optional<std::string> device;  // e.g. "/dev/i2c-1@0x68"
   std::optional<double> rate_hz;          // measured sample rate [Hz]
   std::optional<double> nominal_rate_hz;  // configured sample rate [Hz]
@@ -140,6 +151,58 @@ struct ServerStatus {
 };
 std::string statusLine(const StatusReport& daemon, const ServerStatus& server);
 
+// ---- server → client, read by a client ---------------------------------------------------
+// The parse functions read what the functions above write (format → parse gives back the
+// same values). A field the formatter leaves out comes back as NaN (numbers), empty
+// (strings, lists) or an empty optional; fields and classes this version does not know are
+// ignored, as docs/protocol.md asks of clients.
+
+// A server line that is not what this protocol says (not JSON, no "class", a wrong type).
+class MalformedLine : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct VersionReply {
+  std::string release;
+  std::optional<std::int64_t> proto_major, proto_minor;
+};
+struct WatchReply {
+  bool enable = true;
+  std::uint32_t decimate = 1;
+};
+// GapEvent owning its reason.
+struct GapNotice {
+  std::uint64_t first_missing_seq = 0;
+  std::uint64_t count = 0;
+  std::string reason;
+};
+struct ErrorReply {
+  std::string code;
+  std::optional<std::string> message;
+};
+// A STATUS field this version does not know (from a newer gyrod), kept for display.
+struct OtherField {
+  std::string key;
+  std::optional<std::string> text;  // when the value is a JSON string
+  std::optional<double> real;       // when it is a number with a fraction or exponent
+  std::string json;                 // the value as JSON text
+};
+struct StatusReply {
+  StatusReport daemon;
+  ServerStatus server;
+  std::vector<OtherField> other_fields;  // in the order of the line
+};
+// A line of a class this version does not know.
+struct OtherClass {
+  std::string name;
+};
+using ServerMessage =
+    std::variant<VersionReply, WatchReply, RateSample, GapNotice, AllanReport, StatusReply, ErrorReply, OtherClass>;
+
+// Parses one server line (without its '\n'). Throws MalformedLine.
+ServerMessage parseServerLine(std::string_view line);
+
 // ---- client → server ------------------------------------------------------------------
 
 struct WatchRequest {
@@ -160,7 +223,10 @@ class ProtocolError : public std::invalid_argument {
   ErrorCode code_;
 };
 
+// The request as one line, without its '\n' (parseRequest reads it back).
+std::string requestLine(const Request& request);
+
 // Parses one line (without its '\n'). Throws ProtocolError saying what is wrong.
 Request parseRequest(std::string_view line);
 
-}  // namespace gyrod::daemon
+}  // namespace gyrod::protocol

@@ -1,6 +1,7 @@
 #pragma once
 // An owned file descriptor: closed exactly once, when its owner goes away. Every fd the
-// daemon opens (epoll, timerfd, signalfd, sockets, clients) lives in one of these.
+// daemon, the driver and gyroctl open (epoll, timers, sockets, clients, the I2C bus) lives
+// in one of these. Header-only and free of the protocol's JSON: target gyrod_fd.
 #include <unistd.h>
 
 #include <cerrno>
@@ -8,7 +9,7 @@
 #include <system_error>
 #include <utility>
 
-namespace gyrod::daemon {
+namespace gyrod::protocol {
 
 class Fd {
  public:
@@ -46,4 +47,4 @@ inline std::system_error errnoError(const std::string& what) {
   return std::system_error(errno, std::generic_category(), what);
 }
 
-}  // namespace gyrod::daemon
+}  // namespace gyrod::protocol

@@ -1,11 +1,11 @@
-#include "daemon/protocol.hpp"
+#include "protocol/protocol.hpp"
 
 #include <charconv>
 #include <cmath>
 #include <cstring>
 #include <nlohmann/json.hpp>
 
-namespace gyrod::daemon {
+namespace gyrod::protocol {
 namespace {
 
 // Insertion-ordered, so that "class" comes first in every line, as in gpsd.
@@ -205,12 +205,19 @@ std::string statusLine(const StatusReport& d, const ServerStatus& s) {
             {"resets", d.resets},
             {"device_state", d.device_state}};
   if (!std::isfinite(d.uptime_s)) j.erase("uptime");
+  if (!d.device_reason.empty()) j["device_reason"] = d.device_reason;
+  if (d.device_retrying) j["device_retrying"] = *d.device_retrying;
   if (d.device) j["device"] = *d.device;
   putIfFinite(j, "rate", d.rate_hz);
   putIfFinite(j, "nominal_rate", d.nominal_rate_hz);
   putIfFinite(j, "temp", d.temp_c);
   if (d.bias_source) j["bias_source"] = *d.bias_source;
   if (d.recording) j["recording"] = *d.recording;
+  if (!d.device_counters.empty()) {
+    json counters = json::object();
+    for (const NamedCount& c : d.device_counters) counters[c.name] = c.value;
+    j["counters"] = std::move(counters);
+  }
   j["clients"] = s.clients;
   j["clients_total"] = s.clients_total;
   j["clients_dropped"] = s.clients_dropped;
@@ -231,6 +238,13 @@ std::string statusLine(const StatusReport& d, const ServerStatus& s) {
   }
   j["client_list"] = std::move(list);
   return json(j).dump(-1, ' ', false, json::error_handler_t::replace) + '\n';
+}
+
+std::string requestLine(const Request& request) {
+  if (const auto* w = std::get_if<WatchRequest>(&request))
+    return json({{"cmd", "watch"}, {"enable", w->enable}, {"decimate", w->decimate}}).dump();
+  if (std::holds_alternative<AllanRequest>(request)) return R"({"cmd":"allan"})";
+  return R"({"cmd":"status"})";
 }
 
 Request parseRequest(std::string_view line) {
@@ -282,4 +296,4 @@ Request parseRequest(std::string_view line) {
   throw ProtocolError(ErrorCode::UnknownCommand, "unknown cmd \"" + cmd + "\" (known: watch, allan, status)");
 }
 
-}  // namespace gyrod::daemon
+}  // namespace gyrod::protocol

@@ -8,9 +8,9 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "daemon/protocol.hpp"
+#include "protocol/protocol.hpp"
 
-using namespace gyrod::daemon;
+using namespace gyrod::protocol;
 using nlohmann::json;
 
 namespace {

@@ -1,0 +1,225 @@
+// Reading the server's lines: the inverse of the formatters in protocol.cpp.
+#include <cmath>
+#include <limits>
+#include <nlohmann/json.hpp>
+
+#include "protocol/protocol.hpp"
+
+namespace gyrod::protocol {
+namespace {
+
+// Insertion-ordered, so that a client sees fields (counters, unknown fields) in line order.
+using json = nlohmann::ordered_json;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+[[noreturn]] void malformed(std::string_view cls, const std::string& what) {
+  throw MalformedLine(std::string(cls) + " line: " + what);
+}
+
+// A field of the expected JSON type, or nullptr when absent; MalformedLine when mistyped.
+const json* field(const json& j, std::string_view cls, const char* key, bool (json::*is_type)() const noexcept,
+                  const char* type_name) {
+  const auto it = j.find(key);
+  if (it == j.end()) return nullptr;
+  if (!((*it).*is_type)()) malformed(cls, std::string("\"") + key + "\" must be " + type_name + ", got " + it->dump());
+  return &*it;
+}
+
+const json& required(const json* value, std::string_view cls, const char* key) {
+  if (value == nullptr) malformed(cls, std::string("no \"") + key + "\" field");
+  return *value;
+}
+
+double realOr(const json& j, std::string_view cls, const char* key, double absent) {
+  const json* v = field(j, cls, key, &json::is_number, "a number");
+  return v ? v->get<double>() : absent;
+}
+
+std::optional<double> optionalReal(const json& j, std::string_view cls, const char* key) {
+  const json* v = field(j, cls, key, &json::is_number, "a number");
+  return v ? std::optional<double>(v->get<double>()) : std::nullopt;
+}
+
+std::uint64_t count(const json& j, std::string_view cls, const char* key) {
+  return required(field(j, cls, key, &json::is_number_unsigned, "an integer >= 0"), cls, key).get<std::uint64_t>();
+}
+
+std::optional<std::int64_t> optionalInteger(const json& j, std::string_view cls, const char* key) {
+  const json* v = field(j, cls, key, &json::is_number_integer, "an integer");
+  return v ? std::optional<std::int64_t>(v->get<std::int64_t>()) : std::nullopt;
+}
+
+std::optional<std::string> optionalText(const json& j, std::string_view cls, const char* key) {
+  const json* v = field(j, cls, key, &json::is_string, "a string");
+  return v ? std::optional<std::string>(v->get<std::string>()) : std::nullopt;
+}
+
+std::optional<bool> optionalFlag(const json& j, std::string_view cls, const char* key) {
+  const json* v = field(j, cls, key, &json::is_boolean, "true or false");
+  return v ? std::optional<bool>(v->get<bool>()) : std::nullopt;
+}
+
+std::array<double, 3> triple(const json& j, const char* key) {
+  const json* v = field(j, "RATE", key, &json::is_array, "[x, y, z]");
+  if (v == nullptr) return {kNaN, kNaN, kNaN};
+  if (v->size() != 3) malformed("RATE", std::string("\"") + key + "\" must have 3 elements");
+  std::array<double, 3> out{};
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (!(*v)[i].is_number()) malformed("RATE", std::string("\"") + key + "\" must hold numbers");
+    out[i] = (*v)[i].get<double>();
+  }
+  return out;
+}
+
+RateSample rateOf(const json& j) {
+  RateSample r;
+  r.seq = count(j, "RATE", "seq");
+  r.t_s = realOr(j, "RATE", "t", kNaN);
+  r.temp_c = realOr(j, "RATE", "temp", kNaN);
+  r.raw_dps = triple(j, "raw");
+  r.mean_dps = triple(j, "mean");
+  r.kalman_dps = triple(j, "kalman");
+  return r;
+}
+
+std::vector<double> reals(const json& list, std::string_view what) {
+  std::vector<double> out;
+  for (const auto& v : list) {
+    if (!v.is_number()) malformed("ALLAN", std::string(what) + " must hold numbers");
+    out.push_back(v.get<double>());
+  }
+  return out;
+}
+
+// An object member of the expected key that is itself an object, or nullptr.
+const json* member(const json* object, std::string_view key) {
+  if (object == nullptr) return nullptr;
+  const auto it = object->find(std::string(key));
+  return it != object->end() && it->is_object() ? &*it : nullptr;
+}
+
+AllanReport allanOf(const json& j) {
+  AllanReport r;
+  r.samples = count(j, "ALLAN", "samples");
+  r.window_s = realOr(j, "ALLAN", "window", kNaN);
+  r.tau0_s = realOr(j, "ALLAN", "tau0", kNaN);
+  if (const json* tau = field(j, "ALLAN", "tau", &json::is_array, "a list")) r.tau_s = reals(*tau, "\"tau\"");
+  const json* adev = field(j, "ALLAN", "adev", &json::is_object, "an object");
+  const json* noise = field(j, "ALLAN", "noise", &json::is_object, "an object");
+  for (std::size_t a = 0; a < kAxisNames.size(); ++a) {
+    for (std::size_t s = 0; s < kStreamNames.size(); ++s) {
+      AllanCurve& curve = r.curves[a][s];
+      const std::string name = std::string(kAxisNames[a]) + "/" + std::string(kStreamNames[s]);
+      if (const json* axis = member(adev, kAxisNames[a])) {
+        if (const auto it = axis->find(std::string(kStreamNames[s])); it != axis->end()) {
+          if (!it->is_array() || it->size() != r.tau_s.size())
+            malformed("ALLAN", "curve " + name + " does not match its tau list");
+          curve.adev_dps = reals(*it, "curve " + name);
+        }
+      }
+      if (const json* terms = member(member(noise, kAxisNames[a]), kStreamNames[s])) {
+        processing::NoiseTerms fitted;
+        for (const auto t : processing::kAllNoiseTerms) {
+          const auto it = terms->find(std::string(processing::noiseTermKey(t)));
+          fitted.set(t, it != terms->end() && it->is_number() ? it->get<double>() : kNaN);
+        }
+        curve.noise = fitted;
+      }
+    }
+  }
+  return r;
+}
+
+ClientStatus clientOf(const json& c) {
+  if (!c.is_object()) malformed("STATUS", "a \"client_list\" entry must be an object");
+  ClientStatus s;
+  s.id = count(c, "STATUS", "id");
+  s.pid = optionalInteger(c, "STATUS", "pid");
+  s.uid = optionalInteger(c, "STATUS", "uid");
+  s.watch = optionalFlag(c, "STATUS", "watch").value_or(false);
+  s.decimate = static_cast<std::uint32_t>(count(c, "STATUS", "decimate"));
+  s.lines_queued = count(c, "STATUS", "lines_queued");
+  s.lines_sent = count(c, "STATUS", "lines_sent");
+  s.buffered_bytes = count(c, "STATUS", "buffered");
+  s.self = optionalFlag(c, "STATUS", "self").value_or(false);
+  return s;
+}
+
+// The STATUS fields this version reads; any other is kept as an OtherField.
+constexpr std::string_view kStatusFields[] = {
+    "class",         "uptime",        "samples",         "gaps",    "missing",       "bus_errors",      "resets",
+    "device_state",  "device_reason", "device_retrying", "device",  "rate",          "nominal_rate",    "temp",
+    "bias_source",   "recording",     "counters",        "clients", "clients_total", "clients_dropped", "lines_dropped",
+    "client_buffer", "client_list"};
+
+StatusReply statusOf(const json& j) {
+  constexpr std::string_view cls = "STATUS";
+  StatusReply r;
+  StatusReport& d = r.daemon;
+  d.uptime_s = realOr(j, cls, "uptime", kNaN);
+  d.samples = count(j, cls, "samples");
+  d.gaps = count(j, cls, "gaps");
+  d.missing_samples = count(j, cls, "missing");
+  d.bus_errors = count(j, cls, "bus_errors");
+  d.resets = count(j, cls, "resets");
+  d.device_state = required(field(j, cls, "device_state", &json::is_string, "a string"), cls, "device_state");
+  d.device_reason = optionalText(j, cls, "device_reason").value_or("");
+  d.device_retrying = optionalFlag(j, cls, "device_retrying");
+  d.device = optionalText(j, cls, "device");
+  d.rate_hz = optionalReal(j, cls, "rate");
+  d.nominal_rate_hz = optionalReal(j, cls, "nominal_rate");
+  d.temp_c = optionalReal(j, cls, "temp");
+  d.bias_source = optionalText(j, cls, "bias_source");
+  d.recording = optionalText(j, cls, "recording");
+  if (const json* counters = field(j, cls, "counters", &json::is_object, "an object")) {
+    for (auto it = counters->begin(); it != counters->end(); ++it) {
+      if (!it->is_number_unsigned()) malformed(cls, "counter \"" + it.key() + "\" must be an integer >= 0");
+      d.device_counters.push_back({it.key(), it->get<std::uint64_t>()});
+    }
+  }
+  ServerStatus& s = r.server;
+  s.clients = count(j, cls, "clients");
+  s.clients_total = count(j, cls, "clients_total");
+  s.clients_dropped = count(j, cls, "clients_dropped");
+  s.lines_dropped = count(j, cls, "lines_dropped");
+  s.client_buffer_bytes = count(j, cls, "client_buffer");
+  if (const json* list = field(j, cls, "client_list", &json::is_array, "a list"))
+    for (const auto& c : *list) s.client_list.push_back(clientOf(c));
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    bool known = false;
+    for (const auto k : kStatusFields) known = known || it.key() == k;
+    if (known) continue;
+    OtherField f{it.key(), std::nullopt, std::nullopt, it->dump()};
+    if (it->is_string()) f.text = it->get<std::string>();
+    if (it->is_number_float()) f.real = it->get<double>();
+    r.other_fields.push_back(std::move(f));
+  }
+  return r;
+}
+
+}  // namespace
+
+ServerMessage parseServerLine(std::string_view line) {
+  const json j = json::parse(line.begin(), line.end(), nullptr, /*allow_exceptions=*/false);
+  if (j.is_discarded() || !j.is_object() || !j.contains("class") || !j["class"].is_string())
+    throw MalformedLine("not a protocol object (a JSON object with a string \"class\")");
+  const std::string& cls = j["class"].get_ref<const std::string&>();
+  if (cls == "RATE") return rateOf(j);
+  if (cls == "GAP") {
+    const json& reason = required(field(j, cls, "reason", &json::is_string, "a string"), cls, "reason");
+    return GapNotice{count(j, cls, "seq"), count(j, cls, "count"), reason.get<std::string>()};
+  }
+  if (cls == "VERSION")
+    return VersionReply{optionalText(j, cls, "release").value_or(""), optionalInteger(j, cls, "proto_major"),
+                        optionalInteger(j, cls, "proto_minor")};
+  if (cls == "WATCH")
+    return WatchReply{optionalFlag(j, cls, "enable").value_or(false),
+                      static_cast<std::uint32_t>(count(j, cls, "decimate"))};
+  if (cls == "ERROR") return ErrorReply{optionalText(j, cls, "code").value_or(""), optionalText(j, cls, "message")};
+  if (cls == "ALLAN") return allanOf(j);
+  if (cls == "STATUS") return statusOf(j);
+  return OtherClass{cls};
+}
+
+}  // namespace gyrod::protocol
