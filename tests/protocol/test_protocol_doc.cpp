@@ -120,12 +120,6 @@ TEST(ProtocolDoc, DeviceStatesAreTheDriverStates) {
 
 TEST(ProtocolDoc, GapReasonsAreTheDriverCauses) {
   const auto documented = firstColumnNames(section(readDoc(), "#### Gap reasons"));
-  // The socket's tokens use '_' where the driver's log names may use '-' (until the two share
-  // one table).
-  auto causes = enumNames<driver::GapCause>([](auto c) {
-    std::string name = driver::gapCauseName(c);
-    std::replace(name.begin(), name.end(), '-', '_');
-    return name;
-  });
+  const auto causes = enumNames<driver::GapCause>([](auto c) { return std::string(driver::gapCauseName(c)); });
   EXPECT_EQ(documented, causes);
 }
