@@ -14,7 +14,7 @@
 #include <sstream>
 #include <system_error>
 
-#include "tools/recording/model_toml.hpp"
+#include "formats/model_toml.hpp"
 
 namespace gyrod::daemon {
 namespace {

@@ -4,7 +4,7 @@
 #include <iostream>
 
 #include "tools/gyroctl/commands.hpp"
-#include "tools/recording/recording_csv.hpp"
+#include "formats/recording_csv.hpp"
 
 int main(int argc, char** argv) {
   using namespace gyrod::gyroctl;

@@ -11,7 +11,7 @@
 
 #include "processing/noise_simulator.hpp"
 #include "tools/gyroctl/commands.hpp"
-#include "tools/recording/model_toml.hpp"
+#include "formats/model_toml.hpp"
 
 namespace gyrod::gyroctl {
 namespace {
