@@ -42,7 +42,9 @@ GyrodCommandLine parseGyrodCommandLine(int argc, const char* const* argv, const 
   std::string config_file, backend, socket_path, record_path, log_level;
   double mock_speed = 0.0;
   app.add_option("--config", config_file, "Configuration file (default: " + default_config_path + " if it exists)");
-  const auto strings = [](const std::vector<std::string_view>& v) { return std::vector<std::string>(v.begin(), v.end()); };
+  const auto strings = [](const std::vector<std::string_view>& v) {
+    return std::vector<std::string>(v.begin(), v.end());
+  };
   app.add_option("--backend", backend, "Device backend")->check(CLI::IsMember(strings(kBackendNames)));
   app.add_option("--socket", socket_path, "Unix socket path (socket.path)");
   app.add_option("--record", record_path, "Record raw samples to this file (record.path); \"\" = off");

@@ -31,7 +31,8 @@ class ModelReader {
   [[noreturn]] void fail(const toml::source_region& where, const std::string& cause) const { doc_.fail(where, cause); }
 
   double number(const toml::node& node, const toml::key& key, const std::string& where) const {
-    if (!node.is_number()) fail(key.source(), where + std::string(key.str()) + " must be a number, got " + tomlTypeName(node));
+    if (!node.is_number())
+      fail(key.source(), where + std::string(key.str()) + " must be a number, got " + tomlTypeName(node));
     const double v = *node.value<double>();
     if (!std::isfinite(v)) fail(key.source(), where + std::string(key.str()) + " must be finite, got " + formatNumber(v));
     return v;
@@ -47,7 +48,8 @@ class ModelReader {
     return v;
   }
   int integerIn(const toml::node& node, const toml::key& key, int lo, int hi) const {
-    if (!node.is_integer()) fail(key.source(), std::string(key.str()) + " must be an integer, got " + tomlTypeName(node));
+    if (!node.is_integer())
+      fail(key.source(), std::string(key.str()) + " must be an integer, got " + tomlTypeName(node));
     const std::int64_t v = *node.value<std::int64_t>();
     if (v < lo || v > hi)
       fail(key.source(), std::string(key.str()) + " must be " + std::to_string(lo) + ".." + std::to_string(hi) +
@@ -55,7 +57,9 @@ class ModelReader {
     return static_cast<int>(v);
   }
   const toml::table& table(const toml::node& node, const toml::key& key) const {
-    if (!node.is_table()) fail(key.source(), std::string(key.str()) + " must be a table ([" + std::string(key.str()) + "]), got " + tomlTypeName(node));
+    if (!node.is_table())
+      fail(key.source(), std::string(key.str()) + " must be a table ([" + std::string(key.str()) + "]), got " +
+                             tomlTypeName(node));
     return *node.as_table();
   }
 
@@ -143,9 +147,11 @@ class ModelReader {
       else if (k == "outlier_amplitude_dps") e.outlier_amplitude_dps = nonNegative(node, key, where);
       else if (k == "outlier_count") e.outlier_count = static_cast<std::size_t>(integerIn(node, key, 0, 1000000000));
       else if (k == "sinusoids" || k == "bias_steps") {
-        if (!node.is_array()) fail(key.source(), where + k + " must be an array of inline tables, got " + tomlTypeName(node));
+        if (!node.is_array())
+          fail(key.source(), where + k + " must be an array of inline tables, got " + tomlTypeName(node));
         for (const toml::node& element : *node.as_array()) {
-          if (!element.is_table()) fail(key.source(), where + k + " must contain inline tables only, found " + tomlTypeName(element));
+          if (!element.is_table())
+            fail(key.source(), where + k + " must contain inline tables only, found " + tomlTypeName(element));
           if (k == "sinusoids") {
             processing::SinusoidEffect sin;
             for (auto&& [ek, ev] : *element.as_table()) {
@@ -191,7 +197,8 @@ class ModelReader {
         if (!node.is_array()) fail(key.source(), where + "phi must be an array of numbers, got " + tomlTypeName(node));
         ar.phi.clear();
         for (const toml::node& element : *node.as_array()) {
-          if (!element.is_number()) fail(key.source(), where + "phi must contain numbers only, found " + tomlTypeName(element));
+          if (!element.is_number())
+            fail(key.source(), where + "phi must contain numbers only, found " + tomlTypeName(element));
           ar.phi.push_back(*element.value<double>());
         }
       } else if (k == "noise_var") {

@@ -174,7 +174,8 @@ std::optional<bool> TomlSection::boolean(std::string_view key) const {
   failType(*n, key, "must be true or false");
 }
 
-std::optional<std::size_t> TomlSection::choice(std::string_view key, const std::vector<std::string_view>& choices) const {
+std::optional<std::size_t> TomlSection::choice(std::string_view key,
+                                               const std::vector<std::string_view>& choices) const {
   const auto s = string(key);
   if (!s) return std::nullopt;
   const auto it = std::find(choices.begin(), choices.end(), *s);

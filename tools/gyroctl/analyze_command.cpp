@@ -8,11 +8,11 @@
 #include <stdexcept>
 #include <string>
 
+#include "formats/model_toml.hpp"
 #include "processing/axis_analysis.hpp"
 #include "processing/noise_terms.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
-#include "formats/model_toml.hpp"
 
 namespace gyrod::gyroctl {
 namespace {

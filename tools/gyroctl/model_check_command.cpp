@@ -22,12 +22,12 @@
 #include <string>
 #include <vector>
 
+#include "formats/model_toml.hpp"
 #include "processing/model_check.hpp"
 #include "processing/warm_up_fit.hpp"
 #include "processing/noise_terms.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
-#include "formats/model_toml.hpp"
 
 namespace gyrod::gyroctl {
 namespace {
