@@ -1,223 +1,27 @@
 #include "daemon/config.hpp"
 
-#include <CLI/CLI.hpp>
-#include <toml++/toml.h>
-
 #include <algorithm>
-#include <array>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <limits>
 #include <sstream>
 
 #include "driver/mpu6050_config.hpp"
-
-
-#ifndef GYROD_VERSION
-#define GYROD_VERSION "unknown"
-#endif
+#include "formats/toml_document.hpp"
 
 namespace gyrod::daemon {
 namespace {
 
-std::string shortest(double v) {
-  std::array<char, 32> buf{};
-  const auto [end, ec] = std::to_chars(buf.data(), buf.data() + buf.size(), v);
-  (void)ec;  // 32 characters always hold the shortest round-trip form of a double
-  return std::string(buf.data(), end);
-}
-
-std::string joined(const std::vector<std::string_view>& names, std::string_view separator = ", ") {
-  std::string s;
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    if (i) s += separator;
-    s += names[i];
-  }
-  return s;
-}
-
-// Levenshtein distance, for "did you mean" on a misspelt key.
-std::size_t editDistance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t above = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = above;
-    }
-  }
-  return row[b.size()];
-}
-
-std::string suggestion(std::string_view typo, const std::vector<std::string_view>& valid) {
-  std::string_view best;
-  std::size_t best_distance = std::numeric_limits<std::size_t>::max();
-  for (auto v : valid) {
-    const auto d = editDistance(typo, v);
-    if (d < best_distance) best_distance = d, best = v;
-  }
-  // Only close matches: at most 2 edits, and fewer than half the letters.
-  if (best_distance <= 2 && best_distance * 2 <= std::max(typo.size(), best.size()))
-    return "; did you mean '" + std::string(best) + "'?";
-  return {};
-}
-
-// A value as the user wrote it, for "(got ...)".
-std::string rendered(const toml::node& n) {
-  if (auto s = n.as_string()) return "\"" + s->get() + "\"";
-  if (auto i = n.as_integer()) return std::to_string(i->get());
-  if (auto f = n.as_floating_point()) return shortest(f->get());
-  if (auto b = n.as_boolean()) return b->get() ? "true" : "false";
-  if (n.is_array()) return "an array";
-  if (n.is_table()) return "a table";
-  return "a date/time";
-}
-
-std::string typeAndValue(const toml::node& n) {
-  if (n.is_string()) return "string " + rendered(n);
-  if (n.is_integer()) return "integer " + rendered(n);
-  if (n.is_floating_point()) return "float " + rendered(n);
-  if (n.is_boolean()) return "boolean " + rendered(n);
-  return rendered(n);
-}
-
-// One table of the file with the keys it may hold. Knows the file and its own dotted
-// name so that every message can say FILE:LINE: key 'section.key': ...
-class Section {
- public:
-  Section(const std::string& file, const toml::table& table, std::string name, std::vector<std::string_view> keys)
-      : file_(file), table_(table), name_(std::move(name)), keys_(std::move(keys)) {
-    for (auto&& [key, node] : table_) {
-      (void)node;
-      if (std::find(keys_.begin(), keys_.end(), key.str()) != keys_.end()) continue;
-      std::ostringstream s;
-      s << location(key.source()) << "unknown key '" << key.str() << "' in [" << name_ << "] (valid keys: "
-        << joined(keys_) << ")" << suggestion(key.str(), keys_);
-      throw ConfigError(s.str());
-    }
-  }
-
-  const std::string& file() const { return file_; }
-  const std::string& name() const { return name_; }
-  std::string qualified(std::string_view key) const { return name_ + "." + std::string(key); }
-  const toml::node* node(std::string_view key) const { return table_.get(key); }
-  bool has(std::string_view key) const { return node(key) != nullptr; }
-
-  std::string location(const toml::source_region& r) const {
-    return r.begin.line > 0 ? file_ + ":" + std::to_string(r.begin.line) + ": " : file_ + ": ";
-  }
-  [[noreturn]] void fail(const toml::node& n, std::string_view key, const std::string& requirement,
-                         const std::string& got) const {
-    throw ConfigError(location(n.source()) + "key '" + qualified(key) + "': " + requirement + " (got " + got + ")");
-  }
-  [[noreturn]] void failValue(std::string_view key, const std::string& requirement) const {
-    const auto& n = *node(key);
-    fail(n, key, requirement, rendered(n));
-  }
-  [[noreturn]] void failType(const toml::node& n, std::string_view key, const std::string& requirement) const {
-    fail(n, key, requirement, typeAndValue(n));
-  }
-
-  // A finite number (integers are accepted where a number is asked for).
-  std::optional<double> number(std::string_view key) const {
-    const auto* n = node(key);
-    if (!n) return std::nullopt;
-    return numberFrom(*n, key);
-  }
-  double numberFrom(const toml::node& n, std::string_view key) const {
-    double v = 0.0;
-    if (auto i = n.as_integer()) v = static_cast<double>(i->get());
-    else if (auto f = n.as_floating_point()) v = f->get();
-    else failType(n, key, "must be a number");
-    if (!std::isfinite(v)) fail(n, key, "must be a finite number", rendered(n));
-    return v;
-  }
-  std::optional<std::int64_t> integer(std::string_view key) const {
-    const auto* n = node(key);
-    if (!n) return std::nullopt;
-    if (auto i = n->as_integer()) return i->get();
-    failType(*n, key, "must be an integer");
-  }
-  std::optional<std::string> string(std::string_view key) const {
-    const auto* n = node(key);
-    if (!n) return std::nullopt;
-    if (auto s = n->as_string()) return s->get();
-    failType(*n, key, "must be a string");
-  }
-  std::optional<bool> boolean(std::string_view key) const {
-    const auto* n = node(key);
-    if (!n) return std::nullopt;
-    if (auto b = n->as_boolean()) return b->get();
-    failType(*n, key, "must be true or false");
-  }
-  // One of `choices`, returned as its index.
-  std::optional<std::size_t> choice(std::string_view key, const std::vector<std::string_view>& choices) const {
-    const auto s = string(key);
-    if (!s) return std::nullopt;
-    const auto it = std::find(choices.begin(), choices.end(), *s);
-    if (it == choices.end()) failValue(key, "must be one of " + joined(choices, ", "));
-    return static_cast<std::size_t>(it - choices.begin());
-  }
-  // A number, or an array of numbers, each checked by `ok`.
-  template <class Ok>
-  std::optional<std::vector<double>> numbers(std::string_view key, Ok ok, const std::string& requirement) const {
-    const auto* n = node(key);
-    if (!n) return std::nullopt;
-    std::vector<double> values;
-    if (auto a = n->as_array()) {
-      for (const auto& element : *a) {
-        if (!element.is_number()) failType(element, key, requirement);
-        values.push_back(numberFrom(element, key));
-        if (!ok(values.back())) fail(element, key, requirement, rendered(element));
-      }
-    } else {
-      if (!n->is_number()) failType(*n, key, requirement);
-      values.push_back(numberFrom(*n, key));
-      if (!ok(values.back())) failValue(key, requirement);
-    }
-    return values;
-  }
-  // A sub-table, or an array of sub-tables (e.g. several bursts), each with `keys`.
-  std::vector<Section> tables(std::string_view key, std::vector<std::string_view> keys) const {
-    std::vector<Section> out;
-    const auto* n = node(key);
-    if (!n) return out;
-    if (auto t = n->as_table()) {
-      out.emplace_back(file_, *t, qualified(key), keys);
-    } else if (auto a = n->as_array()) {
-      for (const auto& element : *a) {
-        if (!element.is_table()) failType(element, key, "must be a table { ... } or an array of them");
-        out.emplace_back(file_, *element.as_table(), qualified(key), keys);
-      }
-    } else {
-      failType(*n, key, "must be a table { ... } or an array of them");
-    }
-    return out;
-  }
-
- private:
-  const std::string& file_;
-  const toml::table& table_;
-  std::string name_;
-  std::vector<std::string_view> keys_;
-};
+using Section = formats::TomlSection;
+using formats::shortest;
 
 const std::vector<std::string_view> kSections = {"device", "gpio", "bias", "filter", "allan",
                                                  "socket", "record", "log", "mock"};
-const std::vector<std::string_view> kBackendNames = {"i2c", "mock"};
 const std::vector<std::string_view> kBiasSourceNames = {"estimate", "model", "config"};
 const std::vector<std::string_view> kMockSourceNames = {"simulator", "replay"};
-const std::vector<std::string_view> kLogLevelNames = {"trace", "debug", "info", "warn", "error", "critical", "off"};
-constexpr std::array<spdlog::level::level_enum, 7> kLogLevels = {
-    spdlog::level::trace, spdlog::level::debug, spdlog::level::info, spdlog::level::warn,
-    spdlog::level::err,   spdlog::level::critical, spdlog::level::off};
 
 bool isAllDigits(std::string_view s) {
   return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
@@ -291,7 +95,7 @@ void readBias(const Section& s, BiasConfig& b) {
     if (!a || a->size() != 3 ||
         !std::all_of(a->begin(), a->end(), [](const toml::node& e) { return e.is_number(); }))
       s.fail(*n, "values", "must be an array of 3 numbers [x, y, z] in °/s",
-             a ? "an array of " + std::to_string(a->size()) + " elements" : typeAndValue(*n));
+             a ? "an array of " + std::to_string(a->size()) + " elements" : formats::tomlTypeAndValue(*n));
     b.values.clear();
     for (const auto& e : *a) b.values.push_back(s.numberFrom(e, "values"));
   }
@@ -496,37 +300,30 @@ std::string i2cDevicePath(std::string_view bus) {
   throw ConfigError("I2C bus '" + std::string(bus) + "': must be a bus number ≥ 0 (1 → /dev/i2c-1) or a path starting with '/'");
 }
 
-GyrodConfig parseConfig(std::string_view toml_text, const std::string& source_name) {
-  toml::table root;
-  try {
-    root = toml::parse(toml_text, source_name);
-  } catch (const toml::parse_error& e) {
-    const auto& where = e.source().begin;
-    throw ConfigError(source_name + ":" + std::to_string(where.line) + ":" + std::to_string(where.column) + ": " +
-                      std::string(e.description()));
-  }
+namespace {
 
+GyrodConfig readConfig(const formats::TomlDocument& doc) {
+  const auto& root = doc.root();
   GyrodConfig config;
   // Unknown top-level names first, so that a misspelt section is reported as such.
   for (auto&& [key, node] : root) {
     const auto name = key.str();
-    const auto where = key.source().begin.line > 0 ? source_name + ":" + std::to_string(key.source().begin.line) + ": "
-                                                   : source_name + ": ";
+    const auto where = doc.location(key.source());
     if (std::find(kSections.begin(), kSections.end(), name) == kSections.end()) {
       if (node.is_table())
-        throw ConfigError(where + "unknown section [" + std::string(name) + "] (valid sections: " + joined(kSections) +
-                          ")" + suggestion(name, kSections));
+        throw ConfigError(where + "unknown section [" + std::string(name) + "] (valid sections: " +
+                          formats::joinedNames(kSections) + ")" + formats::didYouMean(name, kSections));
       throw ConfigError(where + "unknown key '" + std::string(name) + "' at top level (keys belong in a section: " +
-                        joined(kSections) + ")");
+                        formats::joinedNames(kSections) + ")");
     }
     if (!node.is_table())
       throw ConfigError(where + "key '" + std::string(name) + "': must be a section [" + std::string(name) + "] (got " +
-                        typeAndValue(node) + ")");
+                        formats::tomlTypeAndValue(node) + ")");
   }
   const toml::table empty;
   const auto section = [&](std::string_view name, std::vector<std::string_view> keys) {
     const auto* t = root.get_as<toml::table>(name);
-    return Section(source_name, t ? *t : empty, std::string(name), std::move(keys));
+    return Section(doc.file(), t ? *t : empty, std::string(name), std::move(keys));
   };
 
   // device first: allan checks τ against device.rate_hz.
@@ -546,6 +343,16 @@ GyrodConfig parseConfig(std::string_view toml_text, const std::string& source_na
   return config;
 }
 
+}  // namespace
+
+GyrodConfig parseConfig(std::string_view toml_text, const std::string& source_name) {
+  try {
+    return readConfig(formats::TomlDocument(toml_text, source_name, formats::SyntaxErrorColumn::Shown));
+  } catch (const formats::TomlError& e) {
+    throw ConfigError(e.what());
+  }
+}
+
 GyrodConfig loadConfigFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ConfigError(path + ": cannot open: " + std::strerror(errno));
@@ -553,75 +360,6 @@ GyrodConfig loadConfigFile(const std::string& path) {
   text << in.rdbuf();
   if (in.bad()) throw ConfigError(path + ": read error: " + std::strerror(errno));
   return parseConfig(text.str(), path);
-}
-
-void applyOverrides(GyrodConfig& config, const CommandLineOverrides& o) {
-  if (o.backend) config.device.backend = *o.backend;
-  if (o.socket_path) {
-    if (o.socket_path->empty() || o.socket_path->size() > 107)
-      throw ConfigError("--socket: must be a path of 1..107 bytes (got \"" + *o.socket_path + "\")");
-    config.socket.path = *o.socket_path;
-  }
-  if (o.record_path) {
-    if (!o.record_path->empty() && o.record_path->back() == '/')
-      throw ConfigError("--record: must name a file, not a directory (got \"" + *o.record_path + "\")");
-    config.record.path = *o.record_path;
-  }
-  if (o.mock_speed) {
-    if (!(*o.mock_speed > 0.0 && *o.mock_speed <= 1000.0))
-      throw ConfigError("--mock-speed: must be > 0 and ≤ 1000 (got " + shortest(*o.mock_speed) + ")");
-    config.mock.speed = *o.mock_speed;
-  }
-  if (o.log_level) config.log.level = *o.log_level;
-}
-
-GyrodCommandLine parseGyrodCommandLine(int argc, const char* const* argv, const std::string& default_config_path) {
-  CLI::App app{"gyrod: MPU-6050 gyroscope daemon (mean filter + Kalman, rolling Allan statistics)", "gyrod"};
-  std::string config_file, backend, socket_path, record_path, log_level;
-  double mock_speed = 0.0;
-  app.add_option("--config", config_file, "Configuration file (default: " + default_config_path + " if it exists)");
-  const auto strings = [](const std::vector<std::string_view>& v) { return std::vector<std::string>(v.begin(), v.end()); };
-  app.add_option("--backend", backend, "Device backend")->check(CLI::IsMember(strings(kBackendNames)));
-  app.add_option("--socket", socket_path, "Unix socket path (socket.path)");
-  app.add_option("--record", record_path, "Record raw samples to this file (record.path); \"\" = off");
-  app.add_option("--mock-speed", mock_speed, "Mock device speed, 1 = real time (mock.speed)");
-  app.add_option("--log-level", log_level, "Log level")->check(CLI::IsMember(strings(kLogLevelNames)));
-  app.set_version_flag("--version", std::string("gyrod ") + GYROD_VERSION);
-
-  GyrodCommandLine result;
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    std::ostringstream out, err;
-    result.exit_code = app.exit(e, out, err) == 0 ? 0 : kExitUsageError;
-    result.message = *result.exit_code == 0 ? out.str() : err.str();
-    return result;
-  }
-
-  if (app.count("--config")) {
-    result.config_file = config_file;
-  } else if (std::error_code ec; std::filesystem::exists(default_config_path, ec)) {
-    result.config_file = default_config_path;
-  }
-  if (!result.config_file.empty()) result.config = loadConfigFile(result.config_file);
-
-  CommandLineOverrides o;
-  if (app.count("--backend")) o.backend = backend == "mock" ? DeviceBackend::Mock : DeviceBackend::I2c;
-  if (app.count("--socket")) o.socket_path = socket_path;
-  if (app.count("--record")) o.record_path = record_path;
-  if (app.count("--mock-speed")) o.mock_speed = mock_speed;
-  if (app.count("--log-level")) {
-    const auto it = std::find(kLogLevelNames.begin(), kLogLevelNames.end(), log_level);
-    o.log_level = kLogLevels[static_cast<std::size_t>(it - kLogLevelNames.begin())];
-  }
-  try {
-    applyOverrides(result.config, o);
-  } catch (const ConfigError& e) {
-    // A flag's value is a usage problem, not the configuration file's.
-    result.exit_code = kExitUsageError;
-    result.message = std::string(e.what()) + "\n";
-  }
-  return result;
 }
 
 }  // namespace gyrod::daemon

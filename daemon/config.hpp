@@ -1,10 +1,12 @@
 #pragma once
 // gyrod's configuration: one TOML file (config/gyrod.toml documents every key and its
-// default) plus a few command-line flags on top. Every problem is a ConfigError whose
-// message is one line naming the file, the line and the key; the daemon prints it and
-// exits with EX_CONFIG (78). A key the loader does not know is an error, never ignored.
+// default) plus a few command-line flags on top (daemon/command_line.hpp). Every problem
+// is a ConfigError whose message is one line naming the file, the line and the key; the
+// daemon prints it and exits with EX_CONFIG (78). A key the loader does not know is an
+// error, never ignored. The TOML reading itself is formats/toml_document.hpp's.
 #include <spdlog/common.h>
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -25,10 +27,6 @@ class ConfigError : public std::runtime_error {
 // sysexits.h EX_CONFIG: "something was found in an unconfigured or misconfigured state".
 inline constexpr int kExitConfigError = 78;
 inline constexpr int exitCodeForConfigError() { return kExitConfigError; }
-// sysexits.h EX_USAGE: the command line itself is wrong (unknown flag, bad flag value).
-inline constexpr int kExitUsageError = 64;
-
-inline constexpr std::string_view kDefaultConfigPath = "/etc/gyrod/gyrod.toml";
 
 enum class DeviceBackend { I2c, Mock };
 enum class BiasSource { Estimate, Model, Config };
@@ -163,29 +161,12 @@ std::string_view toString(MockSource s);
 // starting with '/' → itself. Throws ConfigError for anything else.
 std::string i2cDevicePath(std::string_view bus);
 
-// Values a flag may set, on top of the file. Each is validated as the same key would be.
-struct CommandLineOverrides {
-  std::optional<DeviceBackend> backend;
-  std::optional<std::string> socket_path;
-  std::optional<std::string> record_path;
-  std::optional<double> mock_speed;
-  std::optional<spdlog::level::level_enum> log_level;
-};
-// Throws ConfigError naming the flag for a value out of range.
-void applyOverrides(GyrodConfig& config, const CommandLineOverrides& overrides);
-
-struct GyrodCommandLine {
-  GyrodConfig config;
-  std::string config_file;        // the file loaded; empty = compiled-in defaults
-  std::optional<int> exit_code;   // set: exit now (0 after --help/--version, 64 for bad usage)
-  std::string message;            // print before exiting: stdout if exit_code == 0, else stderr
-};
-
-// gyrod's command line:  gyrod [--config FILE] [--backend mock|i2c] [--socket PATH]
-//   [--record PATH] [--mock-speed X] [--log-level L] [--help] [--version]
-// Loads --config FILE, or else default_config_path when that file exists, or else the
-// compiled-in defaults, then applies the flags. Throws ConfigError for a bad config file.
-GyrodCommandLine parseGyrodCommandLine(int argc, const char* const* argv,
-                                       const std::string& default_config_path = std::string(kDefaultConfigPath));
+// Names the file and the command line accept, as written.
+inline const std::vector<std::string_view> kBackendNames = {"i2c", "mock"};
+inline const std::vector<std::string_view> kLogLevelNames = {"trace", "debug", "info", "warn",
+                                                             "error", "critical", "off"};
+inline constexpr std::array<spdlog::level::level_enum, 7> kLogLevels = {
+    spdlog::level::trace, spdlog::level::debug, spdlog::level::info, spdlog::level::warn,
+    spdlog::level::err,   spdlog::level::critical, spdlog::level::off};
 
 }  // namespace gyrod::daemon

@@ -9,8 +9,8 @@
 #include "driver/mpu6050_config.hpp"
 #include "driver/polling_data_ready.hpp"
 #include "driver/simulator_signal_source.hpp"
-#include "tools/recording/model_toml.hpp"
-#include "tools/recording/recording_csv.hpp"
+#include "formats/model_toml.hpp"
+#include "formats/recording_csv.hpp"
 
 namespace gyrod::daemon {
 namespace {
@@ -41,11 +41,12 @@ std::unique_ptr<driver::SignalSource> replaySource(const std::string& path, int 
       << " Hz (it must divide it)";
     throw std::runtime_error(s.str());
   }
+  const std::vector<double>* columns[3] = {nullptr, nullptr, nullptr};
+  for (std::size_t c = 0; c < rec.axis_names.size(); ++c)
+    if (const auto axis = recording::axisOfColumn(rec.axis_names[c])) columns[*axis] = &rec.axes[c];
   std::vector<double> axes[3], temp;
   for (int a = 0; a < 3; ++a) {
-    static const char* names[3] = {"gx", "gy", "gz"};
-    const std::vector<double>* col = rec.axis(names[a]);
-    if (!col && a == 0) col = rec.axis("x");
+    const std::vector<double>* col = columns[a];
     for (std::size_t i = 0; i < rec.size(); ++i)
       for (std::size_t k = 0; k < hold; ++k) axes[a].push_back(col ? (*col)[i] : 0.0);
   }

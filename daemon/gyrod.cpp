@@ -15,7 +15,7 @@
 #include <system_error>
 
 #include "driver/counter_names.hpp"
-#include "tools/recording/model_toml.hpp"
+#include "formats/model_toml.hpp"
 
 namespace gyrod::daemon {
 namespace {

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <exception>
 
+#include "daemon/command_line.hpp"
 #include "daemon/config.hpp"
 #include "daemon/event_loop.hpp"
 #include "daemon/gyrod.hpp"

@@ -9,37 +9,26 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <array>
 #include <cerrno>
-#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <ctime>
 #include <filesystem>
 
+#include "formats/recording_format.hpp"
+
 namespace gyrod::daemon {
 namespace {
 
 namespace fs = std::filesystem;
 
-constexpr std::string_view kHeader = "t,gx,gy,gz,temp\n";
 constexpr std::size_t kMaxHeaderBytes = 2048;  // < any page size: the header is written in one write()
 
 std::int64_t steadyNowNs() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
       .count();
 }
-
-// Appends the shortest decimal form that reads back as the same double.
-char* putNumber(char* p, char* end, double v) { return std::to_chars(p, end, v).ptr; }
-
-char* putText(char* p, std::string_view s) {
-  std::memcpy(p, s.data(), s.size());
-  return p + s.size();
-}
-
-char* putUnsigned(char* p, char* end, std::uint64_t v) { return std::to_chars(p, end, v).ptr; }
 
 std::string utcStamp(std::int64_t unix_seconds, const char* format) {
   const std::time_t t = static_cast<std::time_t>(unix_seconds);
@@ -95,7 +84,7 @@ Recorder::Recorder(RecorderOptions options) : options_(std::move(options)), ring
   if (!(options_.flush_interval_s > 0.0) || !std::isfinite(options_.flush_interval_s))
     throw std::invalid_argument("Recorder: flush_interval_s must be > 0 (got " + std::to_string(options_.flush_interval_s) + ")");
   if (!(options_.rotate_after_s >= 0.0)) throw std::invalid_argument("Recorder: rotate_after_s must be ≥ 0");
-  std::size_t header_bytes = kHeader.size() + 128;
+  std::size_t header_bytes = recording::kColumnsLine.size() + 128;
   for (const auto& c : options_.header_comments) {
     if (c.find('\n') != std::string::npos) throw std::invalid_argument("Recorder: a header comment contains a newline");
     header_bytes += c.size() + 3;
@@ -156,12 +145,7 @@ bool Recorder::pushGap(std::uint64_t seq, double t_s, std::uint32_t count, std::
   r.gap_count = count;
   r.t_s = t_s;
   const std::size_t n = std::min(reason.size(), sizeof r.gap_reason - 1);
-  for (std::size_t i = 0; i < n; ++i) {
-    const char c = reason[i];
-    const bool plain = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
-                       c == '.' || c == '-';
-    r.gap_reason[i] = plain ? c : '_';
-  }
+  for (std::size_t i = 0; i < n; ++i) r.gap_reason[i] = recording::reasonCharacter(reason[i]);
   r.gap_reason[n] = '\0';
   return pushRecord(r);
 }
@@ -249,41 +233,18 @@ void Recorder::flushOnce(bool final_flush) {
     openNextFile(previous);
   }
 
-  std::array<char, 256> buf{};
-  char* const end = buf.data() + buf.size();
+  recording::RecordingLine line;
   RecorderRecord r;
   const auto dropLine = [&](std::uint64_t count) {
-    char* p = putText(buf.data(), "# DROPPED count=");
-    p = putUnsigned(p, end, count);
-    p = putText(p, " reason=ring_full\n");
-    appendLine(std::string_view(buf.data(), static_cast<std::size_t>(p - buf.data())), false);
+    appendLine(recording::formatDroppedLine(line, count, "ring_full"), false);
     drops_reported_ += count;
   };
   while (ring_.tryPop(r)) {
     if (r.dropped_before > 0) dropLine(r.dropped_before);
-    char* p = buf.data();
-    bool record = true;
-    if (r.kind == RecorderRecord::Kind::Gap) {
-      p = putText(p, "# GAP seq=");
-      p = putUnsigned(p, end, r.gap_seq);
-      p = putText(p, " t=");
-      p = putNumber(p, end, r.t_s);
-      p = putText(p, " count=");
-      p = putUnsigned(p, end, r.gap_count);
-      p = putText(p, " reason=");
-      p = putText(p, r.gap_reason[0] ? std::string_view(r.gap_reason) : std::string_view("unknown"));
-    } else {
-      const bool finite = std::isfinite(r.t_s) && std::isfinite(r.gx_dps) && std::isfinite(r.gy_dps) &&
-                          std::isfinite(r.gz_dps) && std::isfinite(r.temp_c);
-      // The reader rejects non-finite values; keep the file readable and say what came.
-      if (!finite) p = putText(p, "# NONFINITE ");
-      for (double v : {r.t_s, r.gx_dps, r.gy_dps, r.gz_dps, r.temp_c}) {
-        if (p != buf.data() && p[-1] != ' ') *p++ = ',';
-        p = putNumber(p, end, v);
-      }
-    }
-    *p++ = '\n';
-    appendLine(std::string_view(buf.data(), static_cast<std::size_t>(p - buf.data())), record);
+    if (r.kind == RecorderRecord::Kind::Gap)
+      appendLine(recording::formatGapLine(line, r.gap_seq, r.t_s, r.gap_count, std::string_view(r.gap_reason)), true);
+    else
+      appendLine(recording::formatSampleLine(line, r.t_s, r.gx_dps, r.gy_dps, r.gz_dps, r.temp_c), true);
   }
   if (final_flush) {
     const auto unreported = dropped_.load(std::memory_order_relaxed) - drops_reported_;
@@ -394,10 +355,8 @@ bool Recorder::openNextFile(const std::string& previous_name) {
     errno = e;
     return false;
   }
-  std::string header = "# gyrod recording, opened " + utcStamp(now, "%Y-%m-%dT%H:%M:%SZ") + "\n";
-  if (!previous_name.empty()) header += "# continues " + previous_name + "\n";
-  for (const auto& c : options_.header_comments) header += "# " + c + "\n";
-  header += kHeader;
+  std::string header = recording::recordingHeaderComments(now, previous_name, options_.header_comments);
+  header += recording::kColumnsLine;
   // One write() of less than a page at offset 0: lands whole or not at all.
   const ssize_t n = ::write(fd, header.data(), header.size());
   if (n != static_cast<ssize_t>(header.size())) {

@@ -1,10 +1,11 @@
 #pragma once
-// Recording of raw samples to CSV files that `gyroctl analyze` reads
-// (tools/recording/recording_csv.hpp): a header "t,gx,gy,gz,temp" (s, °/s, °/s, °/s, °C),
-// one line per sample with every value in its shortest round-trip form (reads back
-// bit-exact), and '#' comment lines for everything else:
+// Recording of raw samples to CSV files that `gyroctl analyze` reads. The lines are
+// formats/recording_format.hpp's: a header "t,gx,gy,gz,temp" (s, °/s, °/s, °/s, °C), one
+// line per sample with every value in its shortest round-trip form (reads back bit-exact),
+// and '#' comment lines for everything else:
 //   # GAP seq=123 t=2.46 count=4 reason=fifo_overflow     samples the device lost
 //   # DROPPED count=7 reason=ring_full                     samples the recorder lost
+// This file owns the ring, the writer thread, the files and their rotation.
 //
 // The event loop pushes fixed-size records into a preallocated single-producer /
 // single-consumer ring: no allocation, no lock, no system call; a full ring drops the

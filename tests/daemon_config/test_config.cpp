@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "daemon/command_line.hpp"
 #include "daemon/config.hpp"
 
 using namespace gyrod::daemon;

@@ -15,7 +15,7 @@
 #include <thread>
 
 #include "daemon/recorder.hpp"
-#include "tools/recording/recording_csv.hpp"
+#include "formats/recording_csv.hpp"
 
 using namespace gyrod::daemon;
 using gyrod::recording::readRecordingCsv;
@@ -169,6 +169,35 @@ TEST(Recorder, RingFullDropsAreCountedAndMarkedWhereTheyHappened) {
   EXPECT_EQ(lines[drop4 + 1], "100,100,0,0,25");
   EXPECT_EQ(lines.back(), "# DROPPED count=2 reason=ring_full");  // drops after the last record, at stop
   EXPECT_EQ(readRecordingCsv(file).size(), 32u);
+}
+
+TEST(Recorder, GapsAndDropsReadBackAsLostSampleRecords) {
+  TempDir d;
+  auto o = options(d.path("gyro.csv"));
+  o.ring_capacity = 16;
+  std::string file;
+  {
+    Recorder rec(o);
+    file = rec.currentFile();
+    rec.pushSample(0.00, 1, 2, 3, 25);
+    rec.pushGap(1, 0.02, 3, "fifo overflow");
+    for (int i = 0; i < 16; ++i) rec.pushSample(0.08 + 0.02 * i, 1, 2, 3, 25);  // the last two are dropped
+    rec.stop();
+  }
+  const auto rec = readRecordingCsv(file);
+  ASSERT_EQ(rec.size(), 15u);
+  ASSERT_EQ(rec.lost.size(), 2u);
+  EXPECT_EQ(rec.lost[0].kind, gyrod::recording::LostSamples::Kind::Gap);
+  EXPECT_EQ(rec.lost[0].seq, 1u);
+  EXPECT_EQ(rec.lost[0].t_s, 0.02);
+  EXPECT_EQ(rec.lost[0].count, 3u);
+  EXPECT_EQ(rec.lost[0].reason, "fifo_overflow");
+  EXPECT_EQ(rec.lost[0].before_sample, 1u);
+  EXPECT_EQ(rec.lost[0].line, rec.line_numbers[0] + 1);
+  EXPECT_EQ(rec.lost[1].kind, gyrod::recording::LostSamples::Kind::Dropped);
+  EXPECT_EQ(rec.lost[1].count, 2u);
+  EXPECT_EQ(rec.lost[1].reason, "ring_full");
+  EXPECT_EQ(rec.lost[1].before_sample, 15u);
 }
 
 TEST(Recorder, NoLineCrossesAPageBoundaryOfTheFile) {

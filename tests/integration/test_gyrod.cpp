@@ -12,7 +12,7 @@
 
 #include "gyrod_process.hpp"
 #include "processing/allan.hpp"
-#include "tools/recording/recording_csv.hpp"
+#include "formats/recording_csv.hpp"
 #include "tools/run_command.hpp"
 
 using namespace gyrod::test;

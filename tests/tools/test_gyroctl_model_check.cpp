@@ -91,7 +91,7 @@ TEST(GyroctlModelCheck, TooShortOrMissingFilesAreUsageErrors) {
 
 // ---- the model file's optional [x.extra] tables ------------------------------------------
 
-#include "tools/recording/model_toml.hpp"
+#include "formats/model_toml.hpp"
 
 TEST(ModelTomlExtra, ExtraEffectsReadBackIdentically) {
   gyrod::processing::SimulationModel m;

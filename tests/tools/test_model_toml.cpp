@@ -6,7 +6,7 @@
 #include <fstream>
 #include <string>
 
-#include "tools/recording/model_toml.hpp"
+#include "formats/model_toml.hpp"
 #include "tools/run_command.hpp"
 
 using namespace gyrod::recording;

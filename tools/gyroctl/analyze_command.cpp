@@ -8,11 +8,11 @@
 #include <stdexcept>
 #include <string>
 
+#include "formats/model_toml.hpp"
 #include "processing/axis_analysis.hpp"
 #include "processing/noise_terms.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
-#include "tools/recording/model_toml.hpp"
 
 namespace gyrod::gyroctl {
 namespace {
@@ -207,14 +207,6 @@ void printAxisText(std::ostream& o, const std::string& name, const AxisAnalysis&
   }
 }
 
-// Model axis (x, y, z) for a recording column: gx → x, ..., a bare-number file's x → x.
-std::optional<std::size_t> modelAxisFor(const std::string& column) {
-  if (column == "gx" || column == "x") return 0;
-  if (column == "gy") return 1;
-  if (column == "gz") return 2;
-  return std::nullopt;
-}
-
 int runAnalyze(const AnalyzeOptions& opt) {
   LoadedInput in = loadInput(opt.file, opt.rate_hz, opt.axis);
   const auto& rec = in.recording;
@@ -255,7 +247,7 @@ int runAnalyze(const AnalyzeOptions& opt) {
   }
   for (std::size_t idx : in.axis_indices) {
     const AxisAnalysis a = analyzeAxis(rec.axes[idx], options);
-    if (const auto slot = modelAxisFor(rec.axis_names[idx])) {
+    if (const auto slot = recording::axisOfColumn(rec.axis_names[idx])) {
       model.axes[*slot].terms = a.noise.value;
       model.axes[*slot].bias_dps = a.zero_mean.mean;
     }

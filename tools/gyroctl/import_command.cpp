@@ -92,7 +92,7 @@ int runImport(const ImportOptions& opt) {
   }
   if (columns.empty()) fail(opt.file, line_no, "no column-name line (ax,ay,az,gx,gy,gz) found");
   int gcol[3] = {-1, -1, -1};
-  const char* names[3] = {"gx", "gy", "gz"};
+  const auto& names = recording::kGyroColumns;
   for (std::size_t c = 0; c < columns.size(); ++c)
     for (int a = 0; a < 3; ++a)
       if (columns[c] == names[a]) gcol[a] = static_cast<int>(c);
@@ -103,7 +103,7 @@ int runImport(const ImportOptions& opt) {
 
   const double lsb = kGyroLsbPerDps[opt.fs_sel];
   std::string out = "t";
-  for (int a : present) out += std::string(",") + names[a];
+  for (int a : present) out += "," + std::string(names[a]);
   out += '\n';
   std::size_t samples = 0;
   char buf[40];
@@ -120,9 +120,11 @@ int runImport(const ImportOptions& opt) {
     for (int a : present) {
       long counts = 0;
       const auto& field = f[static_cast<std::size_t>(gcol[a])];
-      if (!parseLong(field, counts)) fail(opt.file, line_no, std::string("column '") + names[a] + "': '" + field + "' is not an integer count");
+      const std::string_view column = names[a];
+      if (!parseLong(field, counts))
+        fail(opt.file, line_no, "column '" + std::string(column) + "': '" + field + "' is not an integer count");
       if (counts < -32768 || counts > 32767)
-        fail(opt.file, line_no, std::string("column '") + names[a] + "': " + field + " is outside the 16-bit range");
+        fail(opt.file, line_no, "column '" + std::string(column) + "': " + field + " is outside the 16-bit range");
       std::snprintf(buf, sizeof buf, ",%.17g", static_cast<double>(counts) / lsb);
       out += buf;
     }

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "tools/recording/recording_csv.hpp"
+#include "formats/recording_csv.hpp"
 
 namespace gyrod::gyroctl {
 

@@ -3,8 +3,8 @@
 #include <exception>
 #include <iostream>
 
+#include "formats/recording_csv.hpp"
 #include "tools/gyroctl/commands.hpp"
-#include "tools/recording/recording_csv.hpp"
 
 int main(int argc, char** argv) {
   using namespace gyrod::gyroctl;

@@ -22,12 +22,12 @@
 #include <string>
 #include <vector>
 
+#include "formats/model_toml.hpp"
 #include "processing/model_check.hpp"
 #include "processing/warm_up_fit.hpp"
 #include "processing/noise_terms.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
-#include "tools/recording/model_toml.hpp"
 
 namespace gyrod::gyroctl {
 namespace {
@@ -270,11 +270,11 @@ void requireWritableTarget(const std::string& path) {
     throw std::runtime_error(path + ": cannot write the model in " + folder.string() + ": " + std::strerror(errno));
 }
 
+// The model axis of a checked column: gx, gy, gz (docs/model-check.md). The column of a
+// file of bare numbers is not written into the model.
 std::optional<std::size_t> simulatorAxisFor(const std::string& column) {
-  if (column == "gx") return 0;
-  if (column == "gy") return 1;
-  if (column == "gz") return 2;
-  return std::nullopt;
+  if (column == recording::kBareNumbersColumn) return std::nullopt;
+  return recording::axisOfColumn(column);
 }
 
 // Seconds from the first sample for each sample: from t when present, else i/rate.

@@ -9,9 +9,9 @@
 #include <stdexcept>
 #include <string>
 
+#include "formats/model_toml.hpp"
 #include "processing/noise_simulator.hpp"
 #include "tools/gyroctl/commands.hpp"
-#include "tools/recording/model_toml.hpp"
 
 namespace gyrod::gyroctl {
 namespace {

@@ -35,7 +35,7 @@
 #include <string_view>
 
 #include "processing/noise_simulator.hpp"
-#include "tools/recording/recording_csv.hpp"
+#include "formats/recording_csv.hpp"
 
 namespace gyrod::recording {
 

@@ -1,4 +1,4 @@
-#include "tools/recording/recording_csv.hpp"
+#include "formats/recording_csv.hpp"
 
 #include <algorithm>
 #include <array>
@@ -57,6 +57,13 @@ bool isSkippable(std::string_view line) { return line.empty() || line.front() ==
 
 }  // namespace
 
+std::optional<std::size_t> axisOfColumn(std::string_view column) {
+  for (std::size_t a = 0; a < kGyroColumns.size(); ++a)
+    if (column == kGyroColumns[a]) return a;
+  if (column == kBareNumbersColumn) return 0;
+  return std::nullopt;
+}
+
 const std::vector<double>* Recording::axis(const std::string& name) const {
   for (std::size_t i = 0; i < axis_names.size(); ++i)
     if (axis_names[i] == name) return &axes[i];
@@ -73,11 +80,21 @@ Recording readRecordingCsv(const std::string& path) {
   std::size_t line_no = 0;
 
   // First meaningful line: a header, or the first of a column of bare numbers.
+  // Empty lines and comments are skipped; GAP and DROPPED lines are kept as records.
+  const auto skippable = [&](std::string_view line) {
+    if (!isSkippable(line)) return false;
+    if (auto lost = parseLostSamplesLine(line)) {
+      lost->line = line_no;
+      lost->before_sample = rec.size();
+      rec.lost.push_back(std::move(*lost));
+    }
+    return true;
+  };
   std::string_view first;
   while (std::getline(in, raw)) {
     ++line_no;
     first = trim(raw);
-    if (!isSkippable(first)) break;
+    if (!skippable(first)) break;
   }
   if (isSkippable(first)) fail(path, 0, "empty file: no header and no samples");
 
@@ -87,7 +104,7 @@ Recording readRecordingCsv(const std::string& path) {
   std::size_t header_line = line_no;
   if (parseNumber(first)) {
     bare_numbers = true;
-    rec.axis_names = {"x"};
+    rec.axis_names = {std::string(kBareNumbersColumn)};
     rec.axes.resize(1);
     roles = {{Role::Axis, 0}};
   } else {
@@ -147,7 +164,7 @@ Recording readRecordingCsv(const std::string& path) {
   while (std::getline(in, raw)) {
     ++line_no;
     const auto line = trim(raw);
-    if (isSkippable(line)) continue;
+    if (skippable(line)) continue;
     if (bare_numbers && line.find(',') != std::string_view::npos)
       fail(path, line_no, "more than one column in a file of bare numbers (add a header t,gx,gy,gz,temp)");
     consume(line);

@@ -1,4 +1,4 @@
-#include "tools/recording/model_toml.hpp"
+#include "formats/model_toml.hpp"
 
 #include <cerrno>
 #include <cmath>
@@ -6,7 +6,8 @@
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
-#include <toml++/toml.h>
+
+#include "formats/toml_document.hpp"
 
 namespace gyrod::recording {
 namespace {
@@ -19,16 +20,19 @@ std::string formatNumber(double v) {
   return buf;
 }
 
+using formats::tomlTypeName;
+
+// The model's keys and checks on top of the TOML reader, which reports every problem as
+// "FILE:LINE: cause" at the key's line.
 class ModelReader {
  public:
-  explicit ModelReader(std::string source) : source_(std::move(source)) {}
+  explicit ModelReader(const formats::TomlDocument& doc) : doc_(doc) {}
 
-  [[noreturn]] void fail(const toml::source_region& where, const std::string& cause) const {
-    throw RecordingError(source_ + ":" + std::to_string(where.begin.line) + ": " + cause);
-  }
+  [[noreturn]] void fail(const toml::source_region& where, const std::string& cause) const { doc_.fail(where, cause); }
 
   double number(const toml::node& node, const toml::key& key, const std::string& where) const {
-    if (!node.is_number()) fail(key.source(), where + std::string(key.str()) + " must be a number, got " + typeName(node));
+    if (!node.is_number())
+      fail(key.source(), where + std::string(key.str()) + " must be a number, got " + tomlTypeName(node));
     const double v = *node.value<double>();
     if (!std::isfinite(v)) fail(key.source(), where + std::string(key.str()) + " must be finite, got " + formatNumber(v));
     return v;
@@ -44,7 +48,8 @@ class ModelReader {
     return v;
   }
   int integerIn(const toml::node& node, const toml::key& key, int lo, int hi) const {
-    if (!node.is_integer()) fail(key.source(), std::string(key.str()) + " must be an integer, got " + typeName(node));
+    if (!node.is_integer())
+      fail(key.source(), std::string(key.str()) + " must be an integer, got " + tomlTypeName(node));
     const std::int64_t v = *node.value<std::int64_t>();
     if (v < lo || v > hi)
       fail(key.source(), std::string(key.str()) + " must be " + std::to_string(lo) + ".." + std::to_string(hi) +
@@ -52,20 +57,10 @@ class ModelReader {
     return static_cast<int>(v);
   }
   const toml::table& table(const toml::node& node, const toml::key& key) const {
-    if (!node.is_table()) fail(key.source(), std::string(key.str()) + " must be a table ([" + std::string(key.str()) + "]), got " + typeName(node));
+    if (!node.is_table())
+      fail(key.source(), std::string(key.str()) + " must be a table ([" + std::string(key.str()) + "]), got " +
+                             tomlTypeName(node));
     return *node.as_table();
-  }
-
-  static std::string typeName(const toml::node& node) {
-    switch (node.type()) {
-      case toml::node_type::string: return "a string";
-      case toml::node_type::integer: return "an integer";
-      case toml::node_type::floating_point: return "a float";
-      case toml::node_type::boolean: return "a boolean";
-      case toml::node_type::array: return "an array";
-      case toml::node_type::table: return "a table";
-      default: return "a date/time";
-    }
   }
 
   SimulationModel read(const toml::table& root) const {
@@ -93,7 +88,7 @@ class ModelReader {
         processing::sampleRateDivisor(*model.dlpf_cfg, model.rate_hz);
       } catch (const std::invalid_argument& e) {
         if (rate_key) fail(rate_key->source(), e.what());
-        throw RecordingError(source_ + ": " + e.what() + " (rate_hz not given: default 50)");
+        doc_.failFile(e.what() + std::string(" (rate_hz not given: default 50)"));
       }
     }
     return model;
@@ -152,9 +147,11 @@ class ModelReader {
       else if (k == "outlier_amplitude_dps") e.outlier_amplitude_dps = nonNegative(node, key, where);
       else if (k == "outlier_count") e.outlier_count = static_cast<std::size_t>(integerIn(node, key, 0, 1000000000));
       else if (k == "sinusoids" || k == "bias_steps") {
-        if (!node.is_array()) fail(key.source(), where + k + " must be an array of inline tables, got " + typeName(node));
+        if (!node.is_array())
+          fail(key.source(), where + k + " must be an array of inline tables, got " + tomlTypeName(node));
         for (const toml::node& element : *node.as_array()) {
-          if (!element.is_table()) fail(key.source(), where + k + " must contain inline tables only, found " + typeName(element));
+          if (!element.is_table())
+            fail(key.source(), where + k + " must contain inline tables only, found " + tomlTypeName(element));
           if (k == "sinusoids") {
             processing::SinusoidEffect sin;
             for (auto&& [ek, ev] : *element.as_table()) {
@@ -186,7 +183,7 @@ class ModelReader {
     try {
       processing::validateExtraEffects(e, axis + ".");
     } catch (const std::invalid_argument& ex) {
-      throw RecordingError(source_ + ": " + ex.what());
+      doc_.failFile(ex.what());
     }
   }
 
@@ -197,10 +194,11 @@ class ModelReader {
       const std::string k(key.str());
       if (k == "phi") {
         phi_key = &key;
-        if (!node.is_array()) fail(key.source(), where + "phi must be an array of numbers, got " + typeName(node));
+        if (!node.is_array()) fail(key.source(), where + "phi must be an array of numbers, got " + tomlTypeName(node));
         ar.phi.clear();
         for (const toml::node& element : *node.as_array()) {
-          if (!element.is_number()) fail(key.source(), where + "phi must contain numbers only, found " + typeName(element));
+          if (!element.is_number())
+            fail(key.source(), where + "phi must contain numbers only, found " + tomlTypeName(element));
           ar.phi.push_back(*element.value<double>());
         }
       } else if (k == "noise_var") {
@@ -213,12 +211,12 @@ class ModelReader {
       processing::validateArComponent(ar, axis + ".");
     } catch (const std::invalid_argument& e) {
       if (phi_key) fail(phi_key->source(), e.what());
-      throw RecordingError(source_ + ": " + e.what());
+      doc_.failFile(e.what());
     }
   }
 
  private:
-  std::string source_;
+  const formats::TomlDocument& doc_;
 };
 
 void appendKeyValue(std::string& out, const std::string& key, double v) {
@@ -232,19 +230,18 @@ void appendKeyValue(std::string& out, const std::string& key, double v) {
 }  // namespace
 
 processing::SimulationModel parseModelToml(std::string_view text, const std::string& source_name) {
-  toml::table root;
   try {
-    root = toml::parse(text, source_name);
-  } catch (const toml::parse_error& e) {
-    throw RecordingError(source_name + ":" + std::to_string(e.source().begin.line) + ": " + std::string(e.description()));
+    const formats::TomlDocument doc(text, source_name);
+    const SimulationModel model = ModelReader(doc).read(doc.root());
+    try {
+      processing::validateSimulationModel(model);  // anything not already tied to a line
+    } catch (const std::invalid_argument& e) {
+      doc.failFile(e.what());
+    }
+    return model;
+  } catch (const formats::TomlError& e) {
+    throw RecordingError(e.what());
   }
-  const SimulationModel model = ModelReader(source_name).read(root);
-  try {
-    processing::validateSimulationModel(model);  // anything not already tied to a line
-  } catch (const std::invalid_argument& e) {
-    throw RecordingError(source_name + ": " + e.what());
-  }
-  return model;
 }
 
 processing::SimulationModel readModelToml(const std::string& path) {

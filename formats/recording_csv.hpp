@@ -1,10 +1,17 @@
 #pragma once
 // Recording files: CSV with a header naming any of the columns t,gx,gy,gz,temp
-// (seconds, °/s, °/s, °/s, °C), or a file of bare numbers (one column, one axis).
+// (seconds, °/s, °/s, °/s, °C), or a file of bare numbers (one column, one axis). Lines
+// starting with '#' are comments; the "# GAP" and "# DROPPED" lines gyrod writes
+// (recording_format.hpp) are returned as LostSamples records, and a line that only looks
+// like one (say "# GAP at 12 s") stays an ordinary comment, as every '#' line always was.
+#include <array>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
+
+#include "formats/recording_format.hpp"
 
 namespace gyrod::recording {
 
@@ -21,9 +28,18 @@ struct Recording {
   std::vector<std::vector<double>> axes; // one vector per axis_names entry
   std::vector<double> temp;              // empty when absent
   std::vector<std::size_t> line_numbers; // file line of each sample, for error messages
+  std::vector<LostSamples> lost;         // the GAP and DROPPED lines, in file order
   std::size_t size() const { return axes.empty() ? 0 : axes.front().size(); }
   const std::vector<double>* axis(const std::string& name) const;
 };
+
+// The gyro columns in axis order: gx is the x axis (0), gy the y axis (1), gz the z axis (2).
+inline constexpr std::array<std::string_view, 3> kGyroColumns = {"gx", "gy", "gz"};
+// The name Recording gives the one column of a file of bare numbers.
+inline constexpr std::string_view kBareNumbersColumn = "x";
+// The axis (0 = x, 1 = y, 2 = z) a recording column measures: gx, gy, gz, and the column
+// of a file of bare numbers, which stands for x. nullopt for any other name.
+std::optional<std::size_t> axisOfColumn(std::string_view column);
 
 // Reads and validates the whole file. Throws RecordingError naming file, line and cause.
 Recording readRecordingCsv(const std::string& path);
