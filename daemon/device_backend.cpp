@@ -7,7 +7,7 @@
 #include "driver/gpio_data_ready.hpp"
 #include "driver/linux_i2c_bus.hpp"
 #include "driver/polling_data_ready.hpp"
-#include "driver/simulator_signal_source.hpp"
+#include "driver/mock/simulator_signal_source.hpp"
 #include "tools/recording/model_toml.hpp"
 #include "tools/recording/recording_csv.hpp"
 

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "driver/clock.hpp"
-#include "driver/mock_mpu6050.hpp"
+#include "driver/mock/mock_mpu6050.hpp"
 #include "driver/mpu6050_driver.hpp"
 #include "driver/polling_data_ready.hpp"
 

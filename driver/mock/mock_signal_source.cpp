@@ -1,4 +1,4 @@
-#include "driver/mock_signal_source.hpp"
+#include "driver/mock/mock_signal_source.hpp"
 
 #include <cmath>
 #include <numbers>

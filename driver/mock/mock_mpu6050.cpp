@@ -1,4 +1,4 @@
-#include "driver/mock_mpu6050.hpp"
+#include "driver/mock/mock_mpu6050.hpp"
 
 #include <sys/timerfd.h>
 #include <unistd.h>

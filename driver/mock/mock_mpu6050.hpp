@@ -17,8 +17,8 @@
 #include "driver/clock.hpp"
 #include "driver/data_ready.hpp"
 #include "driver/i2c_bus.hpp"
-#include "driver/mock_faults.hpp"
-#include "driver/mock_signal_source.hpp"
+#include "driver/mock/mock_faults.hpp"
+#include "driver/mock/mock_signal_source.hpp"
 #include "driver/mpu6050_registers.hpp"
 #include "processing/sensor_model.hpp"
 
