@@ -3,7 +3,7 @@
 // clock-time events, and the bus-side fault state those events drive (error bursts, the
 // outage in progress, random transfer errors from their own seeded stream). What an event
 // does to the chip (power loss, brown-out, forced overflow, a stuck INT line) is the
-// chip's business (MockMpu6050::processNextEvent).
+// chip's business (MockMpu6050::applyFaultEvent, mock_faults.cpp).
 #include <cstddef>
 #include <cstdint>
 #include <optional>
