@@ -8,7 +8,7 @@
 #include "driver/linux_i2c_bus.hpp"
 #include "driver/mpu6050_config.hpp"
 #include "driver/polling_data_ready.hpp"
-#include "driver/simulator_signal_source.hpp"
+#include "driver/mock/simulator_signal_source.hpp"
 #include "formats/model_toml.hpp"
 #include "formats/recording_csv.hpp"
 

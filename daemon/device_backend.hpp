@@ -16,8 +16,8 @@
 #include "driver/clock.hpp"
 #include "driver/data_ready.hpp"
 #include "driver/i2c_bus.hpp"
-#include "driver/mock_mpu6050.hpp"
-#include "driver/mock_signal_source.hpp"
+#include "driver/mock/mock_mpu6050.hpp"
+#include "driver/mock/mock_signal_source.hpp"
 #include "driver/mpu6050_types.hpp"
 #include "processing/noise_simulator.hpp"
 

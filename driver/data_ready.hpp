@@ -1,6 +1,6 @@
 #pragma once
 // The chip's data-ready signal as the daemon's epoll loop sees it. Implementations: the
-// mock device's (driver/mock_mpu6050.hpp), libgpiod v1 line events on the INT pin, and a
+// mock device's (driver/mock/mock_mpu6050.hpp), libgpiod v1 line events on the INT pin, and a
 // timerfd that polls INT_STATUS when no GPIO is wired.
 #include <cstdint>
 

@@ -1,6 +1,6 @@
 #pragma once
 // An I2C bus with one selected device address, as the chip layer sees it. Implemented by
-// the mock device (driver/mock_mpu6050.hpp) and by the Linux backend on /dev/i2c-N.
+// the mock device (driver/mock/mock_mpu6050.hpp) and by the Linux backend on /dev/i2c-N.
 //
 // Errors are errno-style, like libi2c's i2c_smbus_* calls: every transfer returns 0 on
 // success or a negative errno. The values a caller should expect:

@@ -14,9 +14,10 @@
 #include <vector>
 
 #include "driver/clock.hpp"
-#include "driver/mock_mpu6050.hpp"
+#include "driver/mock/mock_mpu6050.hpp"
 #include "driver/mpu6050_driver.hpp"
 #include "driver/polling_data_ready.hpp"
+#include "processing/portable_random.hpp"
 
 namespace gyrod::driver::test {
 
@@ -51,14 +52,14 @@ class Recorder final : public SampleSink {
 class JitteredDataReady final : public DataReadySource {
  public:
   JitteredDataReady(DataReadySource& inner, std::int64_t max_latency_ns, std::uint64_t seed)
-      : inner_(inner), max_latency_ns_(max_latency_ns), state_(seed) {}
+      : inner_(inner), max_latency_ns_(max_latency_ns), rng_(seed) {}
   int fd() const override { return inner_.fd(); }
   int consumeEdge(std::int64_t& t) override {
     const int r = inner_.consumeEdge(t);
     if (r != 0) return r;
     ++edges_;
     if (max_latency_ns_ > 0) {
-      t += static_cast<std::int64_t>(next() % static_cast<std::uint64_t>(max_latency_ns_ + 1));
+      t += static_cast<std::int64_t>(rng_.next() % static_cast<std::uint64_t>(max_latency_ns_ + 1));
     }
     if (glitch_every_ > 0 && edges_ % glitch_every_ == 0) t += glitch_shift_ns_;
     return 0;
@@ -70,15 +71,9 @@ class JitteredDataReady final : public DataReadySource {
   }
 
  private:
-  std::uint64_t next() {  // splitmix64
-    std::uint64_t z = (state_ += 0x9E3779B97F4A7C15ULL);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-    return z ^ (z >> 31);
-  }
   DataReadySource& inner_;
   std::int64_t max_latency_ns_;
-  std::uint64_t state_;
+  processing::SplitMix64 rng_;
   std::uint64_t edges_ = 0;
   std::uint64_t glitch_every_ = 0;
   std::int64_t glitch_shift_ns_ = 0;

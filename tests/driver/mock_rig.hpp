@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "driver/clock.hpp"
-#include "driver/mock_mpu6050.hpp"
+#include "driver/mock/mock_mpu6050.hpp"
 #include "driver/mpu6050_registers.hpp"
 
 namespace gyrod::driver::test {

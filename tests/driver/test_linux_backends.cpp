@@ -17,8 +17,8 @@
 #include "driver/gpio_data_ready.hpp"
 #include "driver/i2c_messages.hpp"
 #include "driver/linux_i2c_bus.hpp"
-#include "driver/mock_mpu6050.hpp"
-#include "driver/mock_signal_source.hpp"
+#include "driver/mock/mock_mpu6050.hpp"
+#include "driver/mock/mock_signal_source.hpp"
 #include "driver/mpu6050_driver.hpp"
 #include "driver/polling_data_ready.hpp"
 

@@ -5,7 +5,7 @@
 
 #include <cerrno>
 
-#include "driver/mock_signal_source.hpp"
+#include "driver/mock/mock_signal_source.hpp"
 #include "tests/driver/mock_rig.hpp"
 
 namespace gyrod::driver::test {

@@ -6,7 +6,7 @@
 #include <iostream>
 #include <numbers>
 
-#include "driver/mock_signal_source.hpp"
+#include "driver/mock/mock_signal_source.hpp"
 #include "processing/sensor_model.hpp"
 #include "tests/driver/mock_rig.hpp"
 

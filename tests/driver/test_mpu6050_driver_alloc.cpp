@@ -6,8 +6,8 @@
 #include <cstdlib>
 #include <new>
 
-#include "driver/mock_mpu6050.hpp"
-#include "driver/mock_signal_source.hpp"
+#include "driver/mock/mock_mpu6050.hpp"
+#include "driver/mock/mock_signal_source.hpp"
 #include "driver/mpu6050_driver.hpp"
 
 namespace {

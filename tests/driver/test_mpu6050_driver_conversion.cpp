@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "driver/mock_signal_source.hpp"
+#include "driver/mock/mock_signal_source.hpp"
 #include "tests/driver/driver_rig.hpp"
 
 namespace gyrod::driver::test {

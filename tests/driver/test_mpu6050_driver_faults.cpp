@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <numeric>
 
-#include "driver/mock_signal_source.hpp"
+#include "driver/mock/mock_signal_source.hpp"
 #include "tests/driver/driver_rig.hpp"
 
 namespace gyrod::driver::test {

@@ -8,7 +8,7 @@
 #include <optional>
 #include <vector>
 
-#include "driver/mock_signal_source.hpp"
+#include "driver/mock/mock_signal_source.hpp"
 #include "tests/driver/driver_rig.hpp"
 
 namespace gyrod::driver::test {

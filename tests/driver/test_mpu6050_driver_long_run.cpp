@@ -6,27 +6,23 @@
 #include <cstdio>
 #include <numeric>
 
-#include "driver/mock_signal_source.hpp"
+#include "driver/mock/mock_signal_source.hpp"
+#include "processing/portable_random.hpp"
 #include "tests/driver/driver_rig.hpp"
 
 namespace gyrod::driver::test {
 namespace {
 
+// Integers from the project's splitmix64.
 class SplitMix {
  public:
-  explicit SplitMix(std::uint64_t seed) : s_(seed) {}
-  std::uint64_t next() {
-    std::uint64_t z = (s_ += 0x9E3779B97F4A7C15ULL);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-    return z ^ (z >> 31);
-  }
+  explicit SplitMix(std::uint64_t seed) : rng_(seed) {}
   std::int64_t uniform(std::int64_t lo, std::int64_t hi) {  // [lo, hi]
-    return lo + static_cast<std::int64_t>(next() % static_cast<std::uint64_t>(hi - lo + 1));
+    return lo + static_cast<std::int64_t>(rng_.next() % static_cast<std::uint64_t>(hi - lo + 1));
   }
 
  private:
-  std::uint64_t s_;
+  processing::SplitMix64 rng_;
 };
 
 // Faults spread over [from, to) sensor time: windows of one kind never overlap.

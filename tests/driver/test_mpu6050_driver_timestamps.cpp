@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "driver/mock_signal_source.hpp"
+#include "driver/mock/mock_signal_source.hpp"
 #include "tests/driver/driver_rig.hpp"
 
 namespace gyrod::driver::test {

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <vector>
 
-#include "driver/simulator_signal_source.hpp"
+#include "driver/mock/simulator_signal_source.hpp"
 #include "mock_rig.hpp"
 #include "processing/allan.hpp"
 

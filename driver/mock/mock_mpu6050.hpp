@@ -6,19 +6,28 @@
 // registers, fills the 1024-byte FIFO, raises INT_STATUS bits and drives the INT line.
 // Time comes from a Clock: virtual (tests step it) or CLOCK_MONOTONIC (demo); the chip
 // catches up to the clock whenever it is touched. Faults are scripted with a FaultPlan.
-// What is and is not modelled: docs/mock-device.md.
+// What is and is not modelled: docs/mock-device.md. The parts live in driver/mock/: the
+// register file, the FIFO, the fault schedule, the INT line and the tick train, each with
+// the chip's side of it in a mock_<part>.cpp.
 #include <array>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <optional>
-#include <vector>
+#include <span>
 
 #include "driver/clock.hpp"
 #include "driver/data_ready.hpp"
 #include "driver/i2c_bus.hpp"
-#include "driver/mock_faults.hpp"
-#include "driver/mock_signal_source.hpp"
+#include "driver/mock/fault_schedule.hpp"
+#include "driver/mock/fifo.hpp"
+#include "driver/mock/int_line.hpp"
+#include "driver/mock/mock_faults.hpp"
+#include "driver/mock/mock_random.hpp"
+#include "driver/mock/mock_signal_source.hpp"
+#include "driver/mock/mock_time.hpp"
+#include "driver/mock/register_file.hpp"
+#include "driver/mock/tick_train.hpp"
 #include "driver/mpu6050_registers.hpp"
 #include "processing/sensor_model.hpp"
 
@@ -54,7 +63,7 @@ struct SampleRecord {
   bool written_to_fifo = false;
 };
 
-class MockMpu6050 final : public I2cBus {
+class MockMpu6050 final : public I2cBus, private mock::ChipTimeline {
  public:
   // `clock` and `source` must outlive the mock. Throws std::invalid_argument for a bad
   // config (address above 0x7F, clock error beyond 10 %, negative reset time, burst
@@ -94,97 +103,54 @@ class MockMpu6050 final : public I2cBus {
   void setSampleObserver(std::function<void(const SampleRecord&)> observer) { observer_ = std::move(observer); }
 
   // The host side of the INT line: an fd readable when an edge is pending.
-  DataReadySource& dataReady() { return data_ready_; }
+  DataReadySource& dataReady() { return int_line_.host(); }
   // Electrical level of INT as the host sees it now (after any stuck-line fault).
   bool intLineHigh() const;
 
  private:
-  class DataReadyLine final : public DataReadySource {
-   public:
-    DataReadyLine(MockMpu6050& owner, EdgeDirection direction, std::size_t depth);
-    ~DataReadyLine() override;
-    DataReadyLine(const DataReadyLine&) = delete;
-    DataReadyLine& operator=(const DataReadyLine&) = delete;
-    int fd() const override { return fd_; }
-    [[nodiscard]] int consumeEdge(std::int64_t& timestamp_ns) override;
-    std::uint64_t edgesDropped() const override { return dropped_; }
+  // mock::ChipTimeline: runs every internal tick and scheduled event up to t_ns.
+  void advanceTo(std::int64_t t_ns) override;
+  // Only a sample tick with an interrupt enabled, or a scheduled event, can move INT.
+  std::int64_t nextPossibleEdgeNs() const override;
 
-    void lineMoved(std::int64_t t_ns, bool rising);
-    // Arms the timerfd: now if an edge is queued; in real-time mode, at the next time the
-    // chip could move the line; otherwise disarmed.
-    void updateReadiness(bool force = false);
-
-   private:
-    MockMpu6050& owner_;
-    int fd_ = -1;
-    EdgeDirection direction_;
-    std::vector<std::int64_t> queue_;  // ring, allocated once
-    std::size_t head_ = 0;
-    std::size_t count_ = 0;
-    std::uint64_t dropped_ = 0;
-    std::int64_t armed_at_ns_ = -1;  // what the timerfd is set to; 0 = disarmed
-  };
-
-  enum class EventKind : std::uint8_t {
-    OutageEnd,
-    StuckEnd,
-    OutageStart,
-    StuckStart,
-    BurstStart,
-    Brownout,
-    ForcedOverflow,
-  };
-  struct ScheduledEvent {
-    std::int64_t time_ns;  // clock time
-    EventKind kind;
-    std::size_t index;  // into the plan's vector of that kind
-  };
-
-  // Time.
-  void advanceTo(std::int64_t t_ns);
-  void processNextEvent();
+  // Scheduled events (mock_mpu6050.cpp, mock_faults.cpp).
   void recomputeNextEvent();
+  void processNextEvent();
+  void applyFaultEvent(const mock::FaultEvent& event, std::int64_t t_ns);
+
+  // Sampling and power (mock_sampling.cpp).
   void internalTick(std::int64_t t_ns);
   void sampleTick(std::int64_t t_ns);
-  std::int64_t tickTimeNs(std::int64_t k) const;
-  std::int64_t nextPossibleEdgeNs() const;
-
-  // Power and configuration.
+  void latchOutputs(const SampleRecord& s);
   void resetChip();  // registers to reset values, FIFO empty, asleep, line inactive
   void updateSampling();
   void startSampling(std::int64_t t_ns);
   void applyDlpfConfig(int cfg);
-  int dlpfCfg() const;
+  double accelNoise();
 
-  // Registers.
+  // Registers (mock_registers.cpp).
   std::uint8_t readRegister(std::uint8_t reg);
   void writeRegister(std::uint8_t reg, std::uint8_t value);
+  void writePowerManagement(std::uint8_t value);
+  void writeConfig(std::uint8_t value);
+  void writeUserControl(std::uint8_t value);
+  void writeIntPinConfig(std::uint8_t value);
   void afterRead();
 
-  // FIFO.
+  // FIFO (mock_fifo.cpp).
   void pushFifo(const std::uint8_t* bytes, std::size_t n, std::int64_t t_ns);
+  std::uint8_t popFifo();
   std::size_t buildFrame(std::uint8_t* out) const;
-  void clearFifo();
   void forceFifoOverflow(std::int64_t t_ns);
 
-  // Interrupts and the INT line.
+  // Interrupts (mock_int_line.cpp).
   void raiseInterrupt(std::uint8_t status_bit, std::uint8_t enable_bit, std::int64_t t_ns);
   void clearInterruptStatus(std::uint8_t bits, std::int64_t t_ns);
-  void setChipPinActive(bool active, std::int64_t t_ns);
-  bool chipLineHigh() const;
-  void lineMaybeMoved(bool was_high, std::int64_t t_ns);
 
-  // Transfers.
+  // Transfers (mock_mpu6050.cpp).
   int beginTransfer(bool& deferred_error);
   int readBurst(std::uint8_t reg, std::span<std::uint8_t> out);
   int finishTransfer(int result);
-
-  // Random numbers (seeded): splitmix64 and Box–Muller.
-  static std::uint64_t splitmix64(std::uint64_t& state);
-  double uniform01(std::uint64_t& state);
-  double accelNoise();
-
-  static constexpr std::int64_t kNever = INT64_MAX;
 
   Clock& clock_;
   SignalSource& source_;
@@ -193,18 +159,12 @@ class MockMpu6050 final : public I2cBus {
   std::int64_t now_ns_;
   std::uint8_t selected_ = 0;
 
-  std::array<std::uint8_t, 128> regs_{};
+  mock::RegisterFile regs_;
   bool powered_ = true;
   bool reset_busy_ = false;
-  std::int64_t reset_done_ns_ = kNever;
+  std::int64_t reset_done_ns_ = mock::kNever;
 
-  // Sample clock: internal tick k (k ≥ 1) happens at anchor + round(k · period).
-  bool sampling_ = false;
-  std::int64_t anchor_ns_ = 0;
-  double period_ns_ = 0.0;
-  std::int64_t tick_index_ = 1;
-  std::int64_t next_tick_ns_ = kNever;
-  int ticks_since_sample_ = 0;
+  mock::TickTrain ticks_;
   bool prime_filters_ = true;
   bool rate_mismatch_ = false;
 
@@ -213,38 +173,16 @@ class MockMpu6050 final : public I2cBus {
   std::array<processing::DigitalLowPassFilter, 3> filters_;
   std::array<double, 3> filtered_dps_{};
   double temperature_c_ = 25.0;
+  mock::BoxMullerNormal accel_noise_;
 
-  // FIFO: a ring of 1024 bytes.
-  std::array<std::uint8_t, mpu6050::fifo::kSize> fifo_{};
-  std::size_t fifo_head_ = 0;
-  std::size_t fifo_count_ = 0;
-  std::uint8_t fifo_last_read_ = 0;
-  std::uint16_t fifo_count_shadow_ = 0;
-
-  // INT line: the chip's output, pulse timing, and the stuck-line fault.
-  bool pin_active_ = false;
-  std::int64_t pulse_end_ns_ = kNever;
-  bool stuck_ = false;
-  bool stuck_high_ = false;
-
-  // Faults.
-  FaultPlan plan_;
-  std::vector<ScheduledEvent> events_;
-  std::size_t next_plan_event_ = 0;
-  std::int64_t next_event_ns_ = kNever;
-  std::uint64_t transfer_rng_ = 1;
-  std::uint32_t burst_remaining_ = 0;
-  int burst_error_ = EIO;
-  bool outage_ = false;
-  int outage_error_ = EREMOTEIO;
-
-  std::uint64_t accel_rng_;
-  std::optional<double> spare_normal_;
+  mock::Fifo fifo_;
+  mock::FaultSchedule faults_;
+  std::int64_t next_event_ns_ = mock::kNever;  // reset done, pulse end or the next fault
 
   MockCounters counters_;
   std::optional<SampleRecord> last_sample_;
   std::function<void(const SampleRecord&)> observer_;
-  DataReadyLine data_ready_;
+  mock::IntLine int_line_;  // after counters_, which it counts hidden edges in
 };
 
 }  // namespace gyrod::driver

@@ -1,4 +1,4 @@
-#include "driver/mock_signal_source.hpp"
+#include "driver/mock/mock_signal_source.hpp"
 
 #include <cmath>
 #include <numbers>
@@ -43,7 +43,8 @@ AnalogSample SinusoidSource::nextTick(double t_s) {
   AnalogSample s;
   for (int i = 0; i < 3; ++i) {
     const SinusoidAxis& a = axes_[i];
-    s.rate_dps[i] = a.offset_dps + a.amplitude_dps * std::sin(2.0 * std::numbers::pi * a.frequency_hz * t_s + a.phase_rad);
+    s.rate_dps[i] =
+        a.offset_dps + a.amplitude_dps * std::sin(2.0 * std::numbers::pi * a.frequency_hz * t_s + a.phase_rad);
   }
   s.temperature_c = temperature_c_;
   return s;

@@ -1,4 +1,4 @@
-#include "driver/simulator_signal_source.hpp"
+#include "driver/mock/simulator_signal_source.hpp"
 
 #include <stdexcept>
 

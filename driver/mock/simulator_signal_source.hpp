@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <memory>
 
-#include "driver/mock_signal_source.hpp"
+#include "driver/mock/mock_signal_source.hpp"
 #include "processing/noise_simulator.hpp"
 
 namespace gyrod::driver {
