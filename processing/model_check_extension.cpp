@@ -61,7 +61,7 @@ AllanNull extendedAllanNull(const ExtensionInputs& in, bool any_model_effect, co
 
 // Where the measured Allan deviation leaves the replicas' band, as an `unexplained` effect.
 void checkUnexplained(const AllanNull& ext_allan, const std::vector<double>& measured_log_adev, bool any_model_effect,
-                      const Context& c, AxisModelCheck& out) {
+                      const Context& c, std::size_t replicas, AxisModelCheck& out) {
   std::vector<double> z_ext;
   const double ext_max_z = maxAbsZ(measured_log_adev, ext_allan.median_log, ext_allan.spread_log, &z_ext);
   out.statistics.push_back(makeStatistic("allan_band_max_z_extended", ext_max_z, ext_allan.max_z));
@@ -76,8 +76,7 @@ void checkUnexplained(const AllanNull& ext_allan, const std::vector<double>& mea
     }
   e.where_lo = lo;
   e.where_hi = hi;
-  e.evidence.statistic = ext_max_z;
-  e.evidence.threshold = ext_allan.max_z.threshold;
+  e.evidence = nullEvidence(ext_max_z, ext_allan.max_z, replicas);
   e.evidence.against_extended = any_model_effect;
   out.effects.push_back(e);
 }
@@ -142,7 +141,7 @@ void checkExtendedModel(const ExtensionInputs& in, const Context& c, const Model
   const bool any_model_effect = in.deterministic_found || in.gauss_markov->found;
   const AllanNull ext_allan = extendedAllanNull(in, any_model_effect, c, o, out);
   out.allan_extended = ext_allan.band;
-  checkUnexplained(ext_allan, *in.measured_log_adev, any_model_effect, c, out);
+  checkUnexplained(ext_allan, *in.measured_log_adev, any_model_effect, c, o.replicas, out);
 
   bandFigures(out.allan_base, out.gain.adev_log_error_base, out.gain.in_band_base);
   bandFigures(out.allan_extended, out.gain.adev_log_error_extended, out.gain.in_band_extended);
