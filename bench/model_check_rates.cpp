@@ -1,5 +1,5 @@
 // Detection rate, false-discovery rate and parameter errors of the model check over many
-// seeds of the hidden-effect generator (tests/model_check/hidden_effect_generator.hpp).
+// seeds of the hidden-effect generator (processing/hidden_effect_generator.hpp).
 // Not a unit test and not run by ctest: scripts/model-check-rates.sh builds and runs it.
 //
 //   model_check_rates [--seeds N] [--first S] [--duration SEC] [--rate HZ] [--replicas R]
@@ -19,8 +19,8 @@
 #include <string>
 #include <vector>
 
+#include "processing/hidden_effect_generator.hpp"
 #include "processing/model_check.hpp"
-#include "tests/model_check/hidden_effect_generator.hpp"
 
 using namespace gyrod;
 using processing::ModelEffect;
@@ -35,10 +35,10 @@ struct Tally {
 };
 
 // How large a hidden effect is against the noise of its axis, in the generator's own terms
-// (tests/model_check/hidden_effect_generator.hpp draws each of these uniformly in a range):
+// (processing/hidden_effect_generator.hpp draws each of these uniformly in a range):
 // what the detection rate depends on. Computed from the truth after the fact, for the table only.
-std::vector<std::pair<std::string, double>> effectSizes(const test::HiddenEffect& h, const test::GeneratedRecording& rec,
-                                                        double duration) {
+std::vector<std::pair<std::string, double>> effectSizes(const processing::HiddenEffect& h,
+                                                        const processing::GeneratedRecording& rec, double duration) {
   const processing::NoiseTerms& terms = rec.terms[h.axis];
   const double white_std = terms.arw_deg_per_sqrt_h / 60.0 * std::sqrt(rec.rate_hz);
   switch (h.effect) {
@@ -72,7 +72,7 @@ double quantile(std::vector<double> v, double q) {  // linear interpolation betw
 }
 double median(std::vector<double> v) { return quantile(std::move(v), 0.5); }
 
-std::string describeHidden(const test::HiddenEffect& h) {
+std::string describeHidden(const processing::HiddenEffect& h) {
   char buf[160];
   switch (h.effect) {
     case ModelEffect::TemperatureBias: std::snprintf(buf, sizeof buf, " k=%.3g", h.k_dps_per_c); break;
@@ -91,7 +91,7 @@ std::string describeHidden(const test::HiddenEffect& h) {
   return buf;
 }
 
-void recordErrors(Tally& t, const test::HiddenEffect& h, const processing::DetectedEffect& d) {
+void recordErrors(Tally& t, const processing::HiddenEffect& h, const processing::DetectedEffect& d) {
   auto rel = [](double est, double truth) { return std::fabs(est - truth) / std::fabs(truth); };
   switch (h.effect) {
     case ModelEffect::TemperatureBias: t.errors["k rel"].push_back(rel(d.k_dps_per_c, h.k_dps_per_c)); break;
@@ -161,16 +161,16 @@ int main(int argc, char** argv) {
   std::size_t axes_checked = 0, axes_with_false = 0, false_total = 0;
   double seconds = 0.0;
   for (std::size_t s = first; s < first + seeds; ++s) {
-    test::HiddenEffectGenerator gen(s);
+    processing::HiddenEffectGenerator gen(s);
     std::vector<ModelEffect> effects;
     const std::size_t count = mode == "clean" ? 0 : (mode == "single" ? 1 : 2);
     while (effects.size() < count) {
       ModelEffect e = gen.randomEffect();
-      for (ModelEffect c : test::kHideableEffects)
+      for (ModelEffect c : processing::kHideableEffects)
         if (!only.empty() && processing::modelEffectName(c) == only) e = c;
       if (std::find(effects.begin(), effects.end(), e) == effects.end()) effects.push_back(e);
     }
-    const test::GeneratedRecording rec = gen.generate(duration, rate, effects);
+    const processing::GeneratedRecording rec = gen.generate(duration, rate, effects);
     processing::ModelCheckOptions o;
     o.replicas = replicas;
     o.seed = s;
@@ -181,7 +181,7 @@ int main(int argc, char** argv) {
       seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       ++axes_checked;
       std::vector<bool> used(r.effects.size(), false);
-      for (const test::HiddenEffect& h : rec.hidden) {
+      for (const processing::HiddenEffect& h : rec.hidden) {
         if (h.axis != a && h.effect != ModelEffect::SampleGaps) continue;
         Tally& t = tallies[std::string(processing::modelEffectName(h.effect))];
         if (a == h.axis) ++t.hidden;
@@ -209,19 +209,22 @@ int main(int argc, char** argv) {
       axes_with_false += false_here > 0 ? 1 : 0;
       if (verbose) {
         std::printf("seed %zu axis %zu:", s, a);
-        for (const test::HiddenEffect& h : rec.hidden)
+        for (const processing::HiddenEffect& h : rec.hidden)
           if (h.axis == a) std::printf(" [hidden %s%s]", std::string(processing::modelEffectName(h.effect)).c_str(),
                                        describeHidden(h).c_str());
         for (const auto& e : r.effects) std::printf(" %s", std::string(processing::modelEffectName(e.effect)).c_str());
         std::printf("\n");
         bool hidden_here = false;
-        for (const test::HiddenEffect& h : rec.hidden) hidden_here = hidden_here || h.axis == a;
+        for (const processing::HiddenEffect& h : rec.hidden) hidden_here = hidden_here || h.axis == a;
         if (hidden_here)
           for (const auto& st : r.statistics)
             std::printf("    %-40s %11.4g  median %11.4g  threshold %11.4g%s\n", st.name.c_str(), st.value, st.null_median,
                         st.threshold, st.fired ? "  FIRED" : "");
         if (false_here > 0)
-          for (const auto& e : r.effects) std::printf("    %s: %s\n", std::string(processing::modelEffectName(e.effect)).c_str(), e.evidence.c_str());
+          for (const auto& e : r.effects)  // the evidence as numbers (its sentences are gyroctl's)
+            std::printf("    %s: statistic %.4g, threshold %.4g, null median %.4g\n",
+                        std::string(processing::modelEffectName(e.effect)).c_str(), e.evidence.statistic,
+                        e.evidence.threshold, e.evidence.null_median);
       }
     }
   }

@@ -41,6 +41,45 @@ enum class ModelEffect {
 };
 std::string_view modelEffectName(ModelEffect e);
 
+// How a slow change of the bias was told apart as a temperature response or as steps (both
+// fire on the low-passed residual when either is there).
+enum class LowFrequencyDecision {
+  None,
+  TemperatureOnly,          // follows temperature; no step once it is removed
+  TemperatureThenSteps,     // follows temperature, and steps remain once it is removed
+  StepsThenTemperature,     // steps, and a temperature response remains once they are removed
+  StepsOnly,                // steps; no temperature response
+  EachRemains,              // each remains when the other is removed
+  TemperatureVanishes,      // the temperature correlation vanishes once the steps are removed
+  StepsVanish,              // the steps vanish once the temperature response is removed
+  ByBic,                    // each explains the other away: BIC of the low-passed residual decides
+};
+
+// A further component of a line already named: a fixed sinusoid did not take the line out.
+struct LineComponent {
+  double freq_hz = 0.0, amp_dps = 0.0;
+  double peak_ratio = 0.0;  // its spectral peak over the local background
+  bool operator==(const LineComponent&) const = default;
+};
+
+// What a named effect rests on, as numbers; the tool that prints them words them. Only the
+// fields of the effect are meaningful.
+struct EffectEvidence {
+  double statistic = 0.0;     // the statistic's value (unexplained: largest |z| of the Allan band)
+  double threshold = 0.0;     // its threshold (two-sided statistics: on |value − null median|)
+  double null_median = 0.0;   // median of its null
+  std::size_t replicas = 0;   // replicas per round the null comes from
+  double peak_ratio = 0.0;    // sinusoid: peak over the local background
+  double freq_hz = 0.0;       // sinusoid: frequency of the first component
+  std::vector<LineComponent> further_components;  // sinusoid: the line's amplitude or phase wanders
+  double chi2_gain = 0.0, chi2_base = 0.0;        // gauss_markov: weighted residual gain, and before
+  LowFrequencyDecision decision = LowFrequencyDecision::None;  // temperature_bias, bias_steps
+  double bic_temperature = 0.0, bic_steps = 0.0;               // when decision is ByBic
+  double median_spacing_s = 0.0, jitter = 0.0;                 // sample_gaps
+  bool against_extended = false;  // unexplained: against the extended model (else the base)
+  bool operator==(const EffectEvidence&) const = default;
+};
+
 struct DetectedEffect {
   ModelEffect effect = ModelEffect::Unexplained;
   // Parameters; only those of `effect` are meaningful.
@@ -54,7 +93,7 @@ struct DetectedEffect {
   std::size_t lost = 0;                        // sample_gaps: samples missing in the gaps
   double outlier_median_amplitude_dps = 0.0;   // outliers: median |excursion|
   double where_lo = 0.0, where_hi = 0.0;       // unexplained: τ range [s] (Allan)
-  std::string evidence;                        // one sentence: statistic, value, threshold
+  EffectEvidence evidence;                     // statistic, value, threshold
 };
 
 // One statistic of the check: its value on the measured series, the replicas' null

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "processing/golden_section.hpp"
+
 namespace gyrod::processing {
 
 TemperatureModel fitExponentialWarmUp(std::span<const double> secs, std::span<const double> temp) {
@@ -72,17 +74,10 @@ TemperatureModel fitExponentialWarmUp(std::span<const double> secs, std::span<co
   }
   if (!std::isfinite(best_sse)) return m;
   const double step = (hi - lo) / (kScan - 1);
-  double a = lo + step * std::max(best - 1, 0), b = lo + step * std::min(best + 1, kScan - 1);
-  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
-  double x1 = b - g * (b - a), x2 = a + g * (b - a), f1 = fitAt(x1).sse, f2 = fitAt(x2).sse;
-  for (int it = 0; it < 30; ++it) {
-    if (f1 < f2) {
-      b = x2; x2 = x1; f2 = f1; x1 = b - g * (b - a); f1 = fitAt(x1).sse;
-    } else {
-      a = x1; x1 = x2; f1 = f2; x2 = a + g * (b - a); f2 = fitAt(x2).sse;
-    }
-  }
-  const double log_tau = 0.5 * (a + b);
+  // The time constant: golden section in log τ within one scan step of the best.
+  const double a = lo + step * std::max(best - 1, 0), b = lo + step * std::min(best + 1, kScan - 1);
+  const double log_tau =
+      goldenSectionMinimum(a, b, {30, 0.0}, [&](double log_tau_tried) { return fitAt(log_tau_tried).sse; }).midpoint();
   const Fit f = fitAt(log_tau);
   if (!std::isfinite(f.sse)) return m;
   m.time_constant_s = std::exp(log_tau);

@@ -1,4 +1,4 @@
-// The model check, blind: data from tests/model_check/hidden_effect_generator.hpp (base-model
+// The model check, blind: data from processing/hidden_effect_generator.hpp (base-model
 // noise, a moving temperature channel, hidden effects with random parameters on random
 // axes, all from a seed); the check sees only the columns. Each test states its tolerance.
 // Short recordings (10 min at 50 Hz) and few replicas keep them at about a second each in
@@ -14,13 +14,10 @@
 #include <string>
 #include <vector>
 
-#include "model_check/hidden_effect_generator.hpp"
+#include "processing/hidden_effect_generator.hpp"
 #include "processing/model_check.hpp"
 
 using namespace gyrod::processing;
-using gyrod::test::GeneratedRecording;
-using gyrod::test::HiddenEffect;
-using gyrod::test::HiddenEffectGenerator;
 
 namespace {
 
@@ -45,7 +42,9 @@ AxisModelCheck check(const GeneratedRecording& g, std::size_t axis, std::uint64_
 
 std::string describe(const AxisModelCheck& r) {
   std::string s;
-  for (const DetectedEffect& e : r.effects) s += std::string(modelEffectName(e.effect)) + ": " + e.evidence + "\n";
+  for (const DetectedEffect& e : r.effects)
+    s += std::string(modelEffectName(e.effect)) + ": statistic " + std::to_string(e.evidence.statistic) + ", threshold " +
+         std::to_string(e.evidence.threshold) + "\n";
   return s.empty() ? "(no effect)" : s;
 }
 

@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "model_check/hidden_effect_generator.hpp"
+#include "processing/hidden_effect_generator.hpp"
 #include "tools/run_command.hpp"
 
 using gyrod::test::readWholeFile;
@@ -19,7 +19,7 @@ using gyrod::test::ScratchDir;
 
 namespace {
 
-std::string recordingCsv(const gyrod::test::GeneratedRecording& g) {
+std::string recordingCsv(const gyrod::processing::GeneratedRecording& g) {
   std::string out = "t,gx,gy,gz,temp\n";
   char line[256];
   for (std::size_t i = 0; i < g.t.size(); ++i) {
@@ -34,7 +34,7 @@ std::string recordingCsv(const gyrod::test::GeneratedRecording& g) {
 
 TEST(GyroctlModelCheck, JsonNamesTheHiddenSinusoidOnItsAxisOnly) {
   ScratchDir d;
-  const auto g = gyrod::test::HiddenEffectGenerator(7).generate(300.0, 50.0, {gyrod::processing::ModelEffect::Sinusoid});
+  const auto g = gyrod::processing::HiddenEffectGenerator(7).generate(300.0, 50.0, {gyrod::processing::ModelEffect::Sinusoid});
   const auto csv = d.write("rec.csv", recordingCsv(g));
   const auto r = runGyroctl("model-check " + csv.string() + " --json --replicas 16 --seed 3 --threads 2", d.path());
   ASSERT_EQ(r.exit_status, 0) << r.err;
@@ -61,7 +61,7 @@ TEST(GyroctlModelCheck, JsonNamesTheHiddenSinusoidOnItsAxisOnly) {
 
 TEST(GyroctlModelCheck, ReportFolderHasMarkdownAndPlotScripts) {
   ScratchDir d;
-  const auto g = gyrod::test::HiddenEffectGenerator(5).generate(200.0, 50.0, {});
+  const auto g = gyrod::processing::HiddenEffectGenerator(5).generate(200.0, 50.0, {});
   const auto csv = d.write("rec.csv", recordingCsv(g));
   const auto dir = d.path() / "report";
   const auto r = runGyroctl("model-check " + csv.string() + " --axis gy --replicas 8 --report " + dir.string(), d.path());
@@ -223,7 +223,7 @@ TEST(GyroctlModelCheckWriteModel, NamesTheHiddenSinusoidAndSimulateAcceptsTheFil
 
 TEST(GyroctlModelCheckWriteModel, SampleGapsAreACommentNotAnEffect) {
   ScratchDir d;
-  const auto g = gyrod::test::HiddenEffectGenerator(13).generate(200.0, 50.0, {gyrod::processing::ModelEffect::SampleGaps});
+  const auto g = gyrod::processing::HiddenEffectGenerator(13).generate(200.0, 50.0, {gyrod::processing::ModelEffect::SampleGaps});
   const auto csv = d.write("rec.csv", recordingCsv(g));
   const auto out = d.path() / "m.toml";
   const auto r =
@@ -243,7 +243,7 @@ TEST(GyroctlModelCheckWriteModel, SampleGapsAreACommentNotAnEffect) {
 
 TEST(GyroctlModelCheckWriteModel, UnwritablePathFailsBeforeTheCheckAndKeepsAnExistingFile) {
   ScratchDir d;
-  const auto g = gyrod::test::HiddenEffectGenerator(5).generate(100.0, 50.0, {});
+  const auto g = gyrod::processing::HiddenEffectGenerator(5).generate(100.0, 50.0, {});
   const auto csv = d.write("rec.csv", recordingCsv(g));
   // A missing folder: exit 1 as for every output that cannot be written (analyze, simulate),
   // one line naming the path, and no check output (it failed before the check ran).

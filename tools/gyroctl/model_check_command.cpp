@@ -69,6 +69,77 @@ json effectParams(const DetectedEffect& e) {
   return json::object();
 }
 
+// ---- the words of the evidence ----------------------------------------------------------
+
+std::string nullText(const EffectEvidence& v) {
+  return "threshold " + fmt("%.4g", v.threshold) + " from " + std::to_string(v.replicas) +
+         " base-model replicas (median " + fmt("%.4g", v.null_median) + ")";
+}
+
+std::string decisionText(const EffectEvidence& v) {
+  switch (v.decision) {
+    case LowFrequencyDecision::None: return "";
+    case LowFrequencyDecision::TemperatureOnly: return "the residual follows temperature; no step once it is removed";
+    case LowFrequencyDecision::TemperatureThenSteps:
+      return "the residual follows temperature, and steps remain once it is removed";
+    case LowFrequencyDecision::StepsThenTemperature:
+      return "abrupt steps, and a temperature response remains once they are removed";
+    case LowFrequencyDecision::StepsOnly: return "abrupt steps in the bias; no temperature response";
+    case LowFrequencyDecision::EachRemains:
+      return "steps and a temperature response: each remains when the other is removed";
+    case LowFrequencyDecision::TemperatureVanishes:
+      return "the temperature correlation vanishes once the steps are removed, the steps do not once the "
+             "temperature fit is";
+    case LowFrequencyDecision::StepsVanish:
+      return "the steps vanish once the temperature response is removed, not the other way round";
+    case LowFrequencyDecision::ByBic:
+      return "either explains the other away; BIC of the low-passed residual: temperature " +
+             fmt("%.1f", v.bic_temperature) + ", steps " + fmt("%.1f", v.bic_steps);
+  }
+  return "";
+}
+
+std::string sinusoidEvidenceText(const EffectEvidence& v) {
+  std::string s = "narrow spectral peak " + fmt("%.3g", v.peak_ratio) + " x the local background at " +
+                  fmt("%.5g", v.freq_hz) + " Hz (log ratio " + fmt("%.3g", v.statistic) + "; " + nullText(v) + ")";
+  for (const LineComponent& c : v.further_components)
+    s += "; a second component " + fmt("%.3g", c.amp_dps) + " deg/s at " + fmt("%.5g", c.freq_hz) +
+         " Hz remains once it is removed (peak " + fmt("%.3g", c.peak_ratio) +
+         " x the background): the line's amplitude or phase wanders over the record";
+  return s;
+}
+
+// One sentence per effect: the statistic, its value and threshold, and how the cause was told.
+std::string evidenceText(const DetectedEffect& e) {
+  const EffectEvidence& v = e.evidence;
+  switch (e.effect) {
+    case ModelEffect::SampleGaps:
+      return std::to_string(e.count) + " intervals in t longer than 1.5 x the median spacing " +
+             fmt("%.6g", v.median_spacing_s) + " s, " + std::to_string(e.lost) + " samples missing; timing jitter " +
+             fmt("%.3g", v.jitter) + " of a spacing";
+    case ModelEffect::Outliers:
+      return "largest robust z " + fmt("%.3g", v.statistic) + " against its neighbours; " + nullText(v) + "; " +
+             std::to_string(e.count) + " samples beyond it, median excursion " +
+             fmt("%.3g", e.outlier_median_amplitude_dps) + " deg/s";
+    case ModelEffect::Sinusoid: return sinusoidEvidenceText(v);
+    case ModelEffect::TemperatureBias:
+      return "low-passed residual against the detrended temperature: slope " + fmt("%.4g", v.statistic) +
+             " deg/s/C, " + nullText(v) + " (two-sided on the distance); " + decisionText(v);
+    case ModelEffect::BiasSteps:
+      return "largest standardised Haar difference of the low-passed residual " + fmt("%.3g", v.statistic) + ", " +
+             nullText(v) + "; " + decisionText(v);
+    case ModelEffect::GaussMarkov:
+      return "a Gauss-Markov term in the Allan fit lowers the weighted residual by " + fmt("%.4g", v.chi2_gain) +
+             " (from " + fmt("%.4g", v.chi2_base) + "), " + nullText(v);
+    case ModelEffect::Unexplained:
+      return "the measured Allan deviation leaves the " + std::string(v.against_extended ? "extended" : "base") +
+             " model's replicas at tau " + fmt("%.4g", e.where_lo) + " to " + fmt("%.4g", e.where_hi) +
+             " s (largest |z| " + fmt("%.3g", v.statistic) + ", threshold " + fmt("%.3g", v.threshold) +
+             "); no catalogued effect accounts for it";
+  }
+  return "";
+}
+
 std::string paramsText(const DetectedEffect& e) {
   std::string s;
   const json params = effectParams(e);
@@ -99,7 +170,9 @@ json gainJson(const ModelCheckGain& g) {
 json axisJson(const AxisModelCheck& r) {
   json effects = json::array();
   for (const DetectedEffect& e : r.effects)
-    effects.push_back({{"effect", std::string(modelEffectName(e.effect))}, {"params", effectParams(e)}, {"evidence", e.evidence}});
+    effects.push_back({{"effect", std::string(modelEffectName(e.effect))},
+                       {"params", effectParams(e)},
+                       {"evidence", evidenceText(e)}});
   json stats = json::array();
   for (const CheckStatistic& s : r.statistics)
     stats.push_back({{"name", s.name}, {"value", s.value}, {"null_median", s.null_median}, {"threshold", s.threshold},
@@ -118,7 +191,7 @@ void printAxisText(std::ostream& o, const std::string& name, const AxisModelChec
   o << "\n== " << name << " ==\n";
   if (r.effects.empty()) o << "  the base model holds: no effect\n";
   for (const DetectedEffect& e : r.effects)
-    o << "  " << modelEffectName(e.effect) << " (" << paramsText(e) << ")\n      " << e.evidence << '\n';
+    o << "  " << modelEffectName(e.effect) << " (" << paramsText(e) << ")\n      " << evidenceText(e) << '\n';
   const ModelCheckGain& g = r.gain;
   char line[256];
   o << "  gain                    base        extended\n";
@@ -232,7 +305,7 @@ void writeReport(const std::string& dir_text, const ModelCheckCliOptions& opt, c
     else {
       md << "| effect | parameters | evidence |\n|---|---|---|\n";
       for (const DetectedEffect& e : r.effects)
-        md << "| `" << modelEffectName(e.effect) << "` | " << paramsText(e) << " | " << e.evidence << " |\n";
+        md << "| `" << modelEffectName(e.effect) << "` | " << paramsText(e) << " | " << evidenceText(e) << " |\n";
     }
     const ModelCheckGain& g = r.gain;
     md << "\n| figure | base | extended |\n|---|---|---|\n"
