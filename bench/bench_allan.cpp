@@ -28,7 +28,6 @@ const std::vector<double>& samples() {
   return y;
 }
 
-
 void BM_StreamingSum(benchmark::State& state) {
   const auto& y = samples();
   for (auto _ : state) {
@@ -86,14 +85,18 @@ int main(int argc, char** argv) {
 
   const auto& y = samples();
   const auto ms = gyrod::processing::octaveClusterSizes(y.size());
-  const double g_stream_ns = medianNs([&] {
-    double s = std::accumulate(y.begin(), y.end(), 0.0);
-    benchmark::DoNotOptimize(s);
-  }, 15);
-  const double g_allan_ns = medianNs([&] {
-    auto v = gyrod::processing::overlappingAllanVariances(y, ms);
-    benchmark::DoNotOptimize(v.data());
-  }, 5);
+  const double g_stream_ns = medianNs(
+      [&] {
+        double s = std::accumulate(y.begin(), y.end(), 0.0);
+        benchmark::DoNotOptimize(s);
+      },
+      15);
+  const double g_allan_ns = medianNs(
+      [&] {
+        auto v = gyrod::processing::overlappingAllanVariances(y, ms);
+        benchmark::DoNotOptimize(v.data());
+      },
+      5);
   std::printf("overlapping ADEV at %zu octave taus on %zu samples: %.1f ms; one streaming sum: %.2f ms; ratio %.1f\n",
               ms.size(), y.size(), g_allan_ns / 1e6, g_stream_ns / 1e6, g_allan_ns / g_stream_ns);
   return 0;

@@ -138,14 +138,22 @@ int main(int argc, char** argv) {
       }
       return argv[++i];
     };
-    if (!std::strcmp(argv[i], "--seeds")) seeds = std::strtoull(next(), nullptr, 10);
-    else if (!std::strcmp(argv[i], "--first")) first = std::strtoull(next(), nullptr, 10);
-    else if (!std::strcmp(argv[i], "--duration")) duration = std::atof(next());
-    else if (!std::strcmp(argv[i], "--rate")) rate = std::atof(next());
-    else if (!std::strcmp(argv[i], "--replicas")) replicas = std::strtoull(next(), nullptr, 10);
-    else if (!std::strcmp(argv[i], "--mode")) mode = next();
-    else if (!std::strcmp(argv[i], "--effect")) only = next();
-    else if (!std::strcmp(argv[i], "--verbose")) verbose = true;
+    if (!std::strcmp(argv[i], "--seeds"))
+      seeds = std::strtoull(next(), nullptr, 10);
+    else if (!std::strcmp(argv[i], "--first"))
+      first = std::strtoull(next(), nullptr, 10);
+    else if (!std::strcmp(argv[i], "--duration"))
+      duration = std::atof(next());
+    else if (!std::strcmp(argv[i], "--rate"))
+      rate = std::atof(next());
+    else if (!std::strcmp(argv[i], "--replicas"))
+      replicas = std::strtoull(next(), nullptr, 10);
+    else if (!std::strcmp(argv[i], "--mode"))
+      mode = next();
+    else if (!std::strcmp(argv[i], "--effect"))
+      only = next();
+    else if (!std::strcmp(argv[i], "--verbose"))
+      verbose = true;
     else {
       std::fprintf(stderr, "unknown option %s\n", argv[i]);
       return 2;
@@ -210,16 +218,17 @@ int main(int argc, char** argv) {
       if (verbose) {
         std::printf("seed %zu axis %zu:", s, a);
         for (const processing::HiddenEffect& h : rec.hidden)
-          if (h.axis == a) std::printf(" [hidden %s%s]", std::string(processing::modelEffectName(h.effect)).c_str(),
-                                       describeHidden(h).c_str());
+          if (h.axis == a)
+            std::printf(" [hidden %s%s]", std::string(processing::modelEffectName(h.effect)).c_str(),
+                        describeHidden(h).c_str());
         for (const auto& e : r.effects) std::printf(" %s", std::string(processing::modelEffectName(e.effect)).c_str());
         std::printf("\n");
         bool hidden_here = false;
         for (const processing::HiddenEffect& h : rec.hidden) hidden_here = hidden_here || h.axis == a;
         if (hidden_here)
           for (const auto& st : r.statistics)
-            std::printf("    %-40s %11.4g  median %11.4g  threshold %11.4g%s\n", st.name.c_str(), st.value, st.null_median,
-                        st.threshold, st.fired ? "  FIRED" : "");
+            std::printf("    %-40s %11.4g  median %11.4g  threshold %11.4g%s\n", st.name.c_str(), st.value,
+                        st.null_median, st.threshold, st.fired ? "  FIRED" : "");
         if (false_here > 0)
           for (const auto& e : r.effects)  // the evidence as numbers (its sentences are gyroctl's)
             std::printf("    %s: statistic %.4g, threshold %.4g, null median %.4g\n",
@@ -234,7 +243,8 @@ int main(int argc, char** argv) {
   std::printf("%-17s %7s %9s  %s\n", "effect", "hidden", "detected", "parameter errors: median / 90th percentile");
   for (const auto& [name, t] : tallies) {
     std::printf("%-17s %7zu %8.1f%%  ", name.c_str(), t.hidden, t.hidden ? 100.0 * t.detected / t.hidden : 0.0);
-    for (const auto& [pname, v] : t.errors) std::printf("%s %.3g / %.3g;  ", pname.c_str(), median(v), quantile(v, 0.9));
+    for (const auto& [pname, v] : t.errors)
+      std::printf("%s %.3g / %.3g;  ", pname.c_str(), median(v), quantile(v, 0.9));
     std::printf("\n");
   }
   // Detection by size: each effect's hidden cases in three equal-count groups of its size.

@@ -79,8 +79,10 @@ int main(int argc, char** argv) {
   double seconds = 3600.0;
   for (int i = 1; i < argc; ++i) {
     const bool has_value = i + 1 < argc;
-    if (!std::strcmp(argv[i], "--repeats") && has_value) repeats = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--seconds") && has_value) seconds = std::atof(argv[++i]);
+    if (!std::strcmp(argv[i], "--repeats") && has_value)
+      repeats = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--seconds") && has_value)
+      seconds = std::atof(argv[++i]);
     else {
       std::fprintf(stderr, "usage: %s [--repeats N] [--seconds S]\n", argv[0]);
       return 2;
@@ -108,8 +110,8 @@ int main(int argc, char** argv) {
   std::printf("%-44s %10.2f   polar/ziggurat = %.2f\n", "normal deviate, ziggurat", best(zig), best(polar) / best(zig));
 #endif
   std::printf("%-44s %10.2f   (%.3g samples/s)\n", "sample, pure axis, Table 2 terms", best(full), 1e9 / best(full));
-  std::printf("%-44s %10.2f   flicker bank share = %.0f %%\n", "sample, same without bias instability", best(no_flicker),
-              100.0 * (1.0 - best(no_flicker) / best(full)));
+  std::printf("%-44s %10.2f   flicker bank share = %.0f %%\n", "sample, same without bias instability",
+              best(no_flicker), 100.0 * (1.0 - best(no_flicker) / best(full)));
   std::printf("%-44s %10.2f\n", "sample, ARW alone", best(arw));
   return 0;
 }

@@ -26,9 +26,9 @@ void applyOverrides(GyrodConfig& config, const CommandLineOverrides& overrides);
 
 struct GyrodCommandLine {
   GyrodConfig config;
-  std::string config_file;        // the file loaded; empty = compiled-in defaults
-  std::optional<int> exit_code;   // set: exit now (0 after --help/--version, 64 for bad usage)
-  std::string message;            // print before exiting: stdout if exit_code == 0, else stderr
+  std::string config_file;       // the file loaded; empty = compiled-in defaults
+  std::optional<int> exit_code;  // set: exit now (0 after --help/--version, 64 for bad usage)
+  std::string message;           // print before exiting: stdout if exit_code == 0, else stderr
 };
 
 // gyrod's command line:  gyrod [--config FILE] [--backend mock|i2c] [--socket PATH]

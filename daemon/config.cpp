@@ -18,8 +18,8 @@ namespace {
 using Section = formats::TomlSection;
 using formats::shortest;
 
-const std::vector<std::string_view> kSections = {"device", "gpio", "bias", "filter", "allan",
-                                                 "socket", "record", "log", "mock"};
+const std::vector<std::string_view> kSections = {"device", "gpio",   "bias", "filter", "allan",
+                                                 "socket", "record", "log",  "mock"};
 const std::vector<std::string_view> kBiasSourceNames = {"estimate", "model", "config"};
 const std::vector<std::string_view> kMockSourceNames = {"simulator", "replay"};
 
@@ -31,9 +31,12 @@ void readDevice(const Section& s, DeviceConfig& d) {
   if (auto b = s.choice("backend", kBackendNames)) d.backend = *b == 0 ? DeviceBackend::I2c : DeviceBackend::Mock;
   if (const auto* n = s.node("bus")) {
     std::string text;
-    if (auto i = n->as_integer()) text = std::to_string(i->get());
-    else if (auto str = n->as_string()) text = str->get();
-    else s.failType(*n, "bus", "must be a bus number (1 → /dev/i2c-1) or a device path");
+    if (auto i = n->as_integer())
+      text = std::to_string(i->get());
+    else if (auto str = n->as_string())
+      text = str->get();
+    else
+      s.failType(*n, "bus", "must be a bus number (1 → /dev/i2c-1) or a device path");
     try {
       d.bus = i2cDevicePath(text);
     } catch (const ConfigError&) {
@@ -53,7 +56,8 @@ void readDevice(const Section& s, DeviceConfig& d) {
     d.dlpf = static_cast<int>(*v);
   }
   if (auto v = s.integer("full_scale_dps")) {
-    if (*v != 250 && *v != 500 && *v != 1000 && *v != 2000) s.failValue("full_scale_dps", "must be 250, 500, 1000 or 2000");
+    if (*v != 250 && *v != 500 && *v != 1000 && *v != 2000)
+      s.failValue("full_scale_dps", "must be 250, 500, 1000 or 2000");
     d.full_scale_dps = static_cast<int>(*v);
   }
   if (auto v = s.number("rate_hz")) d.rate_hz = *v;
@@ -62,8 +66,8 @@ void readDevice(const Section& s, DeviceConfig& d) {
   const double internal = driver::mpu6050::gyroOutputRateHz(d.dlpf);
   if (!driver::smplrtDivFor(d.dlpf, d.rate_hz)) {
     std::ostringstream req;
-    req << "must be " << shortest(internal) << " Hz / N for a whole N in 1..256 (the chip's rate with dlpf "
-        << d.dlpf << ")";
+    req << "must be " << shortest(internal) << " Hz / N for a whole N in 1..256 (the chip's rate with dlpf " << d.dlpf
+        << ")";
     if (s.has("rate_hz")) s.failValue("rate_hz", req.str());
     const char* which = s.has("dlpf") ? "dlpf" : "rate_hz";
     s.fail(*s.node(which), "rate_hz", req.str(), shortest(d.rate_hz) + ", the default");
@@ -72,7 +76,8 @@ void readDevice(const Section& s, DeviceConfig& d) {
 
 void readGpio(const Section& s, GpioConfig& g) {
   if (auto c = s.string("chip")) {
-    if (c->find_first_of(" \t\n") != std::string::npos) s.failValue("chip", "must be a chip name or path without spaces");
+    if (c->find_first_of(" \t\n") != std::string::npos)
+      s.failValue("chip", "must be a chip name or path without spaces");
     g.chip = *c;
   }
   if (auto l = s.integer("line")) {
@@ -92,8 +97,7 @@ void readBias(const Section& s, BiasConfig& b) {
   }
   if (const auto* n = s.node("values")) {
     const auto* a = n->as_array();
-    if (!a || a->size() != 3 ||
-        !std::all_of(a->begin(), a->end(), [](const toml::node& e) { return e.is_number(); }))
+    if (!a || a->size() != 3 || !std::all_of(a->begin(), a->end(), [](const toml::node& e) { return e.is_number(); }))
       s.fail(*n, "values", "must be an array of 3 numbers [x, y, z] in °/s",
              a ? "an array of " + std::to_string(a->size()) + " elements" : formats::tomlTypeAndValue(*n));
     b.values.clear();
@@ -131,11 +135,13 @@ void readFilter(const Section& s, FilterConfig& f) {
 void readAllan(const Section& s, AllanConfig& a, double rate_hz) {
   const double tau0 = 1.0 / rate_hz;
   if (auto v = s.number("window_s")) {
-    if (!(*v * rate_hz >= 4.0)) s.failValue("window_s", "must hold at least 4 samples (≥ " + shortest(4.0 * tau0) + " s at device.rate_hz)");
+    if (!(*v * rate_hz >= 4.0))
+      s.failValue("window_s", "must hold at least 4 samples (≥ " + shortest(4.0 * tau0) + " s at device.rate_hz)");
     a.window_s = *v;
   }
   if (auto v = s.number("refit_interval_s")) {
-    if (!(*v > 0.0 && *v <= a.window_s)) s.failValue("refit_interval_s", "must be > 0 and ≤ allan.window_s (" + shortest(a.window_s) + " s)");
+    if (!(*v > 0.0 && *v <= a.window_s))
+      s.failValue("refit_interval_s", "must be > 0 and ≤ allan.window_s (" + shortest(a.window_s) + " s)");
     a.refit_interval_s = *v;
   }
   if (const auto* n = s.node("taus")) {
@@ -152,11 +158,13 @@ void readAllan(const Section& s, AllanConfig& a, double rate_hz) {
         const double tau = s.numberFrom(e, "taus");
         const double m = tau * rate_hz;
         if (!(tau > 0.0) || std::abs(m - std::round(m)) > 1e-9 * std::max(1.0, m) || std::round(m) < 1.0)
-          s.fail(e, "taus", "each τ must be a whole number of sample periods (τ0 = " + shortest(tau0) + " s)", shortest(tau));
+          s.fail(e, "taus", "each τ must be a whole number of sample periods (τ0 = " + shortest(tau0) + " s)",
+                 shortest(tau));
         if (tau > tau_max)
           s.fail(e, "taus", "each τ must be ≤ allan.window_s / 2 (" + shortest(tau_max) + " s)", shortest(tau));
         if (!a.taus_s.empty() && !(tau > a.taus_s.back()))
-          s.fail(e, "taus", "τ values must be strictly increasing", shortest(tau) + " after " + shortest(a.taus_s.back()));
+          s.fail(e, "taus", "τ values must be strictly increasing",
+                 shortest(tau) + " after " + shortest(a.taus_s.back()));
         a.taus_s.push_back(tau);
       }
     } else {
@@ -297,7 +305,8 @@ std::string_view toString(MockSource s) { return kMockSourceNames[s == MockSourc
 std::string i2cDevicePath(std::string_view bus) {
   if (isAllDigits(bus) && bus.size() <= 6) return "/dev/i2c-" + std::to_string(std::stoul(std::string(bus)));
   if (!bus.empty() && bus.front() == '/') return std::string(bus);
-  throw ConfigError("I2C bus '" + std::string(bus) + "': must be a bus number ≥ 0 (1 → /dev/i2c-1) or a path starting with '/'");
+  throw ConfigError("I2C bus '" + std::string(bus) +
+                    "': must be a bus number ≥ 0 (1 → /dev/i2c-1) or a path starting with '/'");
 }
 
 namespace {
@@ -313,8 +322,8 @@ GyrodConfig readConfig(const formats::TomlDocument& doc) {
       if (node.is_table())
         throw ConfigError(where + "unknown section [" + std::string(name) + "] (valid sections: " +
                           formats::joinedNames(kSections) + ")" + formats::didYouMean(name, kSections));
-      throw ConfigError(where + "unknown key '" + std::string(name) + "' at top level (keys belong in a section: " +
-                        formats::joinedNames(kSections) + ")");
+      throw ConfigError(where + "unknown key '" + std::string(name) +
+                        "' at top level (keys belong in a section: " + formats::joinedNames(kSections) + ")");
     }
     if (!node.is_table())
       throw ConfigError(where + "key '" + std::string(name) + "': must be a section [" + std::string(name) + "] (got " +

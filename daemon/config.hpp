@@ -50,7 +50,7 @@ struct GpioConfig {
 
 struct BiasConfig {
   BiasSource source = BiasSource::Estimate;
-  double still_seconds = 10.0;             // length of the still period averaged at start (estimate)
+  double still_seconds = 10.0;                // length of the still period averaged at start (estimate)
   std::vector<double> values{0.0, 0.0, 0.0};  // x, y, z in °/s (source = config)
   bool operator==(const BiasConfig&) const = default;
 };
@@ -78,19 +78,19 @@ struct AllanConfig {
 
 struct SocketConfig {
   std::string path = protocol::kDefaultSocketPath;
-  unsigned mode = 0660;             // permission bits of the socket file
-  std::string group;                // group of the socket file; empty = the daemon's group
+  unsigned mode = 0660;                 // permission bits of the socket file
+  std::string group;                    // group of the socket file; empty = the daemon's group
   std::size_t client_buffer_kib = 256;  // per-client output queue before dropping
   bool operator==(const SocketConfig&) const = default;
 };
 
 struct RecordConfig {
-  std::string path;                // base file name, e.g. /var/lib/gyrod/gyro.csv; empty = off
-  double rotate_mb = 64.0;         // start a new file past this size (10^6 bytes); 0 = never
-  double rotate_minutes = 0.0;     // start a new file after this long; 0 = never
-  double flush_interval_s = 1.0;   // how often buffered lines are written (bounds crash loss)
-  bool fsync_each_flush = false;   // also fdatasync() at every flush (power-loss safety, SD wear)
-  std::size_t keep = 10;           // recording files kept (oldest deleted); 0 = keep all
+  std::string path;               // base file name, e.g. /var/lib/gyrod/gyro.csv; empty = off
+  double rotate_mb = 64.0;        // start a new file past this size (10^6 bytes); 0 = never
+  double rotate_minutes = 0.0;    // start a new file after this long; 0 = never
+  double flush_interval_s = 1.0;  // how often buffered lines are written (bounds crash loss)
+  bool fsync_each_flush = false;  // also fdatasync() at every flush (power-loss safety, SD wear)
+  std::size_t keep = 10;          // recording files kept (oldest deleted); 0 = keep all
   bool enabled() const { return !path.empty(); }
   bool operator==(const RecordConfig&) const = default;
 };
@@ -128,7 +128,7 @@ struct MockConfig {
   MockSource source = MockSource::Simulator;
   std::string replay_file;  // recording CSV (t,gx,gy,gz,temp) when source = replay
   std::uint64_t seed = 1;
-  double speed = 1.0;       // 1 = real time; 10 = ten times faster
+  double speed = 1.0;  // 1 = real time; 10 = ten times faster
   MockFaults faults;
   bool operator==(const MockConfig&) const = default;
 };
@@ -163,10 +163,10 @@ std::string i2cDevicePath(std::string_view bus);
 
 // Names the file and the command line accept, as written.
 inline const std::vector<std::string_view> kBackendNames = {"i2c", "mock"};
-inline const std::vector<std::string_view> kLogLevelNames = {"trace", "debug", "info", "warn",
+inline const std::vector<std::string_view> kLogLevelNames = {"trace", "debug",    "info", "warn",
                                                              "error", "critical", "off"};
 inline constexpr std::array<spdlog::level::level_enum, 7> kLogLevels = {
-    spdlog::level::trace, spdlog::level::debug, spdlog::level::info, spdlog::level::warn,
+    spdlog::level::trace, spdlog::level::debug,    spdlog::level::info, spdlog::level::warn,
     spdlog::level::err,   spdlog::level::critical, spdlog::level::off};
 
 }  // namespace gyrod::daemon

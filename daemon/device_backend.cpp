@@ -6,9 +6,9 @@
 
 #include "driver/gpio_data_ready.hpp"
 #include "driver/linux_i2c_bus.hpp"
+#include "driver/mock/simulator_signal_source.hpp"
 #include "driver/mpu6050_config.hpp"
 #include "driver/polling_data_ready.hpp"
-#include "driver/mock/simulator_signal_source.hpp"
 #include "formats/model_toml.hpp"
 #include "formats/recording_csv.hpp"
 

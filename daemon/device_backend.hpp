@@ -25,7 +25,7 @@ namespace gyrod::daemon {
 
 struct DeviceParts {
   std::unique_ptr<driver::Clock> clock;
-  std::unique_ptr<driver::SignalSource> source;          // mock only
+  std::unique_ptr<driver::SignalSource> source;  // mock only
   std::unique_ptr<driver::I2cBus> bus;
   std::unique_ptr<driver::DataReadySource> data_ready_owned;  // GPIO or polling
   driver::DataReadySource* data_ready = nullptr;

@@ -22,7 +22,8 @@ sigset_t signalSet(std::initializer_list<int> signals) {
   sigset_t set;
   sigemptyset(&set);
   for (const int s : signals) {
-    if (sigaddset(&set, s) != 0) throw std::invalid_argument("EventLoop: " + std::to_string(s) + " is not a signal number");
+    if (sigaddset(&set, s) != 0)
+      throw std::invalid_argument("EventLoop: " + std::to_string(s) + " is not a signal number");
   }
   return set;
 }
@@ -60,11 +61,13 @@ void EventLoop::addFd(int fd, std::uint32_t events, FdCallback callback) {
 
 void EventLoop::modifyFd(int fd, std::uint32_t events) {
   const auto it = fd_sources_.find(fd);
-  if (it == fd_sources_.end()) throw std::invalid_argument("EventLoop::modifyFd: fd " + std::to_string(fd) + " is not watched");
+  if (it == fd_sources_.end())
+    throw std::invalid_argument("EventLoop::modifyFd: fd " + std::to_string(fd) + " is not watched");
   epoll_event ev{};
   ev.events = events;
   ev.data.u64 = it->second;
-  if (::epoll_ctl(epoll_.get(), EPOLL_CTL_MOD, fd, &ev) != 0) throw errnoError("epoll_ctl(MOD, fd " + std::to_string(fd) + ")");
+  if (::epoll_ctl(epoll_.get(), EPOLL_CTL_MOD, fd, &ev) != 0)
+    throw errnoError("epoll_ctl(MOD, fd " + std::to_string(fd) + ")");
 }
 
 void EventLoop::removeFd(int fd) noexcept {
@@ -94,13 +97,15 @@ EventLoop::SourceId EventLoop::addTimer(std::chrono::nanoseconds first, std::chr
 
 EventLoop::SourceId EventLoop::addPeriodicTimer(std::chrono::nanoseconds period, TimerCallback callback) {
   if (period <= std::chrono::nanoseconds::zero())
-    throw std::invalid_argument("EventLoop::addPeriodicTimer: period must be > 0 (got " + std::to_string(period.count()) + " ns)");
+    throw std::invalid_argument("EventLoop::addPeriodicTimer: period must be > 0 (got " +
+                                std::to_string(period.count()) + " ns)");
   return addTimer(period, period, false, std::move(callback));
 }
 
 EventLoop::SourceId EventLoop::addOneShotTimer(std::chrono::nanoseconds delay, TimerCallback callback) {
   if (delay <= std::chrono::nanoseconds::zero())
-    throw std::invalid_argument("EventLoop::addOneShotTimer: delay must be > 0 (got " + std::to_string(delay.count()) + " ns)");
+    throw std::invalid_argument("EventLoop::addOneShotTimer: delay must be > 0 (got " + std::to_string(delay.count()) +
+                                " ns)");
   return addTimer(delay, std::chrono::nanoseconds::zero(), true, std::move(callback));
 }
 
@@ -137,9 +142,7 @@ void EventLoop::dispatch(SourceId id, std::uint32_t events) {
   // Keep the source alive while its callback runs, even if the callback removes it.
   const std::shared_ptr<Source> source = it->second;
   switch (source->kind) {
-    case Kind::Fd:
-      source->on_fd(events);
-      break;
+    case Kind::Fd: source->on_fd(events); break;
     case Kind::Timer: {
       std::uint64_t expirations = 0;
       const ssize_t n = ::read(source->fd, &expirations, sizeof expirations);
@@ -166,7 +169,8 @@ std::size_t EventLoop::runOnce(std::chrono::milliseconds timeout) {
     if (errno == EINTR) return 0;
     throw errnoError("epoll_wait");
   }
-  for (int i = 0; i < n; ++i) dispatch(events_[static_cast<std::size_t>(i)].data.u64, events_[static_cast<std::size_t>(i)].events);
+  for (int i = 0; i < n; ++i)
+    dispatch(events_[static_cast<std::size_t>(i)].data.u64, events_[static_cast<std::size_t>(i)].events);
   return static_cast<std::size_t>(n);
 }
 

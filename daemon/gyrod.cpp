@@ -78,9 +78,7 @@ PipelineSettings Gyrod::pipelineSettings(const GyrodConfig& c) {
       s.bias_origin = BiasOrigin::Model;
       s.bias_dps = modelBias(c.filter.model);
       break;
-    case BiasSource::Estimate:
-      s.bias_origin = BiasOrigin::Estimate;
-      break;
+    case BiasSource::Estimate: s.bias_origin = BiasOrigin::Estimate; break;
   }
   s.still_seconds = c.bias.still_seconds;
   s.mean_window = c.filter.mean_window;
@@ -111,7 +109,8 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
   if (config_.record.enabled()) {
     RecorderOptions options = recorderOptions(config_.record, config_.device.rate_hz);
     options.header_comments.push_back("gyrod " + std::string(GYROD_RELEASE) + " recording of " + device_.description);
-    options.header_comments.push_back("raw rates as read from the chip (bias not removed); GAP lines mark lost samples");
+    options.header_comments.push_back(
+        "raw rates as read from the chip (bias not removed); GAP lines mark lost samples");
     recorder_ = std::make_unique<Recorder>(options);
   }
 
@@ -156,8 +155,8 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
   }
 
   spdlog::info("gyrod {}: {} at {} Hz, DLPF_CFG {}, +-{} deg/s; socket {}{}", GYROD_RELEASE, device_.description,
-               config_.device.rate_hz, config_.device.dlpf, config_.device.full_scale_dps, server_->socketPath().empty()
-                   ? std::string("(socket activation)") : server_->socketPath(),
+               config_.device.rate_hz, config_.device.dlpf, config_.device.full_scale_dps,
+               server_->socketPath().empty() ? std::string("(socket activation)") : server_->socketPath(),
                recorder_ ? ", recording to " + recorder_->currentFile() : std::string());
   if (!device_.virtual_clock) spdlog::info("event loop scheduling: {}", loopSchedulingNote());
   if (pipeline_.phase() == PipelinePhase::Estimating)

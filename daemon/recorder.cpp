@@ -82,7 +82,8 @@ RecorderOptions recorderOptions(const RecordConfig& c, double rate_hz) {
 Recorder::Recorder(RecorderOptions options) : options_(std::move(options)), ring_(options_.ring_capacity) {
   if (options_.path.empty()) throw std::invalid_argument("Recorder: path is empty");
   if (!(options_.flush_interval_s > 0.0) || !std::isfinite(options_.flush_interval_s))
-    throw std::invalid_argument("Recorder: flush_interval_s must be > 0 (got " + std::to_string(options_.flush_interval_s) + ")");
+    throw std::invalid_argument("Recorder: flush_interval_s must be > 0 (got " +
+                                std::to_string(options_.flush_interval_s) + ")");
   if (!(options_.rotate_after_s >= 0.0)) throw std::invalid_argument("Recorder: rotate_after_s must be ≥ 0");
   std::size_t header_bytes = recording::kColumnsLine.size() + 128;
   for (const auto& c : options_.header_comments) {
@@ -90,8 +91,8 @@ Recorder::Recorder(RecorderOptions options) : options_(std::move(options)), ring
     header_bytes += c.size() + 3;
   }
   if (header_bytes > kMaxHeaderBytes)
-    throw std::invalid_argument("Recorder: header comments too long (" + std::to_string(header_bytes) + " bytes, at most " +
-                                std::to_string(kMaxHeaderBytes) + ")");
+    throw std::invalid_argument("Recorder: header comments too long (" + std::to_string(header_bytes) +
+                                " bytes, at most " + std::to_string(kMaxHeaderBytes) + ")");
 
   const fs::path p(options_.path);
   directory_ = p.has_parent_path() ? p.parent_path().string() : ".";
@@ -321,7 +322,8 @@ void Recorder::emitPage() {
       if (n < 0 && errno == EINTR) continue;
       const int error_number = n < 0 ? errno : EIO;
       // Take back a partial page so the file still ends with a whole line.
-      if (done > 0 && ::ftruncate(fd_, static_cast<off_t>(file_bytes_)) == 0) ::lseek(fd_, static_cast<off_t>(file_bytes_), SEEK_SET);
+      if (done > 0 && ::ftruncate(fd_, static_cast<off_t>(file_bytes_)) == 0)
+        ::lseek(fd_, static_cast<off_t>(file_bytes_), SEEK_SET);
       reportError("write to " + currentFile(), error_number);
       lost_.fetch_add(page_records_, std::memory_order_relaxed);
       page_.clear();

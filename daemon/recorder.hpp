@@ -53,7 +53,7 @@ struct RecorderOptions {
   double rotate_after_s = 0.0;       // new file at the first flush this long after opening; 0 = never
   double flush_interval_s = 1.0;     // > 0
   bool fsync_each_flush = false;
-  std::size_t keep = 0;              // files of this base name to keep (oldest deleted); 0 = all
+  std::size_t keep = 0;                      // files of this base name to keep (oldest deleted); 0 = all
   std::vector<std::string> header_comments;  // written as "# ..." lines at the top of each file
 };
 
@@ -62,12 +62,12 @@ struct RecorderOptions {
 RecorderOptions recorderOptions(const RecordConfig& config, double rate_hz);
 
 struct RecorderStats {
-  std::uint64_t pushed = 0;         // records accepted into the ring
-  std::uint64_t dropped = 0;        // records refused because the ring was full
-  std::uint64_t written = 0;        // records whose lines write() has accepted
-  std::uint64_t lost_to_errors = 0; // records whose lines could not be written (disk full, I/O error)
-  std::uint64_t write_errors = 0;   // failed write()/open() calls
-  std::uint64_t flushes = 0;        // completed flushes
+  std::uint64_t pushed = 0;          // records accepted into the ring
+  std::uint64_t dropped = 0;         // records refused because the ring was full
+  std::uint64_t written = 0;         // records whose lines write() has accepted
+  std::uint64_t lost_to_errors = 0;  // records whose lines could not be written (disk full, I/O error)
+  std::uint64_t write_errors = 0;    // failed write()/open() calls
+  std::uint64_t flushes = 0;         // completed flushes
   std::uint64_t files_opened = 0;
 };
 
@@ -81,7 +81,7 @@ struct RecorderRecord {
   double t_s = 0.0;
   double gx_dps = 0.0, gy_dps = 0.0, gz_dps = 0.0;
   double temp_c = 0.0;
-  char gap_reason[24] = {};          // Gap: NUL-terminated (truncated) reason token
+  char gap_reason[24] = {};  // Gap: NUL-terminated (truncated) reason token
 };
 
 class Recorder {
@@ -139,11 +139,11 @@ class Recorder {
 
   // Writer-side state (writer thread, and the constructor/stop() before/after it runs).
   int fd_ = -1;
-  std::uint64_t file_bytes_ = 0;        // bytes in the current file (written)
-  std::uint64_t file_records_ = 0;      // sample/gap lines in the current file
-  std::int64_t file_opened_ns_ = 0;     // steady clock
+  std::uint64_t file_bytes_ = 0;     // bytes in the current file (written)
+  std::uint64_t file_records_ = 0;   // sample/gap lines in the current file
+  std::int64_t file_opened_ns_ = 0;  // steady clock
   std::uint64_t next_index_ = 0;
-  std::uint64_t drops_reported_ = 0;    // dropped records already announced in a file
+  std::uint64_t drops_reported_ = 0;  // dropped records already announced in a file
   // Lines formatted but not yet written; padding and rotation are decided when they are
   // written, since both depend on the position in the file.
   std::string pending_;
@@ -152,9 +152,9 @@ class Recorder {
     bool record;      // a sample or gap (counted), not a comment
   };
   std::vector<PendingLine> pending_lines_;
-  std::string page_;                    // bytes for the current page of the file, not yet written
-  std::uint64_t page_records_ = 0;      // records in page_
-  bool in_error_ = false;               // last write failed (log once per episode)
+  std::string page_;                // bytes for the current page of the file, not yet written
+  std::uint64_t page_records_ = 0;  // records in page_
+  bool in_error_ = false;           // last write failed (log once per episode)
   std::atomic<std::uint64_t> written_{0}, lost_{0}, write_errors_{0}, flushes_{0}, files_opened_{0};
 
   mutable std::mutex file_mutex_;  // guards current_file_

@@ -43,7 +43,8 @@ std::string_view toString(BiasOrigin origin) {
 }
 
 SamplePipeline::SamplePipeline(const PipelineSettings& settings)
-    : settings_(validated(settings)), allan_raw_(makeAllanArray(settings)),
+    : settings_(validated(settings)),
+      allan_raw_(makeAllanArray(settings)),
       allan_mean_(makeAllanArray(settings)),
       allan_kalman_(makeAllanArray(settings)) {
   if (settings_.bias_origin != BiasOrigin::Estimate) bias_ = settings_.bias_dps;
@@ -59,12 +60,13 @@ SamplePipeline::SamplePipeline(const PipelineSettings& settings)
     const bool identifying = !(settings_.kalman.a && settings_.kalman.q && settings_.kalman.r);
     if (identifying && still_samples_ < kMinimumIdentificationSamples) {
       std::ostringstream msg;
-      msg << "bias.still_seconds = " << settings_.still_seconds << " gives " << still_samples_
-          << " samples at " << settings_.rate_hz << " Hz; identifying the Kalman filter needs at least "
-          << kMinimumIdentificationSamples << " (or give filter.kalman a, q and r)";
+      msg << "bias.still_seconds = " << settings_.still_seconds << " gives " << still_samples_ << " samples at "
+          << settings_.rate_hz << " Hz; identifying the Kalman filter needs at least " << kMinimumIdentificationSamples
+          << " (or give filter.kalman a, q and r)";
       throw std::invalid_argument(msg.str());
     }
-    if (still_samples_ == 0) throw std::invalid_argument("bias.still_seconds must give at least one sample to estimate the bias");
+    if (still_samples_ == 0)
+      throw std::invalid_argument("bias.still_seconds must give at least one sample to estimate the bias");
     for (auto& v : still_) v.reserve(still_samples_);
     phase_ = PipelinePhase::Estimating;
   } else {
@@ -102,8 +104,8 @@ void SamplePipeline::finishEstimation() {
     }
     for (double& v : x) v -= bias_[axis];
     if (kalmanIdentified()) {
-      params_[axis] = processing::identifyFilterChain(x, settings_.mean_window, settings_.mean_threshold_dps,
-                                                      settings_.kalman);
+      params_[axis] =
+          processing::identifyFilterChain(x, settings_.mean_window, settings_.mean_threshold_dps, settings_.kalman);
     } else {
       params_[axis].kalman = {*settings_.kalman.a, *settings_.kalman.q, *settings_.kalman.r, 0.0, {}};
     }
@@ -145,7 +147,8 @@ void SamplePipeline::reloadFilter(std::size_t mean_window, double mean_threshold
   // Everything is validated on copies first, so that a bad reload changes nothing.
   processing::GrossErrorMeanFilter probe(mean_window, mean_threshold_dps);
   (void)probe;
-  processing::ScalarKalmanFilter given({kalman.a.value_or(0.0), kalman.q.value_or(0.0), kalman.r.value_or(1.0), 0.0, {}});
+  processing::ScalarKalmanFilter given(
+      {kalman.a.value_or(0.0), kalman.q.value_or(0.0), kalman.r.value_or(1.0), 0.0, {}});
   (void)given;
   std::array<processing::FilterChainParameters, kAxes> params = params_;
   for (auto& p : params) {

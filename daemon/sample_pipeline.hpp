@@ -34,8 +34,8 @@ std::string_view toString(BiasOrigin origin);
 struct PipelineSettings {
   double rate_hz = 50.0;
   BiasOrigin bias_origin = BiasOrigin::Estimate;
-  Vec3 bias_dps{};             // used unless bias_origin == Estimate
-  double still_seconds = 10.0; // estimation period (bias and/or Kalman identification)
+  Vec3 bias_dps{};              // used unless bias_origin == Estimate
+  double still_seconds = 10.0;  // estimation period (bias and/or Kalman identification)
   std::size_t mean_window = 20;
   double mean_threshold_dps = 0.3;
   processing::KalmanOverrides kalman;  // given values; the rest are identified
@@ -49,9 +49,9 @@ struct ProcessedSample {
   std::uint64_t seq = 0;
   double t_s = 0.0;
   double temp_c = 0.0;
-  Vec3 raw{};        // as measured (bias not removed)
-  Vec3 mean{};       // mean filter output on raw − bias
-  Vec3 kalman{};     // Kalman output
+  Vec3 raw{};             // as measured (bias not removed)
+  Vec3 mean{};            // mean filter output on raw − bias
+  Vec3 kalman{};          // Kalman output
   bool filtered = false;  // false while estimating: mean/kalman not set
 };
 

@@ -8,12 +8,12 @@
 #include <sys/un.h>
 #include <systemd/sd-daemon.h>
 
+#include <spdlog/spdlog.h>
 #include <algorithm>
 #include <array>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <spdlog/spdlog.h>
 #include <stdexcept>
 
 namespace gyrod::daemon {
@@ -37,7 +37,8 @@ sockaddr_un socketAddress(const std::string& path) {
   if (path.empty()) throw std::invalid_argument("socket path is empty");
   if (path.size() >= sizeof addr.sun_path)
     throw std::invalid_argument("socket path " + singleQuoted(path) + " is " + std::to_string(path.size()) +
-                                " bytes long; a Unix socket path must be shorter than " + std::to_string(sizeof addr.sun_path));
+                                " bytes long; a Unix socket path must be shorter than " +
+                                std::to_string(sizeof addr.sun_path));
   std::memcpy(addr.sun_path, path.data(), path.size());
   return addr;
 }
@@ -130,7 +131,8 @@ class RingBuffer {
 ListeningSocket bindListeningSocket(const SocketOptions& options) {
   namespace fs = std::filesystem;
   const sockaddr_un addr = socketAddress(options.path);
-  if ((options.mode & ~mode_t{0777}) != 0) throw std::invalid_argument("socket mode " + std::to_string(options.mode) + " has bits outside 0777");
+  if ((options.mode & ~mode_t{0777}) != 0)
+    throw std::invalid_argument("socket mode " + std::to_string(options.mode) + " has bits outside 0777");
   // (gid_t)-1 tells chown() to leave the group as it is.
   const gid_t gid = options.group ? groupId(*options.group) : static_cast<gid_t>(-1);
 
@@ -144,13 +146,14 @@ ListeningSocket bindListeningSocket(const SocketOptions& options) {
     }
   }
 
-  struct stat st{};
+  struct stat st {};
   if (::lstat(options.path.c_str(), &st) == 0) {
     if (!S_ISSOCK(st.st_mode))
       throw std::runtime_error(options.path + " exists and is not a socket; refusing to replace it");
     if (socketIsLive(options.path))
       throw std::runtime_error(options.path + " is already in use by a running server (is gyrod already running?)");
-    if (::unlink(options.path.c_str()) != 0) throw errnoError("unlink(" + singleQuoted(options.path) + ") of a stale socket");
+    if (::unlink(options.path.c_str()) != 0)
+      throw errnoError("unlink(" + singleQuoted(options.path) + ") of a stale socket");
     spdlog::info("removed stale socket file {}", options.path);
   } else if (errno != ENOENT) {
     throw errnoError("lstat(" + singleQuoted(options.path) + ")");
@@ -172,7 +175,8 @@ ListeningSocket bindListeningSocket(const SocketOptions& options) {
   ls.path = options.path;
   auto removeOnError = [&] { ::unlink(options.path.c_str()); };
   if (options.group && ::chown(options.path.c_str(), static_cast<uid_t>(-1), gid) != 0) {
-    const auto err = errnoError("chown(" + singleQuoted(options.path) + ", group " + singleQuoted(*options.group) + ")");
+    const auto err =
+        errnoError("chown(" + singleQuoted(options.path) + ", group " + singleQuoted(*options.group) + ")");
     removeOnError();
     throw err;
   }
@@ -213,10 +217,12 @@ std::optional<ListeningSocket> adoptActivatedSocket(std::string_view name) {
     std::string list;
     for (const auto& s : fd_names) list += (list.empty() ? "" : ", ") + s;
     throw std::runtime_error("systemd passed " + std::to_string(n) + " sockets (" + list + ") but none is named " +
-                             singleQuoted(name) + " (set FileDescriptorName=" + std::string(name) + " in the socket unit)");
+                             singleQuoted(name) + " (set FileDescriptorName=" + std::string(name) +
+                             " in the socket unit)");
   }
   if (::sd_is_socket_unix(chosen, SOCK_STREAM, /*listening=*/1, nullptr, 0) <= 0)
-    throw std::runtime_error("fd " + std::to_string(chosen) + " passed by systemd is not a listening Unix stream socket");
+    throw std::runtime_error("fd " + std::to_string(chosen) +
+                             " passed by systemd is not a listening Unix stream socket");
   ListeningSocket ls;
   ls.fd.reset(chosen);
   ls.activated = true;
@@ -255,12 +261,14 @@ struct UnixSocketServer::Client {
   std::uint64_t lines_sent = 0;
 };
 
-UnixSocketServer::UnixSocketServer(EventLoop& loop, ListeningSocket listening, ServerContent& content, ServerOptions options)
+UnixSocketServer::UnixSocketServer(EventLoop& loop, ListeningSocket listening, ServerContent& content,
+                                   ServerOptions options)
     : loop_(loop), listening_(std::move(listening)), content_(content), options_(std::move(options)) {
   if (!listening_.fd) throw std::invalid_argument("UnixSocketServer: no listening socket");
   if (options_.client_buffer_bytes < kMinClientBufferBytes)
-    throw std::invalid_argument("UnixSocketServer: client_buffer_bytes = " + std::to_string(options_.client_buffer_bytes) +
-                                " is below the minimum of " + std::to_string(kMinClientBufferBytes));
+    throw std::invalid_argument(
+        "UnixSocketServer: client_buffer_bytes = " + std::to_string(options_.client_buffer_bytes) +
+        " is below the minimum of " + std::to_string(kMinClientBufferBytes));
   if (options_.max_clients == 0) throw std::invalid_argument("UnixSocketServer: max_clients must be >= 1");
   // Reserved once, so that adding and removing clients never reallocates the list.
   clients_.reserve(options_.max_clients);
@@ -274,14 +282,15 @@ UnixSocketServer::~UnixSocketServer() {
   clients_.clear();
   loop_.removeFd(listening_.fd.get());
   if (!listening_.path.empty()) {
-    struct stat st{};
+    struct stat st {};
     if (::lstat(listening_.path.c_str(), &st) == 0 && st.st_dev == listening_.device && st.st_ino == listening_.inode)
       ::unlink(listening_.path.c_str());
   }
 }
 
 std::size_t UnixSocketServer::watcherCount() const noexcept {
-  return static_cast<std::size_t>(std::count_if(clients_.begin(), clients_.end(), [](const auto& c) { return c->watch && !c->dead; }));
+  return static_cast<std::size_t>(
+      std::count_if(clients_.begin(), clients_.end(), [](const auto& c) { return c->watch && !c->dead; }));
 }
 
 void UnixSocketServer::onListenerReadable() {
@@ -311,8 +320,8 @@ void UnixSocketServer::onListenerReadable() {
 void UnixSocketServer::acceptClient(Fd fd) {
   ++clients_total_;
   if (clients_.size() >= options_.max_clients) {
-    const std::string line = errorLine(ErrorCode::TooManyClients,
-                                       "gyrod serves at most " + std::to_string(options_.max_clients) + " clients at once");
+    const std::string line = errorLine(
+        ErrorCode::TooManyClients, "gyrod serves at most " + std::to_string(options_.max_clients) + " clients at once");
     [[maybe_unused]] const ssize_t n = ::send(fd.get(), line.data(), line.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
     spdlog::warn("refused a client: {} clients already connected", clients_.size());
     return;  // fd closes here
@@ -379,8 +388,8 @@ void UnixSocketServer::readRequests(Client& c) {
 void UnixSocketServer::handleLine(Client& c, std::string_view line) {
   if (line.size() > kMaxRequestLineBytes) {
     spdlog::warn("client {}: request line longer than {} bytes; disconnecting it", c.id, kMaxRequestLineBytes);
-    queueLine(c, errorLine(ErrorCode::LineTooLong, "request lines are limited to " + std::to_string(kMaxRequestLineBytes) +
-                                                       " bytes; disconnecting"));
+    queueLine(c, errorLine(ErrorCode::LineTooLong, "request lines are limited to " +
+                                                       std::to_string(kMaxRequestLineBytes) + " bytes; disconnecting"));
     beginClose(c);
     return;
   }
@@ -475,9 +484,10 @@ void UnixSocketServer::dropSlowClient(Client& c, std::size_t line_size) {
   const std::uint64_t lost = c.lines_queued - c.lines_sent + 1;  // unsent lines, the one that did not fit
   ++clients_dropped_;
   lines_dropped_ += lost;
-  spdlog::warn("client {} (pid {}) is not reading: its {} byte buffer cannot take a {} byte line; "
-               "disconnecting it ({} lines not delivered)",
-               c.id, c.pid.value_or(-1), options_.client_buffer_bytes, line_size, lost);
+  spdlog::warn(
+      "client {} (pid {}) is not reading: its {} byte buffer cannot take a {} byte line; "
+      "disconnecting it ({} lines not delivered)",
+      c.id, c.pid.value_or(-1), options_.client_buffer_bytes, line_size, lost);
   c.dead = true;
 }
 

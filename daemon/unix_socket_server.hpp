@@ -46,9 +46,9 @@ struct SocketOptions {
 // A listening socket and, when we bound it ourselves, the file to remove at exit.
 struct ListeningSocket {
   Fd fd;
-  std::string path;            // empty when adopted from systemd (systemd owns the file)
-  dev_t device = 0;            // identity of the file we bound, so that we never remove
-  ino_t inode = 0;             //   a socket that another process bound there later
+  std::string path;  // empty when adopted from systemd (systemd owns the file)
+  dev_t device = 0;  // identity of the file we bound, so that we never remove
+  ino_t inode = 0;   //   a socket that another process bound there later
   bool activated = false;
 };
 
@@ -80,7 +80,7 @@ class ServerContent {
 };
 
 struct ServerOptions {
-  std::string release = GYROD_RELEASE;         // VERSION "release" (the project version)
+  std::string release = GYROD_RELEASE;           // VERSION "release" (the project version)
   std::size_t client_buffer_bytes = 256 * 1024;  // per client, preallocated
   std::size_t max_clients = 32;                  // more are refused with ERROR too_many_clients
 };

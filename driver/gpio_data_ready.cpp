@@ -29,8 +29,8 @@ const char* edgeName(EdgeDirection e) {
 
 }  // namespace
 
-std::string describeGpioError(const std::string& step, int error, const GpioLineConfig& config,
-                              unsigned int chip_lines, const std::string& current_consumer) {
+std::string describeGpioError(const std::string& step, int error, const GpioLineConfig& config, unsigned int chip_lines,
+                              const std::string& current_consumer) {
   const std::string chip = "GPIO chip '" + config.chip + "'";
   const std::string line = "line " + std::to_string(config.offset) + " of " + chip;
   const std::string sys = std::string(" (") + std::strerror(error) + ")";
@@ -47,10 +47,8 @@ std::string describeGpioError(const std::string& step, int error, const GpioLine
                ": add the user running gyrod to the 'gpio' group (`sudo usermod -aG gpio $USER`, then log in "
                "again), or run it as the gyrod service user set up by the package.";
       case ENOTTY:
-      case ENODEV:
-        return chip + " is not a GPIO character device" + sys + ". Use a /dev/gpiochipN device or its name.";
-      default:
-        return "cannot open " + chip + sys;
+      case ENODEV: return chip + " is not a GPIO character device" + sys + ". Use a /dev/gpiochipN device or its name.";
+      default: return "cannot open " + chip + sys;
     }
   }
   if (step == "line") {
@@ -68,14 +66,12 @@ std::string describeGpioError(const std::string& step, int error, const GpioLine
              (current_consumer.empty() ? std::string() : " by '" + current_consumer + "'") + sys +
              ": another program or a device-tree overlay owns it (see `gpioinfo`). Free it or wire INT to another GPIO.";
     case EACCES:
-    case EPERM:
-      return "permission denied requesting " + line + sys + ": add the user to the 'gpio' group.";
+    case EPERM: return "permission denied requesting " + line + sys + ": add the user to the 'gpio' group.";
     case EINVAL:
     case EOPNOTSUPP:
       return line + " cannot deliver " + edgeName(config.edge) + "-edge events" + sys +
              " (the pin may not support interrupts); choose another GPIO.";
-    default:
-      return std::string("cannot request ") + edgeName(config.edge) + "-edge events on " + line + sys;
+    default: return std::string("cannot request ") + edgeName(config.edge) + "-edge events on " + line + sys;
   }
 }
 
@@ -111,9 +107,8 @@ GpioDataReady::GpioDataReady(const GpioLineConfig& config) {
   if (flags < 0 || fcntl(fd_, F_SETFL, flags | O_NONBLOCK) != 0) {
     const int e = errno;
     gpiod_chip_close(chip_);  // also releases the line
-    throw GpioError("cannot make the event fd of line " + std::to_string(config.offset) + " non-blocking: " +
-                        std::strerror(e),
-                    e);
+    throw GpioError(
+        "cannot make the event fd of line " + std::to_string(config.offset) + " non-blocking: " + std::strerror(e), e);
   }
 }
 

@@ -35,18 +35,12 @@ std::string describeTransferError(int negative_errno) {
       // nobody acknowledges as ENODEV; a removed adapter gives it too.
       return "ENODEV (no device answered at this address, or the I2C adapter is gone. Check power "
              "(3.3 V on VCC), SDA/SCL wiring, the AD0 pin (low = 0x68, high = 0x69) and run `i2cdetect -y 1`)";
-    case EBUSY:
-      return "EBUSY (the bus stayed busy too long: another master, or SDA/SCL held low)";
-    case EINVAL:
-      return "EINVAL (the adapter refused the request: too long a burst or an unsupported transfer)";
-    case EOPNOTSUPP:
-      return "EOPNOTSUPP (the adapter does not support this kind of transfer)";
-    case ENODATA:
-      return "short read (the adapter returned fewer bytes than asked; the transfer was cut off)";
-    case EAGAIN:
-      return "EAGAIN (the adapter was busy; try again)";
-    default:
-      return std::string(busErrorName(negative_errno)) + " (errno " + std::to_string(-negative_errno) + ")";
+    case EBUSY: return "EBUSY (the bus stayed busy too long: another master, or SDA/SCL held low)";
+    case EINVAL: return "EINVAL (the adapter refused the request: too long a burst or an unsupported transfer)";
+    case EOPNOTSUPP: return "EOPNOTSUPP (the adapter does not support this kind of transfer)";
+    case ENODATA: return "short read (the adapter returned fewer bytes than asked; the transfer was cut off)";
+    case EAGAIN: return "EAGAIN (the adapter was busy; try again)";
+    default: return std::string(busErrorName(negative_errno)) + " (errno " + std::to_string(-negative_errno) + ")";
   }
 }
 
@@ -72,10 +66,8 @@ bool isTransientTransferError(int negative_errno) {
     case ETIMEDOUT:
     case EAGAIN:
     case EBUSY:
-    case ENODATA:
-      return true;
-    default:
-      return false;
+    case ENODATA: return true;
+    default: return false;
   }
 }
 

@@ -33,10 +33,8 @@ std::string describeOpenError(int error, const std::string& path) {
     case ENXIO:
     case ENODEV:
       return path + " exists but no adapter is behind it" + sys + " (the controller was removed or failed to probe)";
-    case EBUSY:
-      return path + " is busy" + sys;
-    default:
-      return "cannot open " + path + sys;
+    case EBUSY: return path + " is busy" + sys;
+    default: return "cannot open " + path + sys;
   }
 }
 
@@ -48,9 +46,9 @@ std::string describeFunctionalityError(int error, const std::string& path) {
   return "cannot query the functions of " + path + " (" + std::strerror(error) + ")";
 }
 
-std::array<i2c_msg, 2> registerReadMessages(std::uint8_t address, std::uint8_t* reg_byte,
-                                            std::span<std::uint8_t> out) {
-  if (address > 0x7F) throw std::invalid_argument("registerReadMessages: address must be 7-bit, got " + hexByte(address));
+std::array<i2c_msg, 2> registerReadMessages(std::uint8_t address, std::uint8_t* reg_byte, std::span<std::uint8_t> out) {
+  if (address > 0x7F)
+    throw std::invalid_argument("registerReadMessages: address must be 7-bit, got " + hexByte(address));
   if (out.empty() || out.size() > 0xFFFF) {
     throw std::invalid_argument("registerReadMessages: length must be 1..65535, got " + std::to_string(out.size()));
   }

@@ -40,8 +40,7 @@ std::string describeFunctionalityError(int error, const std::string& path);
 // Buffers are the caller's (`reg_byte` holds the register number; `out` receives the data).
 // Pure: builds, sends nothing. Throws std::invalid_argument for an address above 0x7F or a
 // length outside 1..65535 (i2c_msg.len is 16 bits).
-std::array<i2c_msg, 2> registerReadMessages(std::uint8_t address, std::uint8_t* reg_byte,
-                                            std::span<std::uint8_t> out);
+std::array<i2c_msg, 2> registerReadMessages(std::uint8_t address, std::uint8_t* reg_byte, std::span<std::uint8_t> out);
 
 class LinuxI2cBus final : public I2cBus {
  public:

@@ -74,10 +74,9 @@ std::uint8_t sampleRateDivider(const Mpu6050Config& c) {
   const std::optional<std::uint8_t> div = smplrtDivFor(c.dlpf_cfg, c.sample_rate_hz);
   if (!div) {
     const double internal = mpu6050::gyroOutputRateHz(c.dlpf_cfg);
-    throw std::invalid_argument("Mpu6050Config.sample_rate_hz " + std::to_string(c.sample_rate_hz) +
-                                " is not " + std::to_string(static_cast<int>(internal)) +
-                                " Hz / n for n = 1..256 (with dlpf_cfg " + std::to_string(c.dlpf_cfg) +
-                                "); e.g. 1000, 500, 200, 100, 50, 20, 10 Hz");
+    throw std::invalid_argument("Mpu6050Config.sample_rate_hz " + std::to_string(c.sample_rate_hz) + " is not " +
+                                std::to_string(static_cast<int>(internal)) + " Hz / n for n = 1..256 (with dlpf_cfg " +
+                                std::to_string(c.dlpf_cfg) + "); e.g. 1000, 500, 200, 100, 50, 20, 10 Hz");
   }
   return *div;
 }
@@ -89,8 +88,8 @@ double nominalSamplePeriodNs(const Mpu6050Config& c) {
 std::int64_t pollingPeriodNs(const Mpu6050Config& c) {
   const double fastest_period = nominalSamplePeriodNs(c) / (1.0 + c.max_clock_error);
   const double frames = static_cast<double>(kCloneFifoSize / kFrameBytes);
-  double period = std::min({frames * fastest_period / 4.0, 100e6,
-                            static_cast<double>(c.max_frames_per_wakeup) * fastest_period / 2.0});
+  double period = std::min(
+      {frames * fastest_period / 4.0, 100e6, static_cast<double>(c.max_frames_per_wakeup) * fastest_period / 2.0});
   period = std::max(period, 1e6);
   return static_cast<std::int64_t>(period);
 }
@@ -109,8 +108,8 @@ void validateConfig(const Mpu6050Config& c) {
   }
   const int max_frames = static_cast<int>(mpu6050::fifo::kSize / kFrameBytes);
   if (c.max_frames_per_wakeup < 1 || c.max_frames_per_wakeup > max_frames) {
-    bad("max_frames_per_wakeup", "must be 1.." + std::to_string(max_frames) + ", got " +
-                                     std::to_string(c.max_frames_per_wakeup));
+    bad("max_frames_per_wakeup",
+        "must be 1.." + std::to_string(max_frames) + ", got " + std::to_string(c.max_frames_per_wakeup));
   }
   if (c.register_check_interval_ns <= 0) bad("register_check_interval_ns", "must be > 0");
   if (!(c.alignment_bound_c > 0.0 && c.alignment_bound_c < 50.0)) {
@@ -149,8 +148,8 @@ std::array<RegisterSetting, kRegisterTableSize> registerTableFor(const Mpu6050Co
   std::uint8_t pin = 0;
   if (c.int_active_low) pin |= reg::INT_LEVEL;
   if (c.int_open_drain) pin |= reg::INT_OPEN;
-  const std::uint8_t pin_clear = static_cast<std::uint8_t>(
-      ((reg::INT_LEVEL | reg::INT_OPEN) & ~pin) | reg::LATCH_INT_EN | reg::INT_RD_CLEAR | reg::FSYNC_INT_EN);
+  const std::uint8_t pin_clear = static_cast<std::uint8_t>(((reg::INT_LEVEL | reg::INT_OPEN) & ~pin) |
+                                                           reg::LATCH_INT_EN | reg::INT_RD_CLEAR | reg::FSYNC_INT_EN);
   return {{
       // Written in this order. Wake with the PLL on the X gyro as clock source (RM Register
       // 107 recommends a gyro reference over the internal oscillator).

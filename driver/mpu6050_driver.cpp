@@ -93,8 +93,7 @@ void Mpu6050Driver::onDataReady() {
   if (step_ != Step::Streaming) {
     // Drain, so a level-triggered loop does not spin; these edges belong to no segment.
     std::int64_t t = 0;
-    for (int i = 0; i < 4096 && data_ready_.consumeEdge(t) == 0; ++i) {
-    }
+    for (int i = 0; i < 4096 && data_ready_.consumeEdge(t) == 0; ++i) {}
     stashed_edge_.reset();
     return;
   }
@@ -106,8 +105,7 @@ void Mpu6050Driver::onDataReady() {
     return;
   }
   if (config_.data_ready_mode == DataReadyMode::Polling) {
-    for (int i = 0; i < 4096 && data_ready_.consumeEdge(t) == 0; ++i) {
-    }
+    for (int i = 0; i < 4096 && data_ready_.consumeEdge(t) == 0; ++i) {}
     readFifo(Trigger::Poll);
     return;
   }
@@ -145,8 +143,8 @@ void Mpu6050Driver::doProbe() {
   if (!ever_streamed_ && status_.state != DeviceState::Failed) setState(DeviceState::Probing, status_.reason);
   const int sel = bus_.selectDevice(config_.address);
   if (sel != 0) {
-    enterRecovery(GapCause::DeviceUnreachable, 0, "cannot address the " + where() + ": " +
-                                                      describeSelectError(sel, config_.address));
+    enterRecovery(GapCause::DeviceUnreachable, 0,
+                  "cannot address the " + where() + ": " + describeSelectError(sel, config_.address));
     return;
   }
   std::uint8_t who = 0;
@@ -169,8 +167,8 @@ void Mpu6050Driver::doProbe() {
               "scale may differ, so °C may be off by a few degrees.");
     }
   } else {
-    const std::string reason = "WHO_AM_I of the device at " + hexByte(config_.address) + " on " +
-                               config_.bus_name + " reads " + hexByte(who) +
+    const std::string reason = "WHO_AM_I of the device at " + hexByte(config_.address) + " on " + config_.bus_name +
+                               " reads " + hexByte(who) +
                                ": not an MPU6050 (0x68) nor a known clone (0x70, 0x72, 0x98). Another chip "
                                "answers at this address (an RTC also uses 0x68); check the wiring and address.";
     if (!ever_streamed_) {
@@ -275,8 +273,8 @@ void Mpu6050Driver::doStartFifo() {
     }
     if (!table_[i].matches(v)) {
       const std::string what = "register " + hexByte(mpu6050::address(table_[i].reg)) + " of the " + where() +
-                               " reads " + hexByte(v) + " after configuration (wanted bits " +
-                               hexByte(table_[i].set) + " set, " + hexByte(table_[i].clear) + " clear)";
+                               " reads " + hexByte(v) + " after configuration (wanted bits " + hexByte(table_[i].set) +
+                               " set, " + hexByte(table_[i].clear) + " clear)";
       if (++configure_attempts_ < kMaxConfigureAttempts) {
         log(LogLevel::Warning, what + "; configuring again");
         doConfigure();
@@ -359,7 +357,6 @@ int Mpu6050Driver::writeRegister(Register r, std::uint8_t value) {
 int Mpu6050Driver::readWord(Register r, std::uint16_t& value) {
   return withRetries([&] { return bus_.readWordBigEndian(mpu6050::address(r), value); });
 }
-
 
 // ---------------------------------------------------------------------------------------
 // State and messages

@@ -41,8 +41,8 @@ class Mpu6050Driver {
  public:
   // All references must outlive the driver. Throws std::invalid_argument for a bad config
   // (validateConfig) — the only exception it ever throws.
-  Mpu6050Driver(I2cBus& bus, DataReadySource& data_ready, const Clock& clock, SampleSink& sink,
-                Mpu6050Config config, LogFunction log = {});
+  Mpu6050Driver(I2cBus& bus, DataReadySource& data_ready, const Clock& clock, SampleSink& sink, Mpu6050Config config,
+                LogFunction log = {});
   Mpu6050Driver(const Mpu6050Driver&) = delete;
   Mpu6050Driver& operator=(const Mpu6050Driver&) = delete;
 
@@ -86,8 +86,8 @@ class Mpu6050Driver {
   void abandonSegment(GapCause cause, std::uint64_t& counter, const std::string& message, int error = 0);
   void noteMissedDataReady(std::int64_t now);
   void observeNewestFrame(std::int64_t observation_ns, std::size_t frames_available);
-  bool readFrames(std::size_t frames);      // false: abandoned
-  bool framesAligned(std::size_t frames);   // false: abandoned
+  bool readFrames(std::size_t frames);     // false: abandoned
+  bool framesAligned(std::size_t frames);  // false: abandoned
   void collectEdges(std::int64_t before_ns, std::int64_t after_ns, std::optional<std::int64_t>& newest,
                     bool& ambiguous);
   bool determineSegmentBase(std::optional<std::int64_t> observation_ns, std::size_t frames_available,
@@ -153,12 +153,12 @@ class Mpu6050Driver {
   std::size_t next_check_ = 0;
 
   // The current FIFO segment: frames since the last FIFO reset.
-  std::int64_t segment_start_ns_ = 0;   // time the FIFO reset completed
+  std::int64_t segment_start_ns_ = 0;  // time the FIFO reset completed
   bool segment_base_known_ = false;
-  std::uint64_t segment_base_ = 0;      // sequence number of the segment's frame 0
-  std::uint64_t segment_frames_ = 0;    // frames delivered (or consumed) in this segment
-  int sync_waits_ = 0;                  // wake-ups spent waiting for a usable edge
-  bool phase_broken_ = false;           // the chip restarted its sample clock since the last segment
+  std::uint64_t segment_base_ = 0;         // sequence number of the segment's frame 0
+  std::uint64_t segment_frames_ = 0;       // frames delivered (or consumed) in this segment
+  int sync_waits_ = 0;                     // wake-ups spent waiting for a usable edge
+  bool phase_broken_ = false;              // the chip restarted its sample clock since the last segment
   std::optional<GapCause> pending_cause_;  // why the previous segment ended
 
   // Sequence and time.

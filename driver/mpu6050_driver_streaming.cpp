@@ -241,8 +241,7 @@ bool Mpu6050Driver::readFrames(std::size_t frames) {
       // FIFO's position is unknown. Reset it; the sample clock counts what was lost.
       ++counters_.transfers_failed;
       abandonSegment(GapCause::TransferError, counters_.fifo_transfer_errors,
-                     "FIFO read from the " + where() + " failed: " + describeTransferError(br) +
-                         "; resetting the FIFO",
+                     "FIFO read from the " + where() + " failed: " + describeTransferError(br) + "; resetting the FIFO",
                      br);
       return false;
     }
@@ -329,8 +328,8 @@ bool Mpu6050Driver::determineSegmentBase(std::optional<std::int64_t> observation
     ++counters_.gaps;
     counters_.samples_lost += gap.count;
     log(LogLevel::Warning, "lost " + std::to_string(gap.count) + " samples (seq " + std::to_string(gap.first_seq) +
-                               ".." + std::to_string(gap.first_seq + gap.count - 1) + ", " +
-                               gapCauseName(gap.cause) + ")");
+                               ".." + std::to_string(gap.first_seq + gap.count - 1) + ", " + gapCauseName(gap.cause) +
+                               ")");
     sink_.onGap(gap);
   }
   pending_cause_.reset();

@@ -216,8 +216,7 @@ struct [[gnu::packed]] FullFrame {
   std::uint8_t GYRO_ZOUT_H, GYRO_ZOUT_L;
 };
 static_assert(sizeof(FullFrame) == 14);
-static_assert(frameSize(TEMP_FIFO_EN | XG_FIFO_EN | YG_FIFO_EN | ZG_FIFO_EN | ACCEL_FIFO_EN) ==
-              sizeof(FullFrame));
+static_assert(frameSize(TEMP_FIFO_EN | XG_FIFO_EN | YG_FIFO_EN | ZG_FIFO_EN | ACCEL_FIFO_EN) == sizeof(FullFrame));
 
 // Frame layout gyrod's driver uses (FIFO_EN = 0xF0): temperature as the sync marker, then
 // the gyro (registers 0x41..0x48).
@@ -228,8 +227,7 @@ struct [[gnu::packed]] TempGyroFrame {
   std::uint8_t GYRO_ZOUT_H, GYRO_ZOUT_L;
 };
 static_assert(sizeof(TempGyroFrame) == 8);
-static_assert(frameSize(TEMP_FIFO_EN | XG_FIFO_EN | YG_FIFO_EN | ZG_FIFO_EN) ==
-              sizeof(TempGyroFrame));
+static_assert(frameSize(TEMP_FIFO_EN | XG_FIFO_EN | YG_FIFO_EN | ZG_FIFO_EN) == sizeof(TempGyroFrame));
 
 }  // namespace fifo
 

@@ -20,8 +20,8 @@ struct GyroSample {
   // CLOCK_MONOTONIC ns when the chip produced the sample (its data-ready edge), from the
   // sensor's own sample clock anchored to the edges. Never wall-clock time.
   std::int64_t t_ns = 0;
-  std::array<double, 3> rate_dps{};  // x, y, z in °/s (chip axes, signs as the chip reports)
-  double temp_c = 0.0;               // die temperature, °C
+  std::array<double, 3> rate_dps{};        // x, y, z in °/s (chip axes, signs as the chip reports)
+  double temp_c = 0.0;                     // die temperature, °C
   std::array<std::int16_t, 3> raw_gyro{};  // the frame's words, for recording and tests
   std::int16_t raw_temp = 0;
 };
@@ -60,29 +60,29 @@ const char* deviceStateName(DeviceState state);
 
 struct DeviceStatus {
   DeviceState state = DeviceState::Probing;
-  std::string reason;     // empty while all is well
-  bool retrying = true;   // false only for a refusal that retrying cannot fix (wrong chip)
+  std::string reason;         // empty while all is well
+  bool retrying = true;       // false only for a refusal that retrying cannot fix (wrong chip)
   std::uint8_t who_am_i = 0;  // last value read, 0 before the first probe
 };
 
 // Everything the driver counts, for STATUS. Monotonic over the driver's life.
 struct DriverCounters {
-  std::uint64_t transfers_failed = 0;    // every failed bus transfer (each attempt)
-  std::uint64_t retries = 0;             // transfers repeated after a transient error
-  std::uint64_t operations_failed = 0;   // register operations that failed after retries
+  std::uint64_t transfers_failed = 0;   // every failed bus transfer (each attempt)
+  std::uint64_t retries = 0;            // transfers repeated after a transient error
+  std::uint64_t operations_failed = 0;  // register operations that failed after retries
   std::uint64_t fifo_overflows = 0;
-  std::uint64_t fifo_resets = 0;         // every FIFO reset, whatever the cause
-  std::uint64_t misaligned_bursts = 0;   // temperature sync check failed
+  std::uint64_t fifo_resets = 0;           // every FIFO reset, whatever the cause
+  std::uint64_t misaligned_bursts = 0;     // temperature sync check failed
   std::uint64_t fifo_transfer_errors = 0;  // FIFO bursts that failed (contents then unknown)
-  std::uint64_t device_resets = 0;       // DEVICE_RESET written
-  std::uint64_t configures = 0;          // register table written (first time included)
-  std::uint64_t silent_resets = 0;       // register read-back found the table lost
-  std::uint64_t recoveries = 0;          // entries into the backoff/recovery path
-  std::uint64_t data_ready_missed = 0;   // watchdog reads that found data no edge announced
-  std::uint64_t empty_wakeups = 0;       // data-ready or poll with an empty FIFO
-  std::uint64_t backlog_capped = 0;      // wake-ups that left frames for the next one
+  std::uint64_t device_resets = 0;         // DEVICE_RESET written
+  std::uint64_t configures = 0;            // register table written (first time included)
+  std::uint64_t silent_resets = 0;         // register read-back found the table lost
+  std::uint64_t recoveries = 0;            // entries into the backoff/recovery path
+  std::uint64_t data_ready_missed = 0;     // watchdog reads that found data no edge announced
+  std::uint64_t empty_wakeups = 0;         // data-ready or poll with an empty FIFO
+  std::uint64_t backlog_capped = 0;        // wake-ups that left frames for the next one
   std::uint64_t samples_delivered = 0;
-  std::uint64_t samples_lost = 0;        // sum of all gap counts
+  std::uint64_t samples_lost = 0;  // sum of all gap counts
   std::uint64_t gaps = 0;
   std::uint64_t timestamp_rejections = 0;  // edge observations outside the plausible bound
   std::uint64_t timestamp_relocks = 0;     // the sample clock was re-anchored hard
@@ -121,7 +121,7 @@ struct Mpu6050Config {
   double sample_rate_hz = 50.0;
   // CONFIG.DLPF_CFG 0..6: 4 is 20 Hz gyro bandwidth, below the 25 Hz Nyquist of 50 Hz.
   int dlpf_cfg = 4;
-  int fs_sel = 0;  // GYRO_CONFIG.FS_SEL 0..3: ±250, ±500, ±1000, ±2000 °/s
+  int fs_sel = 0;               // GYRO_CONFIG.FS_SEL 0..3: ±250, ±500, ±1000, ±2000 °/s
   bool int_active_low = false;  // INT_PIN_CFG.INT_LEVEL
   bool int_open_drain = false;  // INT_PIN_CFG.INT_OPEN
   DataReadyMode data_ready_mode = DataReadyMode::InterruptEdges;
@@ -130,12 +130,12 @@ struct Mpu6050Config {
   std::int64_t polling_period_ns = 0;
 
   // Robustness knobs; the defaults are what the tests and docs/driver.md assume.
-  int transfer_attempts = 3;                 // per register transfer (1 + 2 retries)
-  int max_frames_per_wakeup = 32;            // backlog cap per wake-up
+  int transfer_attempts = 3;                              // per register transfer (1 + 2 retries)
+  int max_frames_per_wakeup = 32;                         // backlog cap per wake-up
   std::int64_t register_check_interval_ns = 100'000'000;  // one table entry per interval
-  double alignment_bound_c = 1.0;            // |frame temperature − TEMP_OUT| allowed, °C
-  double max_clock_error = 0.10;             // plausible |period/nominal − 1|
-  int failures_before_recovery = 3;          // failed operations (decaying score) → recovery
+  double alignment_bound_c = 1.0;                         // |frame temperature − TEMP_OUT| allowed, °C
+  double max_clock_error = 0.10;                          // plausible |period/nominal − 1|
+  int failures_before_recovery = 3;                       // failed operations (decaying score) → recovery
   std::int64_t backoff_initial_ns = 50'000'000;
   std::int64_t backoff_max_ns = 2'000'000'000;
   int recovery_attempts_before_failed = 5;   // then DeviceState::Failed (still retrying)

@@ -19,7 +19,7 @@ namespace gyrod::driver {
 
 struct SampleClockConfig {
   double nominal_period_ns = 20e6;
-  double max_clock_error = 0.10;     // plausible relative period error
+  double max_clock_error = 0.10;  // plausible relative period error
   // How far (ns) an observation may be from the model and still be believed, once the
   // period is known. Edges: latency/jitter of the interrupt path; polling: half a period
   // plus margin, because the newest sample may be up to one period old.
@@ -27,9 +27,9 @@ struct SampleClockConfig {
   // The observed time is this much later than the sample on average (0 for edges; half a
   // period for polling, where the newest sample is uniformly 0..P old).
   double observation_bias_ns = 0.0;
-  double easing = 0.1;               // fraction of the residual the anchor moves per observation
-  int acquisition_observations = 8;  // after a lock, anchor hard on this many observations
-  int rejections_before_relock = 4;  // consecutive implausible observations → hard re-anchor
+  double easing = 0.1;                    // fraction of the residual the anchor moves per observation
+  int acquisition_observations = 8;       // after a lock, anchor hard on this many observations
+  int rejections_before_relock = 4;       // consecutive implausible observations → hard re-anchor
   std::uint64_t baseline_window = 30000;  // samples; the period baseline is renewed after this
 };
 

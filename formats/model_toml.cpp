@@ -34,7 +34,8 @@ class ModelReader {
     if (!node.is_number())
       fail(key.source(), where + std::string(key.str()) + " must be a number, got " + tomlTypeName(node));
     const double v = *node.value<double>();
-    if (!std::isfinite(v)) fail(key.source(), where + std::string(key.str()) + " must be finite, got " + formatNumber(v));
+    if (!std::isfinite(v))
+      fail(key.source(), where + std::string(key.str()) + " must be finite, got " + formatNumber(v));
     return v;
   }
   double nonNegative(const toml::node& node, const toml::key& key, const std::string& where) const {
@@ -58,8 +59,8 @@ class ModelReader {
   }
   const toml::table& table(const toml::node& node, const toml::key& key) const {
     if (!node.is_table())
-      fail(key.source(), std::string(key.str()) + " must be a table ([" + std::string(key.str()) + "]), got " +
-                             tomlTypeName(node));
+      fail(key.source(),
+           std::string(key.str()) + " must be a table ([" + std::string(key.str()) + "]), got " + tomlTypeName(node));
     return *node.as_table();
   }
 
@@ -97,11 +98,17 @@ class ModelReader {
   void readTemperature(const toml::table& t, processing::TemperatureModel& temp) const {
     for (auto&& [key, node] : t) {
       const std::string k(key.str());
-      if (k == "start_c") temp.start_c = number(node, key, "temperature.");
-      else if (k == "final_c") temp.final_c = number(node, key, "temperature.");
-      else if (k == "time_constant_s") temp.time_constant_s = positive(node, key, "temperature.");
-      else if (k == "noise_std_c") temp.noise_std_c = nonNegative(node, key, "temperature.");
-      else fail(key.source(), "unknown key '" + k + "' in [temperature] (expected start_c, final_c, time_constant_s, noise_std_c)");
+      if (k == "start_c")
+        temp.start_c = number(node, key, "temperature.");
+      else if (k == "final_c")
+        temp.final_c = number(node, key, "temperature.");
+      else if (k == "time_constant_s")
+        temp.time_constant_s = positive(node, key, "temperature.");
+      else if (k == "noise_std_c")
+        temp.noise_std_c = nonNegative(node, key, "temperature.");
+      else
+        fail(key.source(),
+             "unknown key '" + k + "' in [temperature] (expected start_c, final_c, time_constant_s, noise_std_c)");
     }
   }
 
@@ -125,8 +132,8 @@ class ModelReader {
         readExtra(table(node, key), axis, out.extra);
       } else {
         fail(key.source(), "unknown key '" + k + "' in [" + axis +
-                               "] (expected the five noise-term keys of noise_terms.hpp, bias_dps, [" + axis + ".ar], [" +
-                               axis + ".extra])");
+                               "] (expected the five noise-term keys of noise_terms.hpp, bias_dps, [" + axis +
+                               ".ar], [" + axis + ".extra])");
       }
     }
   }
@@ -140,12 +147,18 @@ class ModelReader {
     const std::string where = axis + ".extra.";
     for (auto&& [key, node] : t) {
       const std::string k(key.str());
-      if (k == "temperature_coefficient_dps_per_c") e.temperature_coefficient_dps_per_c = number(node, key, where);
-      else if (k == "temperature_reference_c") e.temperature_reference_c = number(node, key, where);
-      else if (k == "gauss_markov_tau_s") e.gauss_markov_tau_s = nonNegative(node, key, where);
-      else if (k == "gauss_markov_sigma_dps") e.gauss_markov_sigma_dps = nonNegative(node, key, where);
-      else if (k == "outlier_amplitude_dps") e.outlier_amplitude_dps = nonNegative(node, key, where);
-      else if (k == "outlier_count") e.outlier_count = static_cast<std::size_t>(integerIn(node, key, 0, 1000000000));
+      if (k == "temperature_coefficient_dps_per_c")
+        e.temperature_coefficient_dps_per_c = number(node, key, where);
+      else if (k == "temperature_reference_c")
+        e.temperature_reference_c = number(node, key, where);
+      else if (k == "gauss_markov_tau_s")
+        e.gauss_markov_tau_s = nonNegative(node, key, where);
+      else if (k == "gauss_markov_sigma_dps")
+        e.gauss_markov_sigma_dps = nonNegative(node, key, where);
+      else if (k == "outlier_amplitude_dps")
+        e.outlier_amplitude_dps = nonNegative(node, key, where);
+      else if (k == "outlier_count")
+        e.outlier_count = static_cast<std::size_t>(integerIn(node, key, 0, 1000000000));
       else if (k == "sinusoids" || k == "bias_steps") {
         if (!node.is_array())
           fail(key.source(), where + k + " must be an array of inline tables, got " + tomlTypeName(node));
@@ -156,19 +169,27 @@ class ModelReader {
             processing::SinusoidEffect sin;
             for (auto&& [ek, ev] : *element.as_table()) {
               const std::string n(ek.str());
-              if (n == "freq_hz") sin.freq_hz = positive(ev, ek, where + "sinusoids.");
-              else if (n == "amp_dps") sin.amp_dps = nonNegative(ev, ek, where + "sinusoids.");
-              else if (n == "phase_rad") sin.phase_rad = number(ev, ek, where + "sinusoids.");
-              else fail(ek.source(), "unknown key '" + n + "' in " + where + "sinusoids (expected freq_hz, amp_dps, phase_rad)");
+              if (n == "freq_hz")
+                sin.freq_hz = positive(ev, ek, where + "sinusoids.");
+              else if (n == "amp_dps")
+                sin.amp_dps = nonNegative(ev, ek, where + "sinusoids.");
+              else if (n == "phase_rad")
+                sin.phase_rad = number(ev, ek, where + "sinusoids.");
+              else
+                fail(ek.source(),
+                     "unknown key '" + n + "' in " + where + "sinusoids (expected freq_hz, amp_dps, phase_rad)");
             }
             e.sinusoids.push_back(sin);
           } else {
             processing::BiasStepEffect step;
             for (auto&& [ek, ev] : *element.as_table()) {
               const std::string n(ek.str());
-              if (n == "time_s") step.time_s = nonNegative(ev, ek, where + "bias_steps.");
-              else if (n == "size_dps") step.size_dps = number(ev, ek, where + "bias_steps.");
-              else fail(ek.source(), "unknown key '" + n + "' in " + where + "bias_steps (expected time_s, size_dps)");
+              if (n == "time_s")
+                step.time_s = nonNegative(ev, ek, where + "bias_steps.");
+              else if (n == "size_dps")
+                step.size_dps = number(ev, ek, where + "bias_steps.");
+              else
+                fail(ek.source(), "unknown key '" + n + "' in " + where + "bias_steps (expected time_s, size_dps)");
             }
             e.bias_steps.push_back(step);
           }

@@ -34,8 +34,8 @@
 #include <string>
 #include <string_view>
 
-#include "processing/noise_simulator.hpp"
 #include "formats/recording_csv.hpp"
+#include "processing/noise_simulator.hpp"
 
 namespace gyrod::recording {
 

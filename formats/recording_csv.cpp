@@ -35,7 +35,8 @@ std::vector<std::string_view> splitFields(std::string_view line) {
   std::size_t start = 0;
   while (true) {
     const auto comma = line.find(',', start);
-    fields.push_back(trim(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start)));
+    fields.push_back(
+        trim(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start)));
     if (comma == std::string_view::npos) break;
     start = comma + 1;
   }
@@ -111,7 +112,8 @@ Recording readRecordingCsv(const std::string& path) {
     const auto names = splitFields(first);
     if (names.size() == 1 && first.find(',') == std::string_view::npos &&
         std::find(kKnownColumns.begin(), kKnownColumns.end(), names[0]) == kKnownColumns.end())
-      fail(path, line_no, "'" + std::string(names[0]) + "' is neither a number nor a header of columns t,gx,gy,gz,temp");
+      fail(path, line_no,
+           "'" + std::string(names[0]) + "' is neither a number nor a header of columns t,gx,gy,gz,temp");
     bool have_t = false, have_temp = false;
     for (auto name : names) {
       if (std::find(kKnownColumns.begin(), kKnownColumns.end(), name) == kKnownColumns.end())
@@ -144,10 +146,10 @@ Recording readRecordingCsv(const std::string& path) {
     }
     rec.line_numbers.push_back(line_no);
     for (std::size_t c = 0; c < fields.size(); ++c) {
-      const std::string column = bare_numbers ? std::string("value")
-                                 : roles[c].first == Role::T ? std::string("t")
+      const std::string column = bare_numbers                   ? std::string("value")
+                                 : roles[c].first == Role::T    ? std::string("t")
                                  : roles[c].first == Role::Temp ? std::string("temp")
-                                                                 : rec.axis_names[roles[c].second];
+                                                                : rec.axis_names[roles[c].second];
       const auto value = parseNumber(fields[c]);
       if (!value) fail(path, line_no, "column '" + column + "': '" + std::string(fields[c]) + "' is not a number");
       if (!std::isfinite(*value))

@@ -23,12 +23,12 @@ class RecordingError : public std::runtime_error {
 
 struct Recording {
   std::string path;
-  std::vector<double> t;                 // empty when the file has no t column
-  std::vector<std::string> axis_names;   // "gx", "gy", "gz" in file order (or "x" for bare numbers)
-  std::vector<std::vector<double>> axes; // one vector per axis_names entry
-  std::vector<double> temp;              // empty when absent
-  std::vector<std::size_t> line_numbers; // file line of each sample, for error messages
-  std::vector<LostSamples> lost;         // the GAP and DROPPED lines, in file order
+  std::vector<double> t;                  // empty when the file has no t column
+  std::vector<std::string> axis_names;    // "gx", "gy", "gz" in file order (or "x" for bare numbers)
+  std::vector<std::vector<double>> axes;  // one vector per axis_names entry
+  std::vector<double> temp;               // empty when absent
+  std::vector<std::size_t> line_numbers;  // file line of each sample, for error messages
+  std::vector<LostSamples> lost;          // the GAP and DROPPED lines, in file order
   std::size_t size() const { return axes.empty() ? 0 : axes.front().size(); }
   const std::vector<double>* axis(const std::string& name) const;
 };

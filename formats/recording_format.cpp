@@ -52,8 +52,8 @@ class LineWriter {
 std::optional<std::string_view> field(std::string_view& rest, std::string_view key) {
   if (rest.substr(0, key.size()) != key || rest.substr(key.size(), 1) != "=") return std::nullopt;
   const auto space = rest.find(' ');
-  const auto value = rest.substr(key.size() + 1, space == std::string_view::npos ? std::string_view::npos
-                                                                                  : space - key.size() - 1);
+  const auto value =
+      rest.substr(key.size() + 1, space == std::string_view::npos ? std::string_view::npos : space - key.size() - 1);
   rest = space == std::string_view::npos ? std::string_view() : rest.substr(space + 1);
   if (value.empty()) return std::nullopt;
   return value;

@@ -58,8 +58,8 @@ struct LostSamples {
   Kind kind = Kind::Gap;
   std::uint64_t count = 0;
   std::string reason;
-  std::uint64_t seq = 0;  // Gap: sequence number of the first missing sample
-  double t_s = 0.0;       // Gap: time of the first missing sample
+  std::uint64_t seq = 0;          // Gap: sequence number of the first missing sample
+  double t_s = 0.0;               // Gap: time of the first missing sample
   std::size_t line = 0;           // file line (set by the reader)
   std::size_t before_sample = 0;  // index of the first sample after the line (set by the reader)
   bool operator==(const LostSamples&) const = default;

@@ -28,8 +28,7 @@ std::size_t editDistance(std::string_view a, std::string_view b) {
 
 }  // namespace
 
-TomlDocument::TomlDocument(std::string_view text, std::string file, SyntaxErrorColumn column)
-    : file_(std::move(file)) {
+TomlDocument::TomlDocument(std::string_view text, std::string file, SyntaxErrorColumn column) : file_(std::move(file)) {
   try {
     root_ = toml::parse(text, file_);
   } catch (const toml::parse_error& e) {
@@ -118,8 +117,8 @@ TomlSection::TomlSection(const std::string& file, const toml::table& table, std:
     (void)node;
     if (std::find(keys_.begin(), keys_.end(), key.str()) != keys_.end()) continue;
     std::ostringstream s;
-    s << location(key.source()) << "unknown key '" << key.str() << "' in [" << name_ << "] (valid keys: "
-      << joinedNames(keys_) << ")" << didYouMean(key.str(), keys_);
+    s << location(key.source()) << "unknown key '" << key.str() << "' in [" << name_
+      << "] (valid keys: " << joinedNames(keys_) << ")" << didYouMean(key.str(), keys_);
     throw TomlError(s.str());
   }
 }
@@ -146,9 +145,12 @@ std::optional<double> TomlSection::number(std::string_view key) const {
 
 double TomlSection::numberFrom(const toml::node& n, std::string_view key) const {
   double v = 0.0;
-  if (auto i = n.as_integer()) v = static_cast<double>(i->get());
-  else if (auto f = n.as_floating_point()) v = f->get();
-  else failType(n, key, "must be a number");
+  if (auto i = n.as_integer())
+    v = static_cast<double>(i->get());
+  else if (auto f = n.as_floating_point())
+    v = f->get();
+  else
+    failType(n, key, "must be a number");
   if (!std::isfinite(v)) fail(n, key, "must be a finite number", tomlRendered(n));
   return v;
 }

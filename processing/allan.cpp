@@ -32,8 +32,8 @@ double compensatedMean(std::span<const double> rate, const char* where) {
   for (std::size_t i = 0; i < rate.size(); ++i) {
     const double v = rate[i];
     if (!std::isfinite(v)) {
-      throw std::invalid_argument(std::string(where) + ": rate[" + std::to_string(i) +
-                                  "] is not finite (" + formatNumber(v) + ")");
+      throw std::invalid_argument(std::string(where) + ": rate[" + std::to_string(i) + "] is not finite (" +
+                                  formatNumber(v) + ")");
     }
     const double t = sum + v;
     compensation += std::abs(sum) >= std::abs(v) ? (sum - t) + v : (v - t) + sum;
@@ -49,8 +49,7 @@ class SumOfSquares {
  public:
   void add(double block_total) {
     const double t = sum_ + block_total;
-    compensation_ += std::abs(sum_) >= std::abs(block_total) ? (sum_ - t) + block_total
-                                                             : (block_total - t) + sum_;
+    compensation_ += std::abs(sum_) >= std::abs(block_total) ? (sum_ - t) + block_total : (block_total - t) + sum_;
     sum_ = t;
   }
   double total() const { return sum_ + compensation_; }
@@ -174,9 +173,7 @@ Lag1 lag1Autocorrelation(std::span<const double> z) {
   return {den > 0.0 ? num / den : 0.0, den};
 }
 
-int clampAlpha(double alpha) {
-  return static_cast<int>(std::clamp(std::round(alpha), -2.0, 2.0));
-}
+int clampAlpha(double alpha) { return static_cast<int>(std::clamp(std::round(alpha), -2.0, 2.0)); }
 
 // Riley & Greenhall (2004), lag-1 ACF method for frequency data, dmax = 2: average the
 // rate over m (non-overlapping), then difference d times until ρ = r1/(1 + r1) < 0.25;
@@ -223,8 +220,8 @@ int identifyWithMean(std::span<const double> rate, std::size_t m, double mean, c
   const std::size_t m_a = std::min(m, m_max);
   const std::size_t m_b = (m_a + 1 <= m_max) ? m_a + 1 : m_a - 1;
   if (m_b == 0) {
-    throw std::invalid_argument("identifyPowerLawNoise: series too short for a slope (" +
-                                std::to_string(count) + " samples)");
+    throw std::invalid_argument("identifyPowerLawNoise: series too short for a slope (" + std::to_string(count) +
+                                " samples)");
   }
   const double va = phase->overlappingAllanVariance(m_a);
   const double vb = phase->overlappingAllanVariance(m_b);
@@ -256,8 +253,7 @@ std::vector<std::size_t> denseClusterSizes(std::size_t sample_count, std::size_t
   return ms;
 }
 
-std::vector<std::size_t> clusterSizesForTaus(std::span<const double> taus_s, double tau0_s,
-                                             std::size_t sample_count) {
+std::vector<std::size_t> clusterSizesForTaus(std::span<const double> taus_s, double tau0_s, std::size_t sample_count) {
   if (!(std::isfinite(tau0_s) && tau0_s > 0.0)) {
     throw std::invalid_argument("clusterSizesForTaus: tau0 must be a finite positive time in s (got " +
                                 formatNumber(tau0_s) + ")");
@@ -273,13 +269,12 @@ std::vector<std::size_t> clusterSizesForTaus(std::span<const double> taus_s, dou
     const double whole = std::round(samples);
     if (whole < 1.0 || std::abs(samples - whole) > 1e-9 * samples) {
       throw std::invalid_argument("clusterSizesForTaus: tau = " + formatNumber(tau) +
-                                  " s is not a whole number of samples (tau0 = " + formatNumber(tau0_s) +
-                                  " s gives " + formatNumber(samples) + " samples)");
+                                  " s is not a whole number of samples (tau0 = " + formatNumber(tau0_s) + " s gives " +
+                                  formatNumber(samples) + " samples)");
     }
     if (whole > static_cast<double>(sample_count / 2)) {
-      throw std::invalid_argument("clusterSizesForTaus: tau = " + formatNumber(tau) + " s (m = " +
-                                  formatNumber(whole) + " samples) is too long for " +
-                                  std::to_string(sample_count) +
+      throw std::invalid_argument("clusterSizesForTaus: tau = " + formatNumber(tau) + " s (m = " + formatNumber(whole) +
+                                  " samples) is too long for " + std::to_string(sample_count) +
                                   " samples: the overlapping estimator needs 2*m <= sample count");
     }
     ms.push_back(static_cast<std::size_t>(whole));
@@ -319,8 +314,8 @@ std::vector<double> overlappingAllanVariances(std::span<const double> rate, std:
 int identifyPowerLawNoise(std::span<const double> rate, std::size_t m) {
   requireClusterSize(m, "identifyPowerLawNoise");
   if (rate.size() < 3) {
-    throw std::invalid_argument("identifyPowerLawNoise: need at least 3 samples (got " +
-                                std::to_string(rate.size()) + ")");
+    throw std::invalid_argument("identifyPowerLawNoise: need at least 3 samples (got " + std::to_string(rate.size()) +
+                                ")");
   }
   const double mean = compensatedMean(rate, "identifyPowerLawNoise");
   if (rate.size() >= kMinAveragedPointsForNoiseId) return identifyWithMean(rate, m, mean, nullptr);

@@ -21,8 +21,7 @@ std::vector<std::size_t> octaveClusterSizes(std::size_t sample_count);
 std::vector<std::size_t> denseClusterSizes(std::size_t sample_count, std::size_t per_decade = 10);
 // Explicit τ list in seconds → m = τ/τ0. Throws std::invalid_argument naming the τ when
 // a τ is not a whole number of samples (relative tolerance 1e-9) or too long for the data.
-std::vector<std::size_t> clusterSizesForTaus(std::span<const double> taus_s, double tau0_s,
-                                             std::size_t sample_count);
+std::vector<std::size_t> clusterSizesForTaus(std::span<const double> taus_s, double tau0_s, std::size_t sample_count);
 
 // ---- estimators (σ², not σ; rate in any unit, result in unit²) ---------------------
 // Non-overlapping Allan variance at averaging factor m (paper eq. 2). NaN if < 2 clusters.
@@ -83,7 +82,6 @@ struct AllanOptions {
 // m too long for an estimator gives NaN there). Throws std::invalid_argument for tau0 ≤ 0,
 // confidence outside (0, 1), m = 0, fewer than 3 samples or a non-finite sample.
 std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double tau0_s,
-                                            std::span<const std::size_t> ms,
-                                            const AllanOptions& options = {});
+                                            std::span<const std::size_t> ms, const AllanOptions& options = {});
 
 }  // namespace gyrod::processing

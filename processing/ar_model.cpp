@@ -73,8 +73,7 @@ std::vector<ArModel> yuleWalker(std::span<const double> x, std::size_t max_order
     m.bic = n * std::log(sigma2) + static_cast<double>(k) * std::log(n);
     // Asymptotic covariance of √N(φ̂ − φ) is σa² Γp⁻¹ (Brockwell & Davis, Time Series: Theory and Methods, §8.1).
     const auto kk = static_cast<Eigen::Index>(k);
-    const Eigen::MatrixXd gamma_inv =
-        toeplitz.topLeftCorner(kk, kk).ldlt().solve(Eigen::MatrixXd::Identity(kk, kk));
+    const Eigen::MatrixXd gamma_inv = toeplitz.topLeftCorner(kk, kk).ldlt().solve(Eigen::MatrixXd::Identity(kk, kk));
     m.phi_std_error.resize(k);
     for (std::size_t j = 0; j < k; ++j) {
       const auto jj = static_cast<Eigen::Index>(j);
@@ -97,11 +96,13 @@ std::size_t orderMinimising(std::span<const ArModel> models, Criterion criterion
 }  // namespace
 
 std::size_t orderByAic(std::span<const ArModel> models) {
-  return orderMinimising(models, [](const ArModel& m) { return m.aic; }, "orderByAic");
+  return orderMinimising(
+      models, [](const ArModel& m) { return m.aic; }, "orderByAic");
 }
 
 std::size_t orderByBic(std::span<const ArModel> models) {
-  return orderMinimising(models, [](const ArModel& m) { return m.bic; }, "orderByBic");
+  return orderMinimising(
+      models, [](const ArModel& m) { return m.bic; }, "orderByBic");
 }
 
 }  // namespace gyrod::processing

@@ -9,10 +9,10 @@
 namespace gyrod::processing {
 
 struct ArModel {
-  std::vector<double> phi;          // φ1..φp
+  std::vector<double> phi;            // φ1..φp
   std::vector<double> phi_std_error;  // asymptotic standard errors of φ: √(diag(σa²·Γp⁻¹)/N)
-  double noise_var = 0.0;           // σa² from the Levinson–Durbin recursion
-  double reflection = 0.0;          // κp, the last reflection (partial autocorrelation) coefficient
+  double noise_var = 0.0;             // σa² from the Levinson–Durbin recursion
+  double reflection = 0.0;            // κp, the last reflection (partial autocorrelation) coefficient
   double aic = 0.0;
   double bic = 0.0;
   std::size_t order() const { return phi.size(); }

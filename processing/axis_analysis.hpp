@@ -18,8 +18,8 @@ namespace gyrod::processing {
 
 struct AnalysisOptions {
   double rate_hz = 50.0;
-  bool detrend = true;                      // remove constant + linear trend first (paper)
-  std::vector<std::size_t> cluster_sizes;   // m values; empty → octave
+  bool detrend = true;                     // remove constant + linear trend first (paper)
+  std::vector<std::size_t> cluster_sizes;  // m values; empty → octave
   std::size_t mean_window = 20;
   double mean_threshold_dps = 0.3;
   std::size_t max_ar_order = 3;
@@ -38,16 +38,16 @@ struct AxisAnalysis {
   ChiSquareNormalityTest normality;
   LinearTrend trend_removed;  // zero when detrend is off
   std::vector<AllanPoint> allan;
-  NoiseTermFit noise;                // weighted fit (Table 2)
-  NoiseTerms noise_from_slopes;      // classical slope reading, cross-check
-  std::vector<ArModel> ar;           // orders 1..max_ar_order (Table 3)
+  NoiseTermFit noise;            // weighted fit (Table 2)
+  NoiseTerms noise_from_slopes;  // classical slope reading, cross-check
+  std::vector<ArModel> ar;       // orders 1..max_ar_order (Table 3)
   std::size_t ar_order_aic = 0, ar_order_bic = 0;
-  FilterChainParameters filter;      // what the Kalman used
+  FilterChainParameters filter;  // what the Kalman used
   double steady_state_gain = 0.0;
   VarianceComparison variance;
-  double peak_ratio = 0.0;           // max|kalman − mean| / max|raw − mean|
+  double peak_ratio = 0.0;  // max|kalman − mean| / max|raw − mean|
   std::vector<AllanPoint> allan_after_kalman;
-  NoiseTermFit noise_after_kalman;   // Table 4
+  NoiseTermFit noise_after_kalman;  // Table 4
 };
 
 AxisAnalysis analyzeAxis(std::span<const double> rate_dps, const AnalysisOptions& options);

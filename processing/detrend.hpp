@@ -5,8 +5,8 @@
 namespace gyrod::processing {
 
 struct LinearTrend {
-  double offset = 0.0;        // value at the first sample
-  double slope_per_s = 0.0;   // unit per second
+  double offset = 0.0;       // value at the first sample
+  double slope_per_s = 0.0;  // unit per second
 };
 
 // Least-squares line x ≈ offset + slope·(i·dt). Numerically stable (centred) form.

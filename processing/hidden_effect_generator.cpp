@@ -54,8 +54,7 @@ HiddenEffect HiddenEffectGenerator::drawEffect(ModelEffect e, double duration_s,
   switch (e) {
     case ModelEffect::TemperatureBias:
       // |k|·(rms detrended temperature) = 3..10 × the bias-instability floor.
-      h.k_dps_per_c =
-          (rng_.uniform() < 0.5 ? -1.0 : 1.0) * uniform(3.0, 10.0) * flat_adev[h.axis] / temp_residual_std;
+      h.k_dps_per_c = (rng_.uniform() < 0.5 ? -1.0 : 1.0) * uniform(3.0, 10.0) * flat_adev[h.axis] / temp_residual_std;
       break;
     case ModelEffect::Sinusoid:
       h.freq_hz = logUniform(0.2, 0.4 * rate_hz);
@@ -94,8 +93,7 @@ HiddenEffect HiddenEffectGenerator::drawEffect(ModelEffect e, double duration_s,
       }
       std::sort(h.times_s.begin(), h.times_s.end());
       for (double t : h.times_s) {
-        h.sizes_dps.push_back((rng_.uniform() < 0.5 ? -1.0 : 1.0) * uniform(step_size_lo, step_size_hi) *
-                              floor_adev);
+        h.sizes_dps.push_back((rng_.uniform() < 0.5 ? -1.0 : 1.0) * uniform(step_size_lo, step_size_hi) * floor_adev);
         extra.bias_steps.push_back({t, h.sizes_dps.back()});
       }
       break;
@@ -109,8 +107,7 @@ HiddenEffect HiddenEffectGenerator::drawEffect(ModelEffect e, double duration_s,
       h.count = integer(1, 5);
       for (std::size_t j = 0; j < h.count; ++j) h.lost += integer(1, 50);
       break;
-    case ModelEffect::Unexplained:
-      break;
+    case ModelEffect::Unexplained: break;
   }
   return h;
 }

@@ -41,9 +41,9 @@ struct GeneratedRecording {
 };
 
 // The effects a generator may hide (the catalogue; `unexplained` is not an effect one hides).
-inline constexpr std::array<ModelEffect, 6> kHideableEffects = {
-    ModelEffect::TemperatureBias, ModelEffect::Sinusoid, ModelEffect::GaussMarkov,
-    ModelEffect::BiasSteps,       ModelEffect::Outliers, ModelEffect::SampleGaps};
+inline constexpr std::array<ModelEffect, 6> kHideableEffects = {ModelEffect::TemperatureBias, ModelEffect::Sinusoid,
+                                                                ModelEffect::GaussMarkov,     ModelEffect::BiasSteps,
+                                                                ModelEffect::Outliers,        ModelEffect::SampleGaps};
 
 class HiddenEffectGenerator {
  public:

@@ -52,12 +52,12 @@ double ScalarKalmanFilter::update(double z) {
     return x_;
   }
   const double a = params_.a;
-  const double x_prior = a * x_;                       // paper eq. 12
-  const double p_prior = a * p_ * a + params_.q;       // eq. 15 (B = 1)
-  k_ = p_prior / (p_prior + params_.r);                // eq. 14 (H = 1); r > 0 keeps it defined
+  const double x_prior = a * x_;                  // paper eq. 12
+  const double p_prior = a * p_ * a + params_.q;  // eq. 15 (B = 1)
+  k_ = p_prior / (p_prior + params_.r);           // eq. 14 (H = 1); r > 0 keeps it defined
   innovation_ = z - x_prior;
-  x_ = x_prior + k_ * innovation_;                     // eq. 13
-  p_ = (1.0 - k_) * p_prior;                           // eq. 16
+  x_ = x_prior + k_ * innovation_;  // eq. 13
+  p_ = (1.0 - k_) * p_prior;        // eq. 16
   return x_;
 }
 
@@ -85,9 +85,8 @@ double steadyStatePosteriorCovariance(double a, double q, double r) {
 KalmanIdentification identifyKalmanParameters(std::span<const double> raw_detrended,
                                               std::span<const double> mean_filtered) {
   if (raw_detrended.size() != mean_filtered.size())
-    throw std::invalid_argument("identifyKalmanParameters: raw_detrended has " +
-                                std::to_string(raw_detrended.size()) + " samples but mean_filtered has " +
-                                std::to_string(mean_filtered.size()));
+    throw std::invalid_argument("identifyKalmanParameters: raw_detrended has " + std::to_string(raw_detrended.size()) +
+                                " samples but mean_filtered has " + std::to_string(mean_filtered.size()));
   if (mean_filtered.size() < 2)
     throw std::invalid_argument("identifyKalmanParameters: need at least 2 samples, got " +
                                 std::to_string(mean_filtered.size()));
@@ -123,11 +122,10 @@ KalmanIdentification identifyKalmanParameters(std::span<const double> raw_detren
   return id;
 }
 
-ArKalmanFilter::ArKalmanFilter(std::span<const double> phi, double q, double r, double p0)
-    : q_(q), r_(r), p0_(p0) {
+ArKalmanFilter::ArKalmanFilter(std::span<const double> phi, double q, double r, double p0) : q_(q), r_(r), p0_(p0) {
   if (phi.empty() || phi.size() > kMaxArOrder)
-    throw std::invalid_argument("ArKalmanFilter: AR order must be in [1, " + std::to_string(kMaxArOrder) +
-                                "], got " + std::to_string(phi.size()));
+    throw std::invalid_argument("ArKalmanFilter: AR order must be in [1, " + std::to_string(kMaxArOrder) + "], got " +
+                                std::to_string(phi.size()));
   for (double v : phi) requireFinite(v, "ArKalmanFilter", "a coefficient phi");
   validateNoise("ArKalmanFilter", q, r, p0);
   const auto p = static_cast<Eigen::Index>(phi.size());

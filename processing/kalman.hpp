@@ -14,10 +14,10 @@
 namespace gyrod::processing {
 
 struct ScalarKalmanParameters {
-  double a = 0.0;   // A = φ1
-  double q = 0.0;   // Q = σa²
-  double r = 0.0;   // R
-  double p0 = 0.0;  // P0
+  double a = 0.0;            // A = φ1
+  double q = 0.0;            // Q = σa²
+  double r = 0.0;            // R
+  double p0 = 0.0;           // P0
   std::optional<double> x0;  // x̂0; empty → first measurement
 };
 
@@ -34,7 +34,7 @@ class ScalarKalmanFilter {
   // Back to the state after construction.
   void reset();
   double gain() const { return k_; }
-  double covariance() const { return p_; }  // P after the last update
+  double covariance() const { return p_; }           // P after the last update
   double innovation() const { return innovation_; }  // Z − x̂⁻ of the last update
   const ScalarKalmanParameters& parameters() const { return params_; }
 
@@ -91,7 +91,7 @@ class ArKalmanFilter {
   double update(double z);
   void reset();
   std::size_t order() const { return static_cast<std::size_t>(f_.rows()); }
-  double gain() const { return k_(0); }  // gain on the first state
+  double gain() const { return k_(0); }           // gain on the first state
   double covariance() const { return p_(0, 0); }  // a-posteriori variance of the first state
 
  private:

@@ -35,7 +35,6 @@ class GrossErrorMeanFilter {
 // Decimating (block) mode: consecutive non-overlapping blocks of L samples, one output
 // per complete block, same rejection rule. A trailing partial block is dropped.
 // Throws as the constructor above, and for non-finite samples.
-std::vector<double> blockMeanFilter(std::span<const double> x, std::size_t window_length,
-                                    double threshold_dps);
+std::vector<double> blockMeanFilter(std::span<const double> x, std::size_t window_length, double threshold_dps);
 
 }  // namespace gyrod::processing

@@ -26,8 +26,7 @@ std::string formatValue(const char* fmt, double v) {
 
 void validateChannels(const AxisModelCheckInput& in) {
   if (!(std::isfinite(in.rate_hz) && in.rate_hz > 0.0))
-    throw std::invalid_argument("model check: rate_hz must be finite and > 0, got " +
-                                formatValue("%g", in.rate_hz));
+    throw std::invalid_argument("model check: rate_hz must be finite and > 0, got " + formatValue("%g", in.rate_hz));
   if (in.rate_dps.size() < kModelCheckMinSamples)
     throw std::invalid_argument("model check: " + std::to_string(in.rate_dps.size()) +
                                 " samples are too few (need at least " + std::to_string(kModelCheckMinSamples) + ")");
@@ -117,9 +116,9 @@ AxisModelCheck checkAxisModel(const AxisModelCheckInput& input, const ModelCheck
   const SeriesStats measured = measureSeries(xd, c, kStatAllan | kStatPsd);
   const AllanNull base_allan = allanNull(base_reps, measured.log_adev, c, o.false_alarm);
   out.allan_base = base_allan.band;
-  out.statistics.push_back(makeStatistic(
-      "allan_band_max_z_base", maxAbsZ(measured.log_adev, base_allan.median_log, base_allan.spread_log),
-      base_allan.max_z));
+  out.statistics.push_back(makeStatistic("allan_band_max_z_base",
+                                         maxAbsZ(measured.log_adev, base_allan.median_log, base_allan.spread_log),
+                                         base_allan.max_z));
   spectrumForPlots(measured, base_reps, c, out);
 
   const NullSummary outlier_null = summarizeNull(column(base_reps, &SeriesStats::outlier_max_z), o.false_alarm, false);

@@ -45,14 +45,14 @@ std::string_view modelEffectName(ModelEffect e);
 // fire on the low-passed residual when either is there).
 enum class LowFrequencyDecision {
   None,
-  TemperatureOnly,          // follows temperature; no step once it is removed
-  TemperatureThenSteps,     // follows temperature, and steps remain once it is removed
-  StepsThenTemperature,     // steps, and a temperature response remains once they are removed
-  StepsOnly,                // steps; no temperature response
-  EachRemains,              // each remains when the other is removed
-  TemperatureVanishes,      // the temperature correlation vanishes once the steps are removed
-  StepsVanish,              // the steps vanish once the temperature response is removed
-  ByBic,                    // each explains the other away: BIC of the low-passed residual decides
+  TemperatureOnly,       // follows temperature; no step once it is removed
+  TemperatureThenSteps,  // follows temperature, and steps remain once it is removed
+  StepsThenTemperature,  // steps, and a temperature response remains once they are removed
+  StepsOnly,             // steps; no temperature response
+  EachRemains,           // each remains when the other is removed
+  TemperatureVanishes,   // the temperature correlation vanishes once the steps are removed
+  StepsVanish,           // the steps vanish once the temperature response is removed
+  ByBic,                 // each explains the other away: BIC of the low-passed residual decides
 };
 
 // A further component of a line already named: a fixed sinusoid did not take the line out.
@@ -65,12 +65,12 @@ struct LineComponent {
 // What a named effect rests on, as numbers; the tool that prints them words them. Only the
 // fields of the effect are meaningful.
 struct EffectEvidence {
-  double statistic = 0.0;     // the statistic's value (unexplained: largest |z| of the Allan band)
-  double threshold = 0.0;     // its threshold (two-sided statistics: on |value − null median|)
-  double null_median = 0.0;   // median of its null
-  std::size_t replicas = 0;   // replicas per round the null comes from
-  double peak_ratio = 0.0;    // sinusoid: peak over the local background
-  double freq_hz = 0.0;       // sinusoid: frequency of the first component
+  double statistic = 0.0;                         // the statistic's value (unexplained: largest |z| of the Allan band)
+  double threshold = 0.0;                         // its threshold (two-sided statistics: on |value − null median|)
+  double null_median = 0.0;                       // median of its null
+  std::size_t replicas = 0;                       // replicas per round the null comes from
+  double peak_ratio = 0.0;                        // sinusoid: peak over the local background
+  double freq_hz = 0.0;                           // sinusoid: frequency of the first component
   std::vector<LineComponent> further_components;  // sinusoid: the line's amplitude or phase wanders
   double chi2_gain = 0.0, chi2_base = 0.0;        // gauss_markov: weighted residual gain, and before
   LowFrequencyDecision decision = LowFrequencyDecision::None;  // temperature_bias, bias_steps
@@ -83,17 +83,17 @@ struct EffectEvidence {
 struct DetectedEffect {
   ModelEffect effect = ModelEffect::Unexplained;
   // Parameters; only those of `effect` are meaningful.
-  double k_dps_per_c = 0.0;                    // temperature_bias
-  double freq_hz = 0.0, amp_dps = 0.0;         // sinusoid
-  double phase_rad = 0.0;                      // sinusoid (amp·sin(2πf·t + phase), t from 0)
-  double tau_s = 0.0, sigma_dps = 0.0;         // gauss_markov
-  std::size_t count = 0;                       // bias_steps, outliers, sample_gaps
-  std::vector<double> times_s;                 // bias_steps (time of each step)
-  std::vector<double> sizes_dps;               // bias_steps (size of each step)
-  std::size_t lost = 0;                        // sample_gaps: samples missing in the gaps
-  double outlier_median_amplitude_dps = 0.0;   // outliers: median |excursion|
-  double where_lo = 0.0, where_hi = 0.0;       // unexplained: τ range [s] (Allan)
-  EffectEvidence evidence;                     // statistic, value, threshold
+  double k_dps_per_c = 0.0;                   // temperature_bias
+  double freq_hz = 0.0, amp_dps = 0.0;        // sinusoid
+  double phase_rad = 0.0;                     // sinusoid (amp·sin(2πf·t + phase), t from 0)
+  double tau_s = 0.0, sigma_dps = 0.0;        // gauss_markov
+  std::size_t count = 0;                      // bias_steps, outliers, sample_gaps
+  std::vector<double> times_s;                // bias_steps (time of each step)
+  std::vector<double> sizes_dps;              // bias_steps (size of each step)
+  std::size_t lost = 0;                       // sample_gaps: samples missing in the gaps
+  double outlier_median_amplitude_dps = 0.0;  // outliers: median |excursion|
+  double where_lo = 0.0, where_hi = 0.0;      // unexplained: τ range [s] (Allan)
+  EffectEvidence evidence;                    // statistic, value, threshold
 };
 
 // One statistic of the check: its value on the measured series, the replicas' null
@@ -122,9 +122,9 @@ struct ModelCheckGain {
 };
 
 struct ModelCheckOptions {
-  std::size_t replicas = 40;       // per round; the thresholds use robust spread, not ranks
+  std::size_t replicas = 40;  // per round; the thresholds use robust spread, not ranks
   std::uint64_t seed = 1;
-  std::size_t threads = 0;         // 0: std::thread::hardware_concurrency()
+  std::size_t threads = 0;  // 0: std::thread::hardware_concurrency()
   // Nominal false-alarm probability of each statistic on one axis: a statistic fires when it
   // exceeds both the largest replica value and the (1 − α) quantile of a Gumbel (maxima) or
   // normal (signed linear statistics) fitted to the replicas' quantiles. About six statistics
@@ -145,7 +145,7 @@ struct AxisModelCheckInput {
 struct AxisModelCheck {
   std::size_t samples = 0;
   NoiseTermFit base_fit;
-  NoiseTermFit extended_fit;        // five terms of the data with the named effects removed
+  NoiseTermFit extended_fit;            // five terms of the data with the named effects removed
   std::vector<DetectedEffect> effects;  // empty when the base model holds
   std::vector<CheckStatistic> statistics;
   ModelCheckGain gain;
@@ -155,7 +155,7 @@ struct AxisModelCheck {
   std::vector<double> spectrum_freq_hz, spectrum_measured, spectrum_base_median;
   std::vector<double> spectrum_measured_peak;  // largest single-bin PSD in each band (lines)
   std::vector<double> block_temperature_c, block_residual_dps;
-  std::size_t ar_order = 0;          // AR order (AIC) of the base Kalman model
+  std::size_t ar_order = 0;  // AR order (AIC) of the base Kalman model
   std::size_t replicas_simulated = 0;
 };
 

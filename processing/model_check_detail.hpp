@@ -20,9 +20,9 @@ namespace gyrod::processing::model_check_detail {
 // exceed σ·Φ⁻¹(1 − α/2). Both from quantiles, so one odd replica cannot move them much.
 struct NullSummary {
   double median = 0.0;
-  double spread = 0.0;      // β (one-sided) or σ (two-sided)
-  double largest = 0.0;     // largest replica value (of |v − median| when two-sided)
-  double threshold = 0.0;   // on the value (one-sided) or on |value − median| (two-sided)
+  double spread = 0.0;     // β (one-sided) or σ (two-sided)
+  double largest = 0.0;    // largest replica value (of |v − median| when two-sided)
+  double threshold = 0.0;  // on the value (one-sided) or on |value − median| (two-sided)
   bool two_sided = false;
   bool fires(double value) const;
   double excess(double value) const;  // (value − median)/spread, |·| when two-sided
@@ -68,7 +68,7 @@ std::vector<double> bandAveragedPsd(const Periodogram& p, double rate_hz, std::s
 // Haar differences D_W(t) = mean(y[t, t+W)) − mean(y[t−W, t)) for t = W..n−W.
 struct HaarScan {
   double max_abs = 0.0;
-  std::size_t argmax = 0;   // t of the largest |D|
+  std::size_t argmax = 0;  // t of the largest |D|
   double value_at_max = 0.0;
   double sum_squares = 0.0;
   std::size_t count = 0;
@@ -82,12 +82,12 @@ HaarScan haarScan(std::span<const double> y, std::size_t w);
 // Weights: σ̂² has variance 2·ref²/edf; ref = the measured σ² in a first pass, then the
 // better fit's model value (at least 1/10 of the measured one), as noise_fit does.
 struct GaussMarkovCurveFit {
-  double chi2_base = 0.0;        // weighted residual of the five-term fit
-  double chi2_with_gm = 0.0;     // of the best five-terms-plus-GM fit
-  double improvement = 0.0;      // chi2_base − chi2_with_gm
-  double tau_s = 0.0;            // best T
-  double sigma_dps = 0.0;        // its σ
-  NoiseTerms terms_with_gm;      // the five terms of that fit
+  double chi2_base = 0.0;     // weighted residual of the five-term fit
+  double chi2_with_gm = 0.0;  // of the best five-terms-plus-GM fit
+  double improvement = 0.0;   // chi2_base − chi2_with_gm
+  double tau_s = 0.0;         // best T
+  double sigma_dps = 0.0;     // its σ
+  NoiseTerms terms_with_gm;   // the five terms of that fit
 };
 GaussMarkovCurveFit fitGaussMarkovToAllan(std::span<const double> tau_s, std::span<const double> variance,
                                           std::span<const double> edf, std::span<const double> t_grid);
@@ -103,7 +103,7 @@ bool levinsonFromAutocovariance(std::span<const double> gamma, std::size_t order
 // innovation beyond 5·√S is a gross error: the update is skipped (the prediction stands
 // in for the sample) and the sample is left out of the statistics.
 struct InnovationStats {
-  double variance = 0.0;  // mean square innovation over the samples used
+  double variance = 0.0;            // mean square innovation over the samples used
   std::vector<double> innovations;  // samples used, after a burn-in of 100
   std::size_t rejected = 0;
 };

@@ -16,9 +16,8 @@ GaussMarkovFound checkGaussMarkov(std::span<const double> xc, const Context& c, 
   std::vector<double> null_values;
   if (deterministic_found) {
     // The null of a model fitted to the cleaned series (the base fit also carried the effects).
-    const std::vector<SeriesStats> reps = runReplicas(pureModel(c.rate, gm.clean_fit.value),
-                                                      statisticalUncertainty(gm.clean_fit), c, {}, o, 2,
-                                                      kStatGaussMarkov);
+    const std::vector<SeriesStats> reps = runReplicas(
+        pureModel(c.rate, gm.clean_fit.value), statisticalUncertainty(gm.clean_fit), c, {}, o, 2, kStatGaussMarkov);
     out.replicas_simulated += o.replicas;
     null_values = column(reps, &SeriesStats::gm_statistic);
   } else {

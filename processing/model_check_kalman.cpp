@@ -29,8 +29,10 @@ InnovationStats kalmanInnovations(std::span<const double> z, std::span<const dou
                                   double gm_decay, double gm_noise_var, bool robust) {
   const std::size_t p = phi.size();
   const bool gm = gm_noise_var > 0.0;
-  if (p == 0 || p > kMaxArOrder) throw std::invalid_argument("kalmanInnovations: AR order must be 1.." + std::to_string(kMaxArOrder));
-  if (!(ar_noise_var > 0.0) || !std::isfinite(ar_noise_var)) throw std::invalid_argument("kalmanInnovations: AR noise variance must be > 0");
+  if (p == 0 || p > kMaxArOrder)
+    throw std::invalid_argument("kalmanInnovations: AR order must be 1.." + std::to_string(kMaxArOrder));
+  if (!(ar_noise_var > 0.0) || !std::isfinite(ar_noise_var))
+    throw std::invalid_argument("kalmanInnovations: AR noise variance must be > 0");
   if (z.size() <= kBurnIn + 10) throw std::invalid_argument("kalmanInnovations: series too short");
   const auto d = static_cast<Eigen::Index>(p + (gm ? 1 : 0));
   const auto pi = static_cast<Eigen::Index>(p);

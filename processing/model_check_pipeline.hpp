@@ -32,11 +32,11 @@ struct Context {
   double rate = 0.0, tau0 = 0.0;
   std::vector<std::size_t> ms;
   std::vector<double> taus, edf;
-  std::vector<double> t_grid;           // Gauss–Markov correlation times tried
-  std::size_t block = 1, blocks = 0;    // block length [samples], number of blocks
-  std::vector<double> temp_blocks;      // detrended block means of temperature (empty: none)
-  std::vector<std::size_t> scales;      // Haar scales [blocks]
-  std::size_t k_lo = 0, k_hi = 0;       // periodogram bins searched for a sinusoid
+  std::vector<double> t_grid;         // Gauss–Markov correlation times tried
+  std::size_t block = 1, blocks = 0;  // block length [samples], number of blocks
+  std::vector<double> temp_blocks;    // detrended block means of temperature (empty: none)
+  std::vector<std::size_t> scales;    // Haar scales [blocks]
+  std::size_t k_lo = 0, k_hi = 0;     // periodogram bins searched for a sinusoid
   std::vector<double> psd_edges;
 };
 
@@ -45,8 +45,14 @@ struct Context {
 Context makeContext(const AxisModelCheckInput& in, std::span<const double> xd, std::vector<AllanPoint>& curve);
 
 enum StatMask : unsigned {
-  kStatAllan = 1u, kStatOutliers = 2u, kStatSpectrum = 4u, kStatTemperature = 8u, kStatSteps = 16u,
-  kStatGaussMarkov = 32u, kStatPsd = 64u, kStatAll = 127u,
+  kStatAllan = 1u,
+  kStatOutliers = 2u,
+  kStatSpectrum = 4u,
+  kStatTemperature = 8u,
+  kStatSteps = 16u,
+  kStatGaussMarkov = 32u,
+  kStatPsd = 64u,
+  kStatAll = 127u,
 };
 
 struct SeriesStats {
@@ -55,7 +61,7 @@ struct SeriesStats {
   double spectral_log_ratio = kNaN;
   std::size_t spectral_bin = 0;
   double temp_slope = kNaN;
-  double step_stat = kNaN;       // stepStatistic of the low-passed residual
+  double step_stat = kNaN;  // stepStatistic of the low-passed residual
   double gm_statistic = kNaN;
   std::vector<double> psd, psd_max;
 };
@@ -151,8 +157,8 @@ bool checkTemperatureAndSteps(const AxisModelCheckInput& input, std::vector<doub
 struct GaussMarkovFound {
   bool found = false;
   GaussMarkovCurveFit fit;
-  NoiseTermFit clean_fit;       // five terms of the cleaned series
-  NoiseTerms extended_terms;    // the model's terms: with the Gauss–Markov term's when found
+  NoiseTermFit clean_fit;     // five terms of the cleaned series
+  NoiseTerms extended_terms;  // the model's terms: with the Gauss–Markov term's when found
 };
 // A bump in the Allan curve of the cleaned series xc; `curve` is the measured series' table,
 // used when nothing deterministic was removed.
@@ -163,8 +169,8 @@ GaussMarkovFound checkGaussMarkov(std::span<const double> xc, const Context& c, 
 // ---- the extended model --------------------------------------------------------------------
 
 struct ExtensionInputs {
-  std::span<const double> xd;        // measured series, detrended
-  std::span<const double> xc;        // with the named effects removed
+  std::span<const double> xd;  // measured series, detrended
+  std::span<const double> xc;  // with the named effects removed
   const std::vector<double>* measured_log_adev = nullptr;
   const AllanNull* base_allan = nullptr;
   const Removal* removal = nullptr;

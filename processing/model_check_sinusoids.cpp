@@ -14,8 +14,8 @@ constexpr double kSameLineBins = 3.0;  // peaks closer than this (periodogram bi
 // The least-squares sinusoid at the frequency within ±1 bin of `bin` of largest amplitude.
 SinusoidFit fitLineNearBin(std::span<const double> x, double rate, std::size_t bin, double df) {
   const double a = (static_cast<double>(bin) - 1.0) * df, b = (static_cast<double>(bin) + 1.0) * df;
-  const GoldenSectionBracket found = goldenSectionMinimum(
-      a, b, {40, 1e-6 * df}, [&](double f) { return -fitSinusoidAt(x, rate, f).amp_dps; });
+  const GoldenSectionBracket found =
+      goldenSectionMinimum(a, b, {40, 1e-6 * df}, [&](double f) { return -fitSinusoidAt(x, rate, f).amp_dps; });
   return fitSinusoidAt(x, rate, found.midpoint());
 }
 

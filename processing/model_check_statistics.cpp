@@ -273,7 +273,8 @@ GaussMarkovCurveFit fitGaussMarkovToAllan(std::span<const double> tau_s, std::sp
   NonNegativeLeastSquares first = bestOverGrid(ref, t_best);
   setGmColumn(t_best);
   const Eigen::VectorXd model = six * first.x;
-  for (std::size_t j = 0; j < ref.size(); ++j) ref[j] = std::max(model(static_cast<Eigen::Index>(j)), 0.1 * variance[j]);
+  for (std::size_t j = 0; j < ref.size(); ++j)
+    ref[j] = std::max(model(static_cast<Eigen::Index>(j)), 0.1 * variance[j]);
 
   GaussMarkovCurveFit fit;
   fit.chi2_base = weightedCurveFit(five, variance, edf, ref).residual_squared;
@@ -373,7 +374,8 @@ SampleTiming analyzeSampleTiming(std::span<const double> t) {
 
 LjungBox ljungBoxTest(std::span<const double> x, std::size_t lags, std::size_t fitted_parameters) {
   const std::size_t n = x.size();
-  if (lags == 0 || n <= lags + 1) throw std::invalid_argument("ljungBoxTest: need lags >= 1 and more samples than lags + 1");
+  if (lags == 0 || n <= lags + 1)
+    throw std::invalid_argument("ljungBoxTest: need lags >= 1 and more samples than lags + 1");
   double mean = 0.0;
   for (double v : x) mean += v;
   mean /= static_cast<double>(n);

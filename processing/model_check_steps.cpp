@@ -274,9 +274,8 @@ bool checkTemperatureAndSteps(const AxisModelCheckInput& input, std::vector<doub
   const bool have_temp = !c.temp_blocks.empty();
   const bool have_steps = !c.scales.empty();
   bool second_look = false;
-  const LowFrequencyNulls lf =
-      nullsAfterFurtherLooks(xc, c, temp.detrended, lowFrequencyNulls(base_reps, o.false_alarm, have_temp, have_steps),
-                             o, out, second_look);
+  const LowFrequencyNulls lf = nullsAfterFurtherLooks(
+      xc, c, temp.detrended, lowFrequencyNulls(base_reps, o.false_alarm, have_temp, have_steps), o, out, second_look);
   const std::vector<double> y0 = lowPassedResidual(xc, c);
   out.block_residual_dps = y0;
   out.block_temperature_c = temp.raw_blocks;
@@ -310,8 +309,9 @@ bool checkTemperatureAndSteps(const AxisModelCheckInput& input, std::vector<doub
     e.evidence = lowFrequencyEvidence(s_stat, lf.steps, o.replicas, ch);
     out.effects.push_back(e);
   }
-  const std::vector<double> d = deterministicPart({{}, removal.k, removal.temperature, removal.step_samples,
-                                                   removal.step_sizes}, xc.size(), c.rate, temp.detrended);
+  const std::vector<double> d =
+      deterministicPart({{}, removal.k, removal.temperature, removal.step_samples, removal.step_sizes}, xc.size(),
+                        c.rate, temp.detrended);
   for (std::size_t i = 0; i < xc.size(); ++i) xc[i] -= d[i];
   return true;
 }

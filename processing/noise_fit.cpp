@@ -99,8 +99,8 @@ NonNegativeLeastSquares solveNonNegativeLeastSquares(const Eigen::MatrixXd& a, c
     throw std::invalid_argument("solveNonNegativeLeastSquares: need 1..16 columns (got " + std::to_string(n) + ")");
   }
   if (a.rows() != b.size()) {
-    throw std::invalid_argument("solveNonNegativeLeastSquares: A has " + std::to_string(a.rows()) +
-                                " rows but b has " + std::to_string(b.size()));
+    throw std::invalid_argument("solveNonNegativeLeastSquares: A has " + std::to_string(a.rows()) + " rows but b has " +
+                                std::to_string(b.size()));
   }
   if (!a.allFinite() || !b.allFinite()) {
     throw std::invalid_argument("solveNonNegativeLeastSquares: A and b must be finite");
@@ -114,7 +114,7 @@ NonNegativeLeastSquares solveNonNegativeLeastSquares(const Eigen::MatrixXd& a, c
   const double b_norm2 = b.squaredNorm();
   const double tie = 1e-13 * b_norm2;
   Eigen::VectorXd best_y = Eigen::VectorXd::Zero(n);  // in scaled coordinates
-  double best_r = b_norm2;                             // the empty support, x = 0
+  double best_r = b_norm2;                            // the empty support, x = 0
   Eigen::Index best_k = 0;
 
   std::vector<Eigen::Index> cols;

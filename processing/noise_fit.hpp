@@ -14,7 +14,7 @@
 namespace gyrod::processing {
 
 struct NoiseTermFit {
-  NoiseTerms value;        // paper units
+  NoiseTerms value;  // paper units
   // 1-σ, paper units. For a fitted term: the covariance of the active set scaled by
   // max(1, reduced χ²), propagated through T ∝ √c (σ_T = σ_c·T/(2c)), but never more than
   // the zero-term bound below. For a term fitted to 0: the value whose coefficient equals

@@ -45,10 +45,10 @@ std::size_t sampleRateDivisor(int dlpf_cfg, double rate_hz) {
   const double ratio = dlpf.internal_rate_hz / rate_hz;
   const double divisor = std::round(ratio);
   if (divisor < 1.0 || divisor > 256.0 || std::fabs(ratio - divisor) > 1e-9 * ratio)
-    throw std::invalid_argument(
-        "rate_hz " + formatNumber(rate_hz) + " is not possible with DLPF_CFG " + std::to_string(dlpf_cfg) +
-        ": the output rate is the internal rate " + formatNumber(dlpf.internal_rate_hz) +
-        " Hz divided by an integer 1..256 (rate = internal/(1+SMPLRT_DIV))");
+    throw std::invalid_argument("rate_hz " + formatNumber(rate_hz) + " is not possible with DLPF_CFG " +
+                                std::to_string(dlpf_cfg) + ": the output rate is the internal rate " +
+                                formatNumber(dlpf.internal_rate_hz) +
+                                " Hz divided by an integer 1..256 (rate = internal/(1+SMPLRT_DIV))");
   return static_cast<std::size_t>(divisor);
 }
 
@@ -67,9 +67,9 @@ std::vector<std::vector<double>> arStepDown(const std::vector<double>& phi, cons
     const std::vector<double>& cur = orders[j - 1];
     const double k = cur[j - 1];
     if (!(std::fabs(k) < 1.0))
-      throw std::invalid_argument(what + "ar.phi is not stationary (reflection coefficient " +
-                                  std::to_string(j) + " is " + formatNumber(k) +
-                                  ", must be in (-1, 1)): all roots of 1 - sum phi_i z^i must lie outside the unit circle");
+      throw std::invalid_argument(
+          what + "ar.phi is not stationary (reflection coefficient " + std::to_string(j) + " is " + formatNumber(k) +
+          ", must be in (-1, 1)): all roots of 1 - sum phi_i z^i must lie outside the unit circle");
     if (j == 1) break;
     std::vector<double>& lower = orders[j - 2];
     lower.resize(j - 1);
@@ -85,7 +85,8 @@ void validateArComponent(const ArComponent& ar, const std::string& prefix) {
   requireNonNegative(ar.noise_var, prefix + "ar.noise_var");
   if (ar.phi.size() > 64)
     throw std::invalid_argument(prefix + "ar.phi has " + std::to_string(ar.phi.size()) + " coefficients (at most 64)");
-  for (std::size_t i = 0; i < ar.phi.size(); ++i) requireFinite(ar.phi[i], prefix + "ar.phi[" + std::to_string(i) + "]");
+  for (std::size_t i = 0; i < ar.phi.size(); ++i)
+    requireFinite(ar.phi[i], prefix + "ar.phi[" + std::to_string(i) + "]");
   arStepDown(ar.phi, prefix);
 }
 
@@ -130,8 +131,7 @@ void validateSimulationModel(const SimulationModel& model) {
   requireNonNegative(temp.noise_std_c, "temperature.noise_std_c");
 }
 
-std::vector<GaussMarkovComponent> flickerGaussMarkovBank(double flat_allan_variance, double tau0_s,
-                                                         double duration_s) {
+std::vector<GaussMarkovComponent> flickerGaussMarkovBank(double flat_allan_variance, double tau0_s, double duration_s) {
   requireNonNegative(flat_allan_variance, "flicker Allan variance level");
   requirePositive(tau0_s, "tau0_s");
   requirePositive(duration_s, "duration_s");
@@ -173,7 +173,8 @@ double aliasedWhiteNoiseFactor(int dlpf_cfg, double rate_hz) {
   const std::size_t divisor = sampleRateDivisor(dlpf_cfg, rate_hz);
   const DigitalLowPassFilter filter(dlpf_cfg);
   double sum = 0.0;
-  for (std::size_t k = 0; k < divisor; ++k) sum += std::norm(filter.frequencyResponse(static_cast<double>(k) * rate_hz));
+  for (std::size_t k = 0; k < divisor; ++k)
+    sum += std::norm(filter.frequencyResponse(static_cast<double>(k) * rate_hz));
   return std::sqrt(sum);
 }
 
@@ -213,8 +214,8 @@ NoiseSimulator::NoiseSimulator(const SimulationModel& model, double duration_s, 
     axis.bias_dps = m.bias_dps;
     // Each term from its Allan coefficient c (σ² = c·τ^p, noise_terms.hpp):
     //  ARW  σ² = c/τ: white rate of two-sided density √c → per-sample std √(c·fs).
-    axis.arw_std = std::sqrt(allanVarianceCoefficient(NoiseTerm::AngleRandomWalk, m.terms.arw_deg_per_sqrt_h) *
-                             internal_rate_hz_);
+    axis.arw_std =
+        std::sqrt(allanVarianceCoefficient(NoiseTerm::AngleRandomWalk, m.terms.arw_deg_per_sqrt_h) * internal_rate_hz_);
     //  RRW  σ² = c·τ = K²τ/3: rate random walk with steps of std K·√τ0 = √(3c·τ0).
     axis.rrw_step_std =
         std::sqrt(3.0 * allanVarianceCoefficient(NoiseTerm::RateRandomWalk, m.terms.rrw_deg_per_h_sqrt_h) * tau0);
@@ -235,7 +236,8 @@ NoiseSimulator::NoiseSimulator(const SimulationModel& model, double duration_s, 
     }
     //  Q    σ² = c/τ² = 3Q²/τ²: white angle noise of std Q = √(c/3), differenced at the
     //       output rate (white PM); its Allan variance is exactly 3Q²/τ² at every τ = m/rate.
-    axis.q_angle_std_deg = std::sqrt(allanVarianceCoefficient(NoiseTerm::Quantization, m.terms.quantization_urad) / 3.0);
+    axis.q_angle_std_deg =
+        std::sqrt(allanVarianceCoefficient(NoiseTerm::Quantization, m.terms.quantization_urad) / 3.0);
     axis.q_previous_angle_deg = axis.q_angle_std_deg * axis.q_noise.next();
     initAr(axis, m.ar);
   }
@@ -363,7 +365,8 @@ SimulatedSample NoiseSimulator::nextAnalog() {
   // Without a warm-up the curve is final + (+0)·e^{…} = final + 0.0 bit for bit: skip the
   // exponential (it was 8 % of a model check's time, which simulates that case).
   const double warmup = temp.start_c - temp.final_c;
-  out.temperature_c = warmup == 0.0 ? temp.final_c + 0.0 : temp.final_c + warmup * portable::exp(-t / temp.time_constant_s);
+  out.temperature_c =
+      warmup == 0.0 ? temp.final_c + 0.0 : temp.final_c + warmup * portable::exp(-t / temp.time_constant_s);
   if (temp.noise_std_c > 0.0) out.temperature_c += temp.noise_std_c * temperature_noise_.next();
   ++analog_index_;
   return out;
@@ -385,7 +388,8 @@ std::array<double, kSimulatedAxes> NoiseSimulator::nextOutputRateNoise() {
       if (p > 0) {
         // ar_history[(newest − (i−1)) mod p] = x_{k−i}
         double prediction = 0.0;
-        for (std::size_t i = 1; i <= p; ++i) prediction += axis.ar_phi[i - 1] * axis.ar_history[(axis.ar_newest + p - (i - 1)) % p];
+        for (std::size_t i = 1; i <= p; ++i)
+          prediction += axis.ar_phi[i - 1] * axis.ar_history[(axis.ar_newest + p - (i - 1)) % p];
         x = prediction + x;
         axis.ar_newest = (axis.ar_newest + 1) % p;
         axis.ar_history[axis.ar_newest] = x;
@@ -430,7 +434,8 @@ SimulatedSample NoiseSimulator::next() {
 }
 
 const std::vector<GaussMarkovComponent>& NoiseSimulator::flickerBank(std::size_t axis) const {
-  if (axis >= kSimulatedAxes) throw std::invalid_argument("flickerBank: axis must be 0..2, got " + std::to_string(axis));
+  if (axis >= kSimulatedAxes)
+    throw std::invalid_argument("flickerBank: axis must be 0..2, got " + std::to_string(axis));
   return axes_[axis].flicker_bank;
 }
 

@@ -42,7 +42,7 @@ struct SinusoidEffect {
   double phase_rad = 0.0;  // amp·sin(2π·f·t + phase)
 };
 struct BiasStepEffect {
-  double time_s = 0.0;    // the bias changes by size_dps from this time on
+  double time_s = 0.0;  // the bias changes by size_dps from this time on
   double size_dps = 0.0;
 };
 struct AxisExtraEffects {
@@ -66,7 +66,7 @@ struct AxisExtraEffects {
 };
 
 struct AxisNoiseModel {
-  NoiseTerms terms;     // paper units (µrad, °/√h, °/h, °/h^1.5, °/h²), each ≥ 0
+  NoiseTerms terms;  // paper units (µrad, °/√h, °/h, °/h^1.5, °/h²), each ≥ 0
   double bias_dps = 0.0;
   ArComponent ar;
   AxisExtraEffects extra;  // none by default
@@ -83,9 +83,9 @@ struct TemperatureModel {
 struct SimulationModel {
   std::array<AxisNoiseModel, kSimulatedAxes> axes;
   TemperatureModel temperature;
-  double rate_hz = 50.0;         // output rate (default: the paper's 50 Hz)
-  std::optional<int> dlpf_cfg;   // DLPF_CFG 0..6; none = no DLPF, generated at rate_hz
-  std::optional<int> fs_sel;     // FS_SEL 0..3; none = no quantisation or saturation
+  double rate_hz = 50.0;        // output rate (default: the paper's 50 Hz)
+  std::optional<int> dlpf_cfg;  // DLPF_CFG 0..6; none = no DLPF, generated at rate_hz
+  std::optional<int> fs_sel;    // FS_SEL 0..3; none = no quantisation or saturation
   // "Pure" mode (both none) shows the Allan terms alone, for testing them.
   bool pure() const { return !dlpf_cfg && !fs_sel; }
 };
@@ -119,8 +119,7 @@ struct GaussMarkovComponent {
 // flat·ln10/(2·ln2·2) (a 1/f spectrum sampled twice per decade), the two end ones
 // raised by √10/(√10 − 1) to stand in for the processes beyond the ends.
 // Empty when flat_allan_variance is 0. Throws std::invalid_argument on bad input.
-std::vector<GaussMarkovComponent> flickerGaussMarkovBank(double flat_allan_variance, double tau0_s,
-                                                         double duration_s);
+std::vector<GaussMarkovComponent> flickerGaussMarkovBank(double flat_allan_variance, double tau0_s, double duration_s);
 
 // White rate noise of two-sided density N at the internal rate, through the DLPF and
 // decimated to rate_hz, is white at low frequency with density N·F where
@@ -130,7 +129,7 @@ std::vector<GaussMarkovComponent> flickerGaussMarkovBank(double flat_allan_varia
 double aliasedWhiteNoiseFactor(int dlpf_cfg, double rate_hz);
 
 struct SimulatedSample {
-  double t_s = 0.0;                                // from 0
+  double t_s = 0.0;                               // from 0
   std::array<double, kSimulatedAxes> rate_dps{};  // °/s
   double temperature_c = 0.0;
 };
@@ -160,7 +159,7 @@ class NoiseSimulator {
 
   double outputRateHz() const { return model_.rate_hz; }
   double internalRateHz() const { return internal_rate_hz_; }
-  std::size_t decimation() const { return decimation_; }  // 1 + SMPLRT_DIV
+  std::size_t decimation() const { return decimation_; }     // 1 + SMPLRT_DIV
   std::size_t sampleCount() const { return sample_count_; }  // ⌊duration·rate⌋
   const SimulationModel& model() const { return model_; }
   // The flicker bank in use (same for all axes up to their level; empty if B = 0).
@@ -174,10 +173,10 @@ class NoiseSimulator {
   };
   struct AxisState {
     double bias_dps = 0.0;
-    double arw_std = 0.0;        // per internal sample
-    double rrw_step_std = 0.0;   // per internal sample
+    double arw_std = 0.0;       // per internal sample
+    double rrw_step_std = 0.0;  // per internal sample
     double rrw_value = 0.0;
-    double ramp_dps_per_s = 0.0; // signed
+    double ramp_dps_per_s = 0.0;  // signed
     std::vector<GaussMarkovComponent> flicker_bank;
     std::vector<GaussMarkovState> flicker;
     double q_angle_std_deg = 0.0;  // white angle noise, per output sample
@@ -213,9 +212,9 @@ class NoiseSimulator {
   std::vector<DigitalLowPassFilter> dlpf_;
   std::uint64_t analog_index_ = 0;
   std::uint64_t output_index_ = 0;
-  std::vector<ExtraState> extras_;   // empty when no axis has extra effects
+  std::vector<ExtraState> extras_;  // empty when no axis has extra effects
   std::optional<ZigguratNormalGenerator> extra_noise_;
-  std::uint64_t extra_index_ = 0;    // output samples produced by nextOutputRateNoise()
+  std::uint64_t extra_index_ = 0;  // output samples produced by nextOutputRateNoise()
 };
 
 }  // namespace gyrod::processing

@@ -22,8 +22,7 @@ double coefficientScale(NoiseTerm t) {
     case NoiseTerm::BiasInstability: return kBiasInstabilityFactor / units::kSecondsPerHour;
     case NoiseTerm::RateRandomWalk:
       return 1.0 / (units::kSecondsPerHour * units::kSqrtSecondsPerSqrtHour) / std::sqrt(3.0);
-    case NoiseTerm::RateRamp:
-      return 1.0 / (units::kSecondsPerHour * units::kSecondsPerHour) / std::sqrt(2.0);
+    case NoiseTerm::RateRamp: return 1.0 / (units::kSecondsPerHour * units::kSecondsPerHour) / std::sqrt(2.0);
   }
   throw std::invalid_argument("unknown noise term");
 }

@@ -16,8 +16,8 @@ namespace gyrod::processing {
 enum class NoiseTerm { Quantization = 0, AngleRandomWalk, BiasInstability, RateRandomWalk, RateRamp };
 inline constexpr std::size_t kNoiseTermCount = 5;
 inline constexpr std::array<NoiseTerm, kNoiseTermCount> kAllNoiseTerms = {
-    NoiseTerm::Quantization, NoiseTerm::AngleRandomWalk, NoiseTerm::BiasInstability,
-    NoiseTerm::RateRandomWalk, NoiseTerm::RateRamp};
+    NoiseTerm::Quantization, NoiseTerm::AngleRandomWalk, NoiseTerm::BiasInstability, NoiseTerm::RateRandomWalk,
+    NoiseTerm::RateRamp};
 
 // The flat level of the Allan deviation of flicker (1/f) rate noise, σ = √(2 ln 2 / π)·B.
 inline constexpr double kBiasInstabilityFactor = 0.6643;

@@ -84,8 +84,8 @@ class NormalGenerator {
 // every IEEE-754 machine.
 struct NormalZigguratLayers {
   static constexpr int kLayers = 256;
-  double r = 0.0;                     // start of the tail
-  double v = 0.0;                     // area of every layer
+  double r = 0.0;                       // start of the tail
+  double v = 0.0;                       // area of every layer
   std::array<double, kLayers + 1> x{};  // layer widths, see above
   std::array<double, kLayers + 1> f{};  // f(x[i]) for i ≥ 1 (f[kLayers] = 1); f[0] = 0
 };

@@ -118,8 +118,7 @@ std::vector<std::size_t> octaveFactorsForWindow(std::size_t window_samples) {
 RollingOverlappingAllan::RollingOverlappingAllan(std::size_t window_samples)
     : RollingOverlappingAllan(window_samples, octaveFactorsForWindow(window_samples)) {}
 
-RollingOverlappingAllan::RollingOverlappingAllan(std::size_t window_samples,
-                                                 std::span<const std::size_t> cluster_sizes)
+RollingOverlappingAllan::RollingOverlappingAllan(std::size_t window_samples, std::span<const std::size_t> cluster_sizes)
     : window_capacity_(window_samples), cluster_sizes_(cluster_sizes.begin(), cluster_sizes.end()) {
   if (window_samples < 2) {
     throw std::invalid_argument("RollingOverlappingAllan: window_samples must be >= 2 (got " +
@@ -135,14 +134,14 @@ RollingOverlappingAllan::RollingOverlappingAllan(std::size_t window_samples,
                                   "] = 0; averaging factor m must be >= 1");
     }
     if (m > window_samples / 2) {
-      throw std::invalid_argument("RollingOverlappingAllan: cluster_sizes[" + std::to_string(i) + "] = " +
-                                  std::to_string(m) + " is too long for a window of " +
+      throw std::invalid_argument("RollingOverlappingAllan: cluster_sizes[" + std::to_string(i) +
+                                  "] = " + std::to_string(m) + " is too long for a window of " +
                                   std::to_string(window_samples) + " samples (need 2*m <= window)");
     }
     if (i > 0 && m <= cluster_sizes_[i - 1]) {
-      throw std::invalid_argument("RollingOverlappingAllan: cluster_sizes must be strictly increasing (m = " +
-                                  std::to_string(m) + " at index " + std::to_string(i) + " follows " +
-                                  std::to_string(cluster_sizes_[i - 1]) + ")");
+      throw std::invalid_argument(
+          "RollingOverlappingAllan: cluster_sizes must be strictly increasing (m = " + std::to_string(m) +
+          " at index " + std::to_string(i) + " follows " + std::to_string(cluster_sizes_[i - 1]) + ")");
     }
   }
   window_sums_.resize(cluster_sizes_.size());
@@ -219,9 +218,9 @@ void RollingOverlappingAllan::push(double rate) {
 
 void RollingOverlappingAllan::requireIndex(std::size_t index, const char* where) const {
   if (index >= cluster_sizes_.size()) {
-    throw std::out_of_range(std::string("RollingOverlappingAllan::") + where + ": index " +
-                            std::to_string(index) + " is not below the number of cluster sizes (" +
-                            std::to_string(cluster_sizes_.size()) + ")");
+    throw std::out_of_range(std::string("RollingOverlappingAllan::") + where + ": index " + std::to_string(index) +
+                            " is not below the number of cluster sizes (" + std::to_string(cluster_sizes_.size()) +
+                            ")");
   }
 }
 

@@ -158,9 +158,7 @@ class RollingOverlappingAllan {
     double lo = 0.0;
   };
   // Ring slot of the phase point `back` places before the newest one (back ≤ capacity).
-  std::size_t slotBack(std::size_t back) const {
-    return head_ >= back ? head_ - back : head_ + ring_.size() - back;
-  }
+  std::size_t slotBack(std::size_t back) const { return head_ >= back ? head_ - back : head_ + ring_.size() - back; }
   // d = x_{j+2m} − 2x_{j+m} + x_j with x_{j+2m} `back` places before the newest phase
   // point, in double-double, rounded once. Deterministic: the same stored points give the
   // same double, which is what lets the window sum remove a leaving term exactly.
@@ -174,7 +172,7 @@ class RollingOverlappingAllan {
   std::vector<PhasePoint> ring_;  // window_capacity_ + 1 phase points
   std::size_t head_ = 0;          // slot of the newest phase point, x_total
   std::uint64_t total_count_ = 0;
-  double reference_ = 0.0;        // the first sample, subtracted from every sample
+  double reference_ = 0.0;  // the first sample, subtracted from every sample
 };
 
 }  // namespace gyrod::processing

@@ -38,8 +38,7 @@ DigitalLowPassFilter::DigitalLowPassFilter(int cfg) : setting_(&dlpfSetting(cfg)
   // when tan(πf_c/fs)/K = √(√2 − 1). portable::tan keeps the coefficients (and hence the
   // simulator's stream) bit-identical across machines.
   const double fs = setting_->internal_rate_hz;
-  const double k = portable::tan(std::numbers::pi * setting_->bandwidth_hz / fs) /
-                   std::sqrt(std::sqrt(2.0) - 1.0);
+  const double k = portable::tan(std::numbers::pi * setting_->bandwidth_hz / fs) / std::sqrt(std::sqrt(2.0) - 1.0);
   const double g = k / (1.0 + k);
   const double p = (k - 1.0) / (k + 1.0);
   b0_ = g * g;
@@ -80,8 +79,7 @@ double DigitalLowPassFilter::groupDelayAtDc() const {
 double gyroSensitivityLsbPerDps(int fs_sel) {
   // Register map rev 4.2 §4.19 (GYRO_XOUT…): FS_SEL → LSB per °/s.
   constexpr std::array<double, 4> kSensitivity = {131.0, 65.5, 32.8, 16.4};
-  if (fs_sel < 0 || fs_sel > 3)
-    throw std::invalid_argument("FS_SEL must be 0..3, got " + std::to_string(fs_sel));
+  if (fs_sel < 0 || fs_sel > 3) throw std::invalid_argument("FS_SEL must be 0..3, got " + std::to_string(fs_sel));
   return kSensitivity[static_cast<std::size_t>(fs_sel)];
 }
 

@@ -10,10 +10,10 @@
 namespace gyrod::processing {
 
 struct DlpfSetting {
-  int cfg = 0;                   // DLPF_CFG 0..6
-  double bandwidth_hz = 0.0;     // documented gyro bandwidth (−3 dB)
-  double delay_ms = 0.0;         // documented gyro delay
-  double internal_rate_hz = 0.0; // gyro output rate before SMPLRT_DIV: 8 kHz for cfg 0, else 1 kHz
+  int cfg = 0;                    // DLPF_CFG 0..6
+  double bandwidth_hz = 0.0;      // documented gyro bandwidth (−3 dB)
+  double delay_ms = 0.0;          // documented gyro delay
+  double internal_rate_hz = 0.0;  // gyro output rate before SMPLRT_DIV: 8 kHz for cfg 0, else 1 kHz
 };
 // Throws std::invalid_argument for cfg outside 0..6 (7 is reserved).
 const DlpfSetting& dlpfSetting(int cfg);
@@ -27,7 +27,7 @@ const DlpfSetting& dlpfSetting(int cfg);
 class DigitalLowPassFilter {
  public:
   explicit DigitalLowPassFilter(int cfg);
-  double update(double x);  // one input at the internal rate → one output
+  double update(double x);         // one input at the internal rate → one output
   void reset(double value = 0.0);  // steady state at `value`
   // H(e^{j2πf/fs}) of the filter as implemented (fs = internal rate).
   std::complex<double> frequencyResponse(double f_hz) const;

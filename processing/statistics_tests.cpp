@@ -81,11 +81,10 @@ ReverseArrangementsTest reverseArrangementsTest(std::span<const double> x, std::
                                                 SegmentStatistic statistic) {
   if (segments < kMinReverseArrangementsSegments)
     throw std::invalid_argument("reverseArrangementsTest: segments must be >= " +
-                                std::to_string(kMinReverseArrangementsSegments) + ", got " +
-                                std::to_string(segments));
+                                std::to_string(kMinReverseArrangementsSegments) + ", got " + std::to_string(segments));
   if (x.size() < segments)
-    throw std::invalid_argument("reverseArrangementsTest: " + std::to_string(x.size()) +
-                                " samples cannot fill " + std::to_string(segments) + " segments");
+    throw std::invalid_argument("reverseArrangementsTest: " + std::to_string(x.size()) + " samples cannot fill " +
+                                std::to_string(segments) + " segments");
   requireFinite(x, "reverseArrangementsTest");
   // Bendat & Piersol apply the test to the mean-square values of equal-length segments of a
   // record they take as zero-mean. The paper ran it on raw data whose mean (1.367) dwarfs the

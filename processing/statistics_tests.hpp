@@ -37,7 +37,7 @@ enum class SegmentStatistic {
 };
 struct ReverseArrangementsTest {
   std::size_t segments = 0;
-  double arrangements = 0.0;   // A
+  double arrangements = 0.0;       // A
   double mean_arrangements = 0.0;  // μ_A
   double sd_arrangements = 0.0;    // σ_A
   double u = 0.0;

@@ -112,7 +112,8 @@ std::size_t formatGapLine(const GapEvent& gap, std::span<char, kMaxGapLineBytes>
 }
 
 std::string versionLine(std::string_view release) {
-  return jsonLine({{"class", "VERSION"}, {"release", release}, {"proto_major", kProtocolMajor}, {"proto_minor", kProtocolMinor}});
+  return jsonLine(
+      {{"class", "VERSION"}, {"release", release}, {"proto_major", kProtocolMajor}, {"proto_minor", kProtocolMinor}});
 }
 
 std::string watchLine(bool enable, std::uint32_t decimate) {
@@ -138,7 +139,8 @@ std::string_view errorCodeName(ErrorCode code) {
 std::string errorLine(ErrorCode code, std::string_view message) {
   // The message may quote client bytes that are not UTF-8: replace them, never throw.
   return json({{"class", "ERROR"}, {"code", errorCodeName(code)}, {"message", message}})
-             .dump(-1, ' ', false, json::error_handler_t::replace) + '\n';
+             .dump(-1, ' ', false, json::error_handler_t::replace) +
+         '\n';
 }
 
 std::string allanLine(const AllanReport& r) {
@@ -147,8 +149,8 @@ std::string allanLine(const AllanReport& r) {
     for (std::size_t s = 0; s < 3; ++s) {
       const auto& c = r.curves[a][s].adev_dps;
       if (!c.empty() && c.size() != n)
-        throw std::invalid_argument("ALLAN: curve " + std::string(kAxisNames[a]) + "/" + std::string(kStreamNames[s]) + " has " +
-                                    std::to_string(c.size()) + " values for " + std::to_string(n) + " taus");
+        throw std::invalid_argument("ALLAN: curve " + std::string(kAxisNames[a]) + "/" + std::string(kStreamNames[s]) +
+                                    " has " + std::to_string(c.size()) + " values for " + std::to_string(n) + " taus");
     }
   // Keep τ only where every computed curve has a value.
   std::vector<std::size_t> keep;
@@ -196,14 +198,9 @@ std::string allanLine(const AllanReport& r) {
 }
 
 std::string statusLine(const StatusReport& d, const ServerStatus& s) {
-  json j = {{"class", "STATUS"},
-            {"uptime", d.uptime_s},
-            {"samples", d.samples},
-            {"gaps", d.gaps},
-            {"missing", d.missing_samples},
-            {"bus_errors", d.bus_errors},
-            {"resets", d.resets},
-            {"device_state", d.device_state}};
+  json j = {{"class", "STATUS"},  {"uptime", d.uptime_s},          {"samples", d.samples},
+            {"gaps", d.gaps},     {"missing", d.missing_samples},  {"bus_errors", d.bus_errors},
+            {"resets", d.resets}, {"device_state", d.device_state}};
   if (!std::isfinite(d.uptime_s)) j.erase("uptime");
   if (!d.device_reason.empty()) j["device_reason"] = d.device_reason;
   if (d.device_retrying) j["device_retrying"] = *d.device_retrying;
@@ -250,7 +247,8 @@ std::string requestLine(const Request& request) {
 Request parseRequest(std::string_view line) {
   const json j = json::parse(line.begin(), line.end(), nullptr, /*allow_exceptions=*/false);
   if (j.is_discarded()) throw ProtocolError(ErrorCode::NotJson, "the line is not valid JSON");
-  if (!j.is_object()) throw ProtocolError(ErrorCode::NotObject, std::string("expected a JSON object, got ") + jsonTypeName(j));
+  if (!j.is_object())
+    throw ProtocolError(ErrorCode::NotObject, std::string("expected a JSON object, got ") + jsonTypeName(j));
   const auto cmd_it = j.find("cmd");
   if (cmd_it == j.end()) throw ProtocolError(ErrorCode::MissingField, "no \"cmd\" field");
   if (!cmd_it->is_string())
@@ -270,14 +268,17 @@ Request parseRequest(std::string_view line) {
     WatchRequest w;
     if (const auto it = j.find("enable"); it != j.end()) {
       if (!it->is_boolean())
-        throw ProtocolError(ErrorCode::BadType, std::string("\"enable\" must be true or false, got ") + jsonTypeName(*it));
+        throw ProtocolError(ErrorCode::BadType,
+                            std::string("\"enable\" must be true or false, got ") + jsonTypeName(*it));
       w.enable = it->get<bool>();
     }
     if (const auto it = j.find("decimate"); it != j.end()) {
       if (!it->is_number_integer())
-        throw ProtocolError(ErrorCode::BadType, std::string("\"decimate\" must be an integer, got ") +
-                                                    (it->is_number_float() ? std::string("a fractional number") : jsonTypeName(*it)));
-      const bool in_range = it->is_number_unsigned() && it->get<std::uint64_t>() >= 1 && it->get<std::uint64_t>() <= kMaxDecimate;
+        throw ProtocolError(ErrorCode::BadType,
+                            std::string("\"decimate\" must be an integer, got ") +
+                                (it->is_number_float() ? std::string("a fractional number") : jsonTypeName(*it)));
+      const bool in_range =
+          it->is_number_unsigned() && it->get<std::uint64_t>() >= 1 && it->get<std::uint64_t>() <= kMaxDecimate;
       if (!in_range)
         throw ProtocolError(ErrorCode::OutOfRange,
                             "\"decimate\" must be in 1.." + std::to_string(kMaxDecimate) + ", got " + it->dump());

@@ -35,9 +35,9 @@ inline constexpr std::array<std::string_view, 3> kStreamNames = {"raw", "mean", 
 
 // One sample of the three axes after each stage of the chain.
 struct RateSample {
-  std::uint64_t seq = 0;             // sample sequence number, +1 per sample of the device
-  double t_s = 0.0;                  // sample time, CLOCK_MONOTONIC [s]
-  double temp_c = 0.0;               // die temperature [°C]
+  std::uint64_t seq = 0;               // sample sequence number, +1 per sample of the device
+  double t_s = 0.0;                    // sample time, CLOCK_MONOTONIC [s]
+  double temp_c = 0.0;                 // die temperature [°C]
   std::array<double, 3> raw_dps{};     // x, y, z angular rate as read [°/s]
   std::array<double, 3> mean_dps{};    // after the gross-error mean filter [°/s]
   std::array<double, 3> kalman_dps{};  // after the Kalman filter [°/s]
@@ -89,14 +89,14 @@ std::string errorLine(ErrorCode code, std::string_view message);
 
 // The Allan statistics of the rolling window, one curve per axis and stream.
 struct AllanCurve {
-  std::vector<double> adev_dps;  // overlapping Allan deviation at each τ [°/s]; empty: not computed
+  std::vector<double> adev_dps;                 // overlapping Allan deviation at each τ [°/s]; empty: not computed
   std::optional<processing::NoiseTerms> noise;  // fitted IEEE 952 terms (NaN term: not estimated)
 };
 struct AllanReport {
-  double window_s = 0.0;       // time spanned by the samples in the window [s]
-  std::uint64_t samples = 0;   // samples in the window
-  double tau0_s = 0.0;         // sample period [s]
-  std::vector<double> tau_s;   // averaging times [s]
+  double window_s = 0.0;                            // time spanned by the samples in the window [s]
+  std::uint64_t samples = 0;                        // samples in the window
+  double tau0_s = 0.0;                              // sample period [s]
+  std::vector<double> tau_s;                        // averaging times [s]
   std::array<std::array<AllanCurve, 3>, 3> curves;  // [axis x,y,z][stream raw,mean,kalman]
 };
 // Throws std::invalid_argument when a computed curve's length differs from tau_s's. A τ at
@@ -112,27 +112,27 @@ struct NamedCount {
 
 // What the daemon knows about itself (STATUS); empty optionals are omitted.
 struct StatusReport {
-  double uptime_s = 0.0;              // since the daemon started [s]
-  std::uint64_t samples = 0;          // samples published since start
-  std::uint64_t gaps = 0;             // GAP events since start
-  std::uint64_t missing_samples = 0;  // samples lost in those gaps
-  std::uint64_t bus_errors = 0;       // failed bus transfers
-  std::uint64_t resets = 0;           // device resets (FIFO overflow, silent reset, errors)
-  std::string device_state;           // e.g. "streaming" (docs/protocol.md lists them)
-  std::string device_reason;          // why the device is in that state; empty (omitted) while all is well
-  std::optional<bool> device_retrying;  // whether the driver keeps trying to reach the device
+  double uptime_s = 0.0;                    // since the daemon started [s]
+  std::uint64_t samples = 0;                // samples published since start
+  std::uint64_t gaps = 0;                   // GAP events since start
+  std::uint64_t missing_samples = 0;        // samples lost in those gaps
+  std::uint64_t bus_errors = 0;             // failed bus transfers
+  std::uint64_t resets = 0;                 // device resets (FIFO overflow, silent reset, errors)
+  std::string device_state;                 // e.g. "streaming" (docs/protocol.md lists them)
+  std::string device_reason;                // why the device is in that state; empty (omitted) while all is well
+  std::optional<bool> device_retrying;      // whether the driver keeps trying to reach the device
   std::vector<NamedCount> device_counters;  // every counter of the driver, in its order ("counters")
-  std::optional<std::string> device;  // e.g. "/dev/i2c-1@0x68"
-  std::optional<double> rate_hz;          // measured sample rate [Hz]
-  std::optional<double> nominal_rate_hz;  // configured sample rate [Hz]
-  std::optional<double> temp_c;           // latest die temperature [°C]
-  std::optional<std::string> bias_source;  // where the bias subtracted from raw comes from
-  std::optional<std::string> recording;    // file being recorded to
+  std::optional<std::string> device;        // e.g. "/dev/i2c-1@0x68"
+  std::optional<double> rate_hz;            // measured sample rate [Hz]
+  std::optional<double> nominal_rate_hz;    // configured sample rate [Hz]
+  std::optional<double> temp_c;             // latest die temperature [°C]
+  std::optional<std::string> bias_source;   // where the bias subtracted from raw comes from
+  std::optional<std::string> recording;     // file being recorded to
 };
 
 // What the server knows about its clients; added to every STATUS line.
 struct ClientStatus {
-  std::uint64_t id = 0;  // 1, 2, ... in order of connection
+  std::uint64_t id = 0;                  // 1, 2, ... in order of connection
   std::optional<std::int64_t> pid, uid;  // of the peer (SO_PEERCRED)
   bool watch = false;
   std::uint32_t decimate = 1;

@@ -25,9 +25,7 @@ void MockMpu6050::applyFaultEvent(const mock::FaultEvent& event, std::int64_t t_
   using Kind = mock::FaultEventKind;
   const FaultPlan& plan = faults_.plan();
   switch (event.kind) {
-    case Kind::BurstStart:
-      faults_.startBurst(event.index);
-      break;
+    case Kind::BurstStart: faults_.startBurst(event.index); break;
     case Kind::OutageStart:
       faults_.startOutage(event.index);
       ++counters_.outages_started;
@@ -48,15 +46,9 @@ void MockMpu6050::applyFaultEvent(const mock::FaultEvent& event, std::int64_t t_
       ++counters_.brownouts;
       resetChip();
       break;
-    case Kind::ForcedOverflow:
-      forceFifoOverflow(t_ns);
-      break;
-    case Kind::StuckStart:
-      int_line_.stick(plan.stuck_data_ready[event.index].level_high, t_ns);
-      break;
-    case Kind::StuckEnd:
-      int_line_.unstick(t_ns);
-      break;
+    case Kind::ForcedOverflow: forceFifoOverflow(t_ns); break;
+    case Kind::StuckStart: int_line_.stick(plan.stuck_data_ready[event.index].level_high, t_ns); break;
+    case Kind::StuckEnd: int_line_.unstick(t_ns); break;
   }
 }
 

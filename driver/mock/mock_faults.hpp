@@ -66,9 +66,9 @@ struct FaultPlan {
 
 struct MockCounters {
   // Bus side.
-  std::uint64_t transfers = 0;                // every transfer attempted
-  std::uint64_t transfers_ok = 0;             // returned 0
-  std::uint64_t nacks_absent_address = 0;     // selected address is not the chip's
+  std::uint64_t transfers = 0;             // every transfer attempted
+  std::uint64_t transfers_ok = 0;          // returned 0
+  std::uint64_t nacks_absent_address = 0;  // selected address is not the chip's
   std::uint64_t injected_random_errors = 0;
   std::uint64_t injected_burst_errors = 0;
   std::uint64_t nacks_during_outage = 0;
@@ -81,17 +81,17 @@ struct MockCounters {
   std::uint64_t device_resets = 0;            // DEVICE_RESET writes
 
   // Chip side.
-  std::uint64_t internal_ticks = 0;             // gyro output ticks (1 or 8 kHz) while awake
+  std::uint64_t internal_ticks = 0;              // gyro output ticks (1 or 8 kHz) while awake
   std::uint64_t source_rate_mismatch_ticks = 0;  // ticks taken at a rate the source did not expect
-  std::uint64_t samples_produced = 0;           // sample-rate ticks; also the next sequence number
-  std::uint64_t fifo_frames_written = 0;        // samples appended to the FIFO
+  std::uint64_t samples_produced = 0;            // sample-rate ticks; also the next sequence number
+  std::uint64_t fifo_frames_written = 0;         // samples appended to the FIFO
   std::uint64_t fifo_bytes_written = 0;
-  std::uint64_t fifo_bytes_overwritten = 0;     // oldest bytes lost to overflow
-  std::uint64_t fifo_overflow_events = 0;       // appends that overwrote something
-  std::uint64_t fifo_bytes_read = 0;            // popped through FIFO_R_W
-  std::uint64_t fifo_empty_reads = 0;           // FIFO_R_W reads with the FIFO empty
+  std::uint64_t fifo_bytes_overwritten = 0;  // oldest bytes lost to overflow
+  std::uint64_t fifo_overflow_events = 0;    // appends that overwrote something
+  std::uint64_t fifo_bytes_read = 0;         // popped through FIFO_R_W
+  std::uint64_t fifo_empty_reads = 0;        // FIFO_R_W reads with the FIFO empty
   std::uint64_t fifo_resets = 0;
-  std::uint64_t data_ready_interrupts = 0;      // DATA_RDY_INT raised (enabled)
+  std::uint64_t data_ready_interrupts = 0;  // DATA_RDY_INT raised (enabled)
 };
 
 }  // namespace gyrod::driver

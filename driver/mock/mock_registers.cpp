@@ -21,20 +21,16 @@ std::uint8_t MockMpu6050::readRegister(std::uint8_t r) {
       clearInterruptStatus(0xFF, now_ns_);
       return v;
     }
-    case R(Register::FIFO_COUNTH):
-      return fifo_.latchCountHigh();
-    case R(Register::FIFO_COUNTL):
-      return fifo_.latchedCountLow();
-    case R(Register::FIFO_R_W):
-      return popFifo();
+    case R(Register::FIFO_COUNTH): return fifo_.latchCountHigh();
+    case R(Register::FIFO_COUNTL): return fifo_.latchedCountLow();
+    case R(Register::FIFO_R_W): return popFifo();
     case R(Register::WHO_AM_I):
       if (const auto fake = faults_.fakeWhoAmI()) {
         ++counters_.who_am_i_faked_reads;
         return *fake;
       }
       return mpu6050::kWhoAmI;
-    default:
-      return regs_.stored(r);
+    default: return regs_.stored(r);
   }
 }
 
@@ -49,27 +45,17 @@ void MockMpu6050::writeRegister(std::uint8_t r, std::uint8_t v) {
     return;
   }
   switch (r) {
-    case R(Register::PWR_MGMT_1):
-      writePowerManagement(v);
-      return;
-    case R(Register::CONFIG):
-      writeConfig(v);
-      return;
-    case R(Register::USER_CTRL):
-      writeUserControl(v);
-      return;
+    case R(Register::PWR_MGMT_1): writePowerManagement(v); return;
+    case R(Register::CONFIG): writeConfig(v); return;
+    case R(Register::USER_CTRL): writeUserControl(v); return;
     case R(Register::SIGNAL_PATH_RESET):
       regs_.at(r) = 0;  // self-clearing; analog/digital path resets have no effect on the model
       return;
-    case R(Register::INT_PIN_CFG):
-      writeIntPinConfig(v);
-      return;
+    case R(Register::INT_PIN_CFG): writeIntPinConfig(v); return;
     case R(Register::FIFO_R_W):
       pushFifo(&v, 1, now_ns_);  // the host may write into the FIFO too
       return;
-    default:
-      regs_.at(r) = v;
-      return;
+    default: regs_.at(r) = v; return;
   }
 }
 

@@ -48,8 +48,8 @@ void MockMpu6050::sampleTick(std::int64_t t_ns) {
     s.accel[i] = processing::quantizeToInt16(config_.accel_g[i] + accelNoise(), mpu6050::kAccelLsbPerG[afs_sel]);
   }
   // TEMP_OUT = (T − 36.53) · 340, the inverse of RM Registers 65–66.
-  s.temperature = processing::quantizeToInt16(temperature_c_ - mpu6050::kTemperatureOffsetDegC,
-                                              mpu6050::kTemperatureLsbPerDegC);
+  s.temperature =
+      processing::quantizeToInt16(temperature_c_ - mpu6050::kTemperatureOffsetDegC, mpu6050::kTemperatureLsbPerDegC);
   latchOutputs(s);
 
   if (regs_.has(Register::USER_CTRL, reg::USER_CTRL_BIT::FIFO_EN)) {

@@ -32,8 +32,7 @@ SinusoidSource::SinusoidSource(std::array<SinusoidAxis, 3> axes, double temperat
     requireFinite(axes[i].frequency_hz, axis + " frequency_hz");
     requireFinite(axes[i].phase_rad, axis + " phase_rad");
     if (axes[i].frequency_hz < 0.0) {
-      throw std::invalid_argument(axis + " frequency_hz must be >= 0, got " +
-                                  std::to_string(axes[i].frequency_hz));
+      throw std::invalid_argument(axis + " frequency_hz must be >= 0, got " + std::to_string(axes[i].frequency_hz));
     }
   }
   requireFinite(temperature_c, "SinusoidSource temperature_c");
@@ -75,8 +74,7 @@ ReplaySource::ReplaySource(std::vector<double> x_dps, std::vector<double> y_dps,
   const auto check_finite = [](const std::vector<double>& v, const char* name) {
     for (std::size_t i = 0; i < v.size(); ++i) {
       if (!std::isfinite(v[i])) {
-        throw std::invalid_argument(std::string("ReplaySource: ") + name + "[" + std::to_string(i) +
-                                    "] is not finite");
+        throw std::invalid_argument(std::string("ReplaySource: ") + name + "[" + std::to_string(i) + "] is not finite");
       }
     }
   };

@@ -20,8 +20,8 @@ processing::SimulationModel modelAtInternalRate(processing::SimulationModel mode
 }
 }  // namespace
 
-SimulatorSignalSource::SimulatorSignalSource(const processing::SimulationModel& model, int dlpf_cfg,
-                                             std::uint64_t seed, double horizon_s)
+SimulatorSignalSource::SimulatorSignalSource(const processing::SimulationModel& model, int dlpf_cfg, std::uint64_t seed,
+                                             double horizon_s)
     : simulator_(std::make_unique<processing::NoiseSimulator>(modelAtInternalRate(model, dlpf_cfg), horizon_s, seed)) {}
 
 AnalogSample SimulatorSignalSource::nextTick(double /*t_s*/) {

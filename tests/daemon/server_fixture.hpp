@@ -18,9 +18,9 @@
 #include <vector>
 
 #include "daemon/event_loop.hpp"
+#include "daemon/unix_socket_server.hpp"
 #include "protocol/fd.hpp"
 #include "protocol/protocol.hpp"
-#include "daemon/unix_socket_server.hpp"
 #include "tools/run_command.hpp"
 
 namespace gyrod::test {
@@ -149,7 +149,8 @@ class TestClient {
 
 // Pumps `loop` and reads all `clients` side by side (as independent processes would)
 // until each has received its count of lines.
-inline void collectConcurrently(EventLoop& loop, const std::vector<TestClient*>& clients, const std::vector<std::size_t>& counts) {
+inline void collectConcurrently(EventLoop& loop, const std::vector<TestClient*>& clients,
+                                const std::vector<std::size_t>& counts) {
   const auto deadline = std::chrono::steady_clock::now() + kHangGuard;
   auto done = [&] {
     for (std::size_t i = 0; i < clients.size(); ++i)
@@ -189,7 +190,8 @@ class ServerFixture : public ::testing::Test {
   void startServer(daemon::ServerOptions options = {}) {
     daemon::SocketOptions so;
     so.path = socketPath();
-    server_ = std::make_unique<daemon::UnixSocketServer>(loop_, daemon::bindListeningSocket(so), content_, std::move(options));
+    server_ = std::make_unique<daemon::UnixSocketServer>(loop_, daemon::bindListeningSocket(so), content_,
+                                                         std::move(options));
   }
   std::string socketPath() const { return (dir_.path() / "gyrod.sock").string(); }
 

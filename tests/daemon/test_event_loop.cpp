@@ -1,7 +1,7 @@
 // The event loop: fds, timers and signals behind one interface, and sources that remove
 // each other (or themselves) while a batch is being dispatched.
-#include <gtest/gtest.h>
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <unistd.h>
 

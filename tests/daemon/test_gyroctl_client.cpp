@@ -242,7 +242,8 @@ TEST_F(GyroctlTest, AllanTableJsonAndPlot) {
   ASSERT_GE(lines.size(), 5u) << h.out;
   EXPECT_NE(lines[0].find("window 600 s (30000 samples, tau0 0.02 s)"), std::string::npos) << lines[0];
   const auto head = words(lines[1]);
-  const std::vector<std::string> expected_head = {"tau", "[s]", "x", "raw", "x", "kalman", "y", "raw", "y", "kalman", "z", "raw", "z", "kalman"};
+  const std::vector<std::string> expected_head = {"tau", "[s]", "x",      "raw", "x",   "kalman", "y",
+                                                  "raw", "y",   "kalman", "z",   "raw", "z",      "kalman"};
   EXPECT_EQ(head, expected_head);
   for (std::size_t i = 0; i < 3; ++i) {
     const auto w = words(lines[2 + i]);
@@ -270,7 +271,8 @@ TEST_F(GyroctlTest, PlotWithoutGnuplotSaysSoAfterTheTable) {
   content_.allan = exampleAllan();
   startServer();
   const auto png = dir_.path() / "adev.png";
-  const CommandResult r = run({"allan", "--socket", socketPath(), "--plot", png.string()}, {"PATH=/nonexistent-gyrod-test"});
+  const CommandResult r =
+      run({"allan", "--socket", socketPath(), "--plot", png.string()}, {"PATH=/nonexistent-gyrod-test"});
   EXPECT_EQ(r.exit_status, 1);
   EXPECT_NE(r.err.find("gnuplot is not installed (apt-get install gnuplot-nox)"), std::string::npos) << r.err;
   EXPECT_NE(r.out.find("tau [s]"), std::string::npos) << r.out;
@@ -313,5 +315,6 @@ TEST_F(GyroctlTest, ConnectionProblemsAreExplained) {
   }
   const CommandResult r = run({"status", "--socket", socketPath()}, {}, as_user);
   EXPECT_EQ(r.exit_status, 1) << r.err;
-  EXPECT_NE(r.err.find(socketPath() + ": permission denied (the socket is for members of group '"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(socketPath() + ": permission denied (the socket is for members of group '"), std::string::npos)
+      << r.err;
 }

@@ -78,8 +78,7 @@ TEST_F(ServerFixture, PublishingAllocatesNothing) {
     }
     {
       CountAllocations c;
-      while (loop_.runOnce(0ms) > 0) {
-      }
+      while (loop_.runOnce(0ms) > 0) {}
       dispatch_allocations += c.count();
     }
     fast->collect();

@@ -173,7 +173,7 @@ TEST_F(ServerTest, BadRequestsGetNamedErrorsAndTheClientStays) {
   };
   std::string all;
   for (const auto& [line, code] : cases) all += line + "\r\n";  // CRLF works too
-  all += "\n   \n";                                              // blank lines are ignored
+  all += "\n   \n";                                             // blank lines are ignored
   c->send(all);
   const auto replies = c->readLines(loop_, cases.size());
   ASSERT_EQ(replies.size(), cases.size());
@@ -339,10 +339,10 @@ TEST_F(ServerTest, SocketFileIsRemovedAtShutdownButNotAReplacement) {
   // Another process replaced the file meanwhile: the old server must leave it alone.
   std::filesystem::remove(socketPath());
   makeStaleSocketFile(socketPath());
-  struct stat before{};
+  struct stat before {};
   ASSERT_EQ(::stat(socketPath().c_str(), &before), 0);
   server_.reset();
-  struct stat after{};
+  struct stat after {};
   ASSERT_EQ(::stat(socketPath().c_str(), &after), 0);
   EXPECT_EQ(before.st_ino, after.st_ino);
 }
@@ -405,7 +405,7 @@ TEST(ListeningSocket, ModeGroupAndParentFolderAreApplied) {
   so.mode = 0640;
   so.group = std::string(g->gr_name);
   const daemon::ListeningSocket ls = daemon::bindListeningSocket(so);
-  struct stat st{};
+  struct stat st {};
   ASSERT_EQ(::stat(path.c_str(), &st), 0);
   EXPECT_TRUE(S_ISSOCK(st.st_mode));
   EXPECT_EQ(st.st_mode & 0777, 0640u);

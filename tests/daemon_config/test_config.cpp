@@ -122,7 +122,8 @@ TEST(ShippedConfig, MentionsEveryKeyTheLoaderAccepts) {
     const auto header = shipped.find("[" + section + "]\n");
     ASSERT_NE(header, std::string::npos) << section;
     const auto next_header = shipped.find("\n[", header + 1);
-    const std::string body = shipped.substr(header, next_header == std::string::npos ? std::string::npos : next_header - header);
+    const std::string body =
+        shipped.substr(header, next_header == std::string::npos ? std::string::npos : next_header - header);
     std::stringstream keys(list);
     std::string key;
     int count = 0;
@@ -310,8 +311,9 @@ TEST(ConfigErrors, UnknownKeysInNestedAndInlineTables) {
             "x.toml:2: unknown key 'vanishh' in [mock.faults] (valid keys: transfer_error_fraction, error_burst, "
             "vanish, silent_reset_at_s, fifo_overflow_at_s, who_am_i, stuck_data_ready_at_s, "
             "stuck_data_ready_duration_s); did you mean 'vanish'?");
-  EXPECT_EQ(errorOf("[mock.faults]\nerror_burst = [\n  { at_s = 1, count = 2 },\n  { at_s = 3, cnt = 4 },\n]\n"),
-            "x.toml:4: unknown key 'cnt' in [mock.faults.error_burst] (valid keys: at_s, count); did you mean 'count'?");
+  EXPECT_EQ(
+      errorOf("[mock.faults]\nerror_burst = [\n  { at_s = 1, count = 2 },\n  { at_s = 3, cnt = 4 },\n]\n"),
+      "x.toml:4: unknown key 'cnt' in [mock.faults.error_burst] (valid keys: at_s, count); did you mean 'count'?");
   EXPECT_EQ(errorOf("[filter]\nkalman = { a = 0.5, qq = 1 }\n"),
             "x.toml:2: unknown key 'qq' in [filter.kalman] (valid keys: a, q, r); did you mean 'q'?");
 }
@@ -350,9 +352,11 @@ TEST(ConfigErrors, OutOfRangeNamesKeyRangeAndValue) {
             "x.toml:2: key 'socket.mode': must be octal permission bits as a string, e.g. \"0660\" (got \"0999\")");
   EXPECT_EQ(errorOf("[record]\nflush_interval_s = 0\n"),
             "x.toml:2: key 'record.flush_interval_s': must be between 0.01 and 3600 s (got 0)");
-  EXPECT_EQ(errorOf("[log]\nlevel = \"verbose\"\n"),
-            "x.toml:2: key 'log.level': must be one of trace, debug, info, warn, error, critical, off (got \"verbose\")");
-  EXPECT_EQ(errorOf("[mock]\nspeed = 0\n"), "x.toml:2: key 'mock.speed': must be > 0 and ≤ 1000 (1 = real time) (got 0)");
+  EXPECT_EQ(
+      errorOf("[log]\nlevel = \"verbose\"\n"),
+      "x.toml:2: key 'log.level': must be one of trace, debug, info, warn, error, critical, off (got \"verbose\")");
+  EXPECT_EQ(errorOf("[mock]\nspeed = 0\n"),
+            "x.toml:2: key 'mock.speed': must be > 0 and ≤ 1000 (1 = real time) (got 0)");
   EXPECT_EQ(errorOf("[mock.faults]\ntransfer_error_fraction = 1.5\n"),
             "x.toml:2: key 'mock.faults.transfer_error_fraction': must be between 0 and 1 (got 1.5)");
   EXPECT_EQ(errorOf("[mock.faults]\nfifo_overflow_at_s = [1,\n -2]\n"),
@@ -436,8 +440,8 @@ TEST(CommandLine, FlagsOverrideTheFile) {
   const auto f = d.write("g.toml",
                          "[device]\nbackend = \"i2c\"\n[socket]\npath = \"/tmp/file.sock\"\n[record]\npath = "
                          "\"/tmp/file.csv\"\n[mock]\nspeed = 2\n[log]\nlevel = \"warn\"\n");
-  const auto r = parseArgs({"--config", f, "--backend", "mock", "--socket", "/tmp/flag.sock", "--record", "/tmp/flag.csv",
-                            "--mock-speed", "50", "--log-level", "trace"},
+  const auto r = parseArgs({"--config", f, "--backend", "mock", "--socket", "/tmp/flag.sock", "--record",
+                            "/tmp/flag.csv", "--mock-speed", "50", "--log-level", "trace"},
                            d.path("absent.toml"));
   ASSERT_FALSE(r.exit_code) << r.message;
   EXPECT_EQ(r.config.device.backend, DeviceBackend::Mock);

@@ -118,8 +118,9 @@ TEST(Recorder, GapsAreCommentLinesInStreamOrder) {
   }
   const auto lines = linesOf(readText(file));
   std::vector<std::string> tail(lines.end() - 5, lines.end());
-  EXPECT_EQ(tail, (std::vector<std::string>{"0,1,2,3,25", "0.02,1,2,3,25", "# GAP seq=2 t=0.04 count=4 reason=fifo_overflow",
-                                            "0.12,1,2,3,25", "# GAP seq=7 t=0.14 count=1 reason=weird_reason_with_newli"}));
+  EXPECT_EQ(tail,
+            (std::vector<std::string>{"0,1,2,3,25", "0.02,1,2,3,25", "# GAP seq=2 t=0.04 count=4 reason=fifo_overflow",
+                                      "0.12,1,2,3,25", "# GAP seq=7 t=0.14 count=1 reason=weird_reason_with_newli"}));
   const auto rec = readRecordingCsv(file);
   EXPECT_EQ(rec.t, (std::vector<double>{0.0, 0.02, 0.12}));
 }
@@ -423,7 +424,8 @@ TEST(RecorderCrash, KillNineLeavesWholeLinesAndEverythingFlushedBeforeIt) {
     const auto rec = readRecordingCsv(files[0]);  // throws on a torn or malformed line
     ASSERT_GE(rec.size(), last_reported) << "lost records the recorder reported written";
     const auto& gx = rec.axes[0];
-    for (std::size_t i = 0; i < gx.size(); ++i) ASSERT_EQ(gx[i], static_cast<double>(i)) << "line " << rec.line_numbers[i];
+    for (std::size_t i = 0; i < gx.size(); ++i)
+      ASSERT_EQ(gx[i], static_cast<double>(i)) << "line " << rec.line_numbers[i];
     std::cout << "kill after " << flushes_before_kill << " flushes: " << last_reported << " reported written, "
               << rec.size() << " in the file\n";
   }

@@ -56,10 +56,9 @@ TEST(SamplePipeline, ConfiguredBiasAndKalmanRunTheOfflineChainFromTheFirstSample
   EXPECT_EQ(pipeline.phase(), PipelinePhase::Running);
   EXPECT_FALSE(pipeline.kalmanIdentified());
 
-  std::array<AxisFilterChain, kAxes> reference = {
-      AxisFilterChain({20, 0.3, {-0.2855, 0.0577, 0.0667, 0.0, {}}}),
-      AxisFilterChain({20, 0.3, {-0.2855, 0.0577, 0.0667, 0.0, {}}}),
-      AxisFilterChain({20, 0.3, {-0.2855, 0.0577, 0.0667, 0.0, {}}})};
+  std::array<AxisFilterChain, kAxes> reference = {AxisFilterChain({20, 0.3, {-0.2855, 0.0577, 0.0667, 0.0, {}}}),
+                                                  AxisFilterChain({20, 0.3, {-0.2855, 0.0577, 0.0667, 0.0, {}}}),
+                                                  AxisFilterChain({20, 0.3, {-0.2855, 0.0577, 0.0667, 0.0, {}}})};
   for (std::size_t i = 0; i < 3000; ++i) {
     const Vec3 raw{s.x[0][i], s.x[1][i], s.x[2][i]};
     const ProcessedSample out = pipeline.process(i, i / 50.0, raw, 30.0);
@@ -108,7 +107,8 @@ TEST(SamplePipeline, FilteredOutputAfterEstimationEqualsTheOfflineChain) {
   p.still_seconds = 4.0;  // 200 samples
   SamplePipeline pipeline(p);
   std::vector<ProcessedSample> outs;
-  for (std::size_t i = 0; i < 1500; ++i) outs.push_back(pipeline.process(i, i / 50.0, {s.x[0][i], s.x[1][i], s.x[2][i]}, 25.0));
+  for (std::size_t i = 0; i < 1500; ++i)
+    outs.push_back(pipeline.process(i, i / 50.0, {s.x[0][i], s.x[1][i], s.x[2][i]}, 25.0));
   for (std::size_t axis = 0; axis < kAxes; ++axis) {
     AxisFilterChain reference(pipeline.filterParameters()[axis]);
     for (std::size_t i = 200; i < 1500; ++i) {

@@ -107,8 +107,9 @@ class DriverRig {
                     ? std::optional<PollingDataReady>(std::in_place, clock, options.driver.polling_period_ns)
                     : std::nullopt),
         jitter(mock.dataReady(), options.edge_latency_ns, options.jitter_seed),
-        driver(mock, readySource(), clock, recorder, options.driver,
-               [this](LogLevel level, std::string_view m) { logs.push_back(std::string(logLevelName(level)) + ": " + std::string(m)); }) {
+        driver(mock, readySource(), clock, recorder, options.driver, [this](LogLevel level, std::string_view m) {
+          logs.push_back(std::string(logLevelName(level)) + ": " + std::string(m));
+        }) {
     mock.setSampleObserver([this](const SampleRecord& r) { truth.push_back(r); });
   }
 
@@ -167,7 +168,8 @@ class DriverRig {
            (mpu6050::gyroOutputRateHz(c.dlpf_cfg) * (1.0 + options_.mock.clock_error_ppm * 1e-6));
   }
   bool logged(const std::string& needle) const {
-    return std::any_of(logs.begin(), logs.end(), [&](const std::string& l) { return l.find(needle) != std::string::npos; });
+    return std::any_of(logs.begin(), logs.end(),
+                       [&](const std::string& l) { return l.find(needle) != std::string::npos; });
   }
 
   VirtualClock clock{5 * kNsPerSecond};
@@ -265,8 +267,8 @@ inline StreamCheck checkStream(const Recorder& rec, const std::vector<SampleReco
       const SampleRecord& r = truth[i];
       if (static_cast<double>(r.time_ns) > static_cast<double>(s.t_ns) + window) break;
       if (std::fabs(static_cast<double>(r.time_ns - s.t_ns)) > window) continue;
-      if (r.written_to_fifo && r.gyro[0] == s.raw_gyro[0] && r.gyro[1] == s.raw_gyro[1] &&
-          r.gyro[2] == s.raw_gyro[2] && r.temperature == s.raw_temp &&
+      if (r.written_to_fifo && r.gyro[0] == s.raw_gyro[0] && r.gyro[1] == s.raw_gyro[1] && r.gyro[2] == s.raw_gyro[2] &&
+          r.temperature == s.raw_temp &&
           (!found || std::llabs(r.time_ns - s.t_ns) < std::llabs(truth[*found].time_ns - s.t_ns))) {
         found = i;
       }

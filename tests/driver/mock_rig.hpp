@@ -50,8 +50,7 @@ inline std::int16_t be16(std::uint8_t h, std::uint8_t l) {
 }
 
 struct Rig {
-  explicit Rig(SignalSource& source, MockMpu6050Config config = quietConfig())
-      : mock(clock, source, config) {}
+  explicit Rig(SignalSource& source, MockMpu6050Config config = quietConfig()) : mock(clock, source, config) {}
   static MockMpu6050Config quietConfig() {
     MockMpu6050Config c;
     c.accel_noise_g = 0.0;  // exact accel values unless a test wants noise

@@ -47,9 +47,9 @@ TEST(FifoFrame, ExtremesDecodeToInt16MinAndMax) {
 }
 
 TEST(FifoFrame, FramesIndexWholeFramesAndIgnoreATrailingPartialOne) {
-  const std::vector<std::uint8_t> bytes = {0x00, 0x01, 0, 0, 0, 0, 0, 0,   // frame 0
+  const std::vector<std::uint8_t> bytes = {0x00, 0x01, 0, 0, 0, 0, 0, 0,     // frame 0
                                            0x00, 0x02, 0, 0, 0, 0, 0, 0x09,  // frame 1
-                                           0x00, 0x03, 0};                  // partial
+                                           0x00, 0x03, 0};                   // partial
   const FifoFrames frames{std::span<const std::uint8_t>(bytes)};
   ASSERT_EQ(frames.size(), 2u);
   EXPECT_EQ(frames[0].temp, 1);

@@ -3,11 +3,11 @@
 // I2C_RDWR message construction, the busy address through the driver, the GPIO request
 // failures, and the polling timer.
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <linux/i2c.h>
 #include <poll.h>
 #include <sys/stat.h>
 #include <unistd.h>
-#include <gtest/gtest.h>
 
 #include <cerrno>
 #include <cstdio>

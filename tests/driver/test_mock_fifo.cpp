@@ -28,7 +28,8 @@ void appendBigEndian(std::vector<std::uint8_t>& out, std::int16_t v) {
 // The datasheet's order written out plainly: accel X, Y, Z, then TEMP, then gyro X, Y, Z.
 std::vector<std::uint8_t> expectedFrame(std::uint8_t fifo_en) {
   std::vector<std::uint8_t> f;
-  if (fifo_en & 0x08) for (std::int16_t a : kAccel) appendBigEndian(f, a);
+  if (fifo_en & 0x08)
+    for (std::int16_t a : kAccel) appendBigEndian(f, a);
   if (fifo_en & 0x80) appendBigEndian(f, kTemp);
   if (fifo_en & 0x40) appendBigEndian(f, kGyro[0]);
   if (fifo_en & 0x20) appendBigEndian(f, kGyro[1]);
@@ -66,14 +67,14 @@ TEST_P(FifoOrder, FramesFollowRegisterOrderOfTheEnabledSensors) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Combinations, FifoOrder,
-                         ::testing::Values(0xF8,  // everything
-                                           0xF0,  // temp + gyro (gyrod's layout)
-                                           0x70,  // gyro only
-                                           0x08,  // accel only
-                                           0x80,  // temp only
-                                           0x88,  // accel + temp
-                                           0x50,  // gyro X and Z
-                                           0x20,  // gyro Y
+                         ::testing::Values(0xF8,    // everything
+                                           0xF0,    // temp + gyro (gyrod's layout)
+                                           0x70,    // gyro only
+                                           0x08,    // accel only
+                                           0x80,    // temp only
+                                           0x88,    // accel + temp
+                                           0x50,    // gyro X and Z
+                                           0x20,    // gyro Y
                                            0xA8));  // accel, temp, gyro Y
 
 TEST(MockMpu6050Fifo, NothingIsWrittenUnlessUserCtrlFifoEnIsSet) {

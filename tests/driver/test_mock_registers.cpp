@@ -53,7 +53,7 @@ TEST(MockMpu6050Registers, ChipAtAd0HighAnswersOnlyAt0x69) {
   Rig rig(source, config);
   std::uint8_t v = 0;
   EXPECT_EQ(rig.mock.readByte(0x75, v), 0);  // selected by default
-  EXPECT_EQ(v, 0x68);                         // WHO_AM_I does not follow AD0
+  EXPECT_EQ(v, 0x68);                        // WHO_AM_I does not follow AD0
   ASSERT_EQ(rig.mock.selectDevice(0x68), 0);
   EXPECT_EQ(rig.mock.readByte(0x75, v), -EREMOTEIO);
 }
@@ -69,7 +69,7 @@ TEST(MockMpu6050Registers, DeviceResetSelfClearsAndLeavesTheChipAsleep) {
 
   write(rig.mock, Register::PWR_MGMT_1, mpu6050::DEVICE_RESET);
   EXPECT_EQ(read(rig.mock, Register::PWR_MGMT_1), 0xC0);  // DEVICE_RESET still set
-  write(rig.mock, Register::SMPLRT_DIV, 9);                // lost: the chip is resetting
+  write(rig.mock, Register::SMPLRT_DIV, 9);               // lost: the chip is resetting
   EXPECT_EQ(rig.mock.counters().writes_ignored, 1u);
 
   rig.advance(99 * kNsPerMillisecond);
@@ -93,7 +93,7 @@ TEST(MockMpu6050Registers, SleepStopsSamplingAndWakeRestartsIt) {
   Rig rig(source);
   rig.advance(kNsPerSecond);
   EXPECT_EQ(rig.mock.counters().samples_produced, 0u);  // asleep after power-on
-  rig.wake(1, 0);                                        // 1 kHz
+  rig.wake(1, 0);                                       // 1 kHz
   rig.advance(10 * kNsPerMillisecond);
   EXPECT_EQ(rig.mock.counters().samples_produced, 10u);
   write(rig.mock, Register::PWR_MGMT_1, mpu6050::SLEEP);
@@ -193,8 +193,7 @@ TEST(MockMpu6050Registers, FifoCountLowAloneReturnsTheValueLatchedByTheHighRead)
 TEST(MockMpu6050Registers, SelfClearingBitsReadBackAsZero) {
   ConstantSource source({0, 0, 0});
   Rig rig(source);
-  write(rig.mock, Register::USER_CTRL,
-        mpu6050::USER_CTRL_BIT::FIFO_EN | mpu6050::FIFO_RESET | mpu6050::SIG_COND_RESET);
+  write(rig.mock, Register::USER_CTRL, mpu6050::USER_CTRL_BIT::FIFO_EN | mpu6050::FIFO_RESET | mpu6050::SIG_COND_RESET);
   EXPECT_EQ(read(rig.mock, Register::USER_CTRL), mpu6050::USER_CTRL_BIT::FIFO_EN);
   write(rig.mock, Register::SIGNAL_PATH_RESET, 0x07);
   EXPECT_EQ(read(rig.mock, Register::SIGNAL_PATH_RESET), 0x00);
@@ -217,7 +216,6 @@ TEST(MockMpu6050Registers, BadConfigurationIsRejected) {
   EXPECT_THROW(MockMpu6050(clock, source, c), std::invalid_argument);
   EXPECT_THROW(clock.advanceNs(-1), std::invalid_argument);
 }
-
 
 TEST(MockMpu6050Registers, WordReadsAreNotLimitedByTheBurstLength) {
   ConstantSource source({0, 0, 0});

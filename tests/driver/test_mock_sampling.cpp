@@ -38,7 +38,8 @@ TEST_P(SampleRate, CountOverTenSecondsIsInternalRateOverOnePlusDivider) {
   // Gyro output rate (RM §4.2): 8 kHz for DLPF_CFG 0 and 7, else 1 kHz; the chip's own
   // clock error scales it. Observe for 10 s plus a quarter sample so that no tick falls
   // on the boundary.
-  const double internal_hz = ((c.dlpf_cfg == 0 || c.dlpf_cfg == 7) ? 8000.0 : 1000.0) * (1.0 + c.clock_error_ppm * 1e-6);
+  const double internal_hz =
+      ((c.dlpf_cfg == 0 || c.dlpf_cfg == 7) ? 8000.0 : 1000.0) * (1.0 + c.clock_error_ppm * 1e-6);
   const double sample_hz = internal_hz / (1 + c.smplrt_div);
   const double window_s = 10.0 + 0.25 / sample_hz;
   for (int i = 0; i < 100; ++i) rig.advance(100 * kNsPerMillisecond);
@@ -89,12 +90,11 @@ TEST_P(GyroScaling, ConstantRateGivesTheDatasheetCount) {
 // Sensitivities 131 / 65.5 / 32.8 / 16.4 LSB per °/s (product spec §6.1), worked by hand.
 INSTANTIATE_TEST_SUITE_P(FullScaleRanges, GyroScaling,
                          ::testing::Values(ScaleCase{0, 100.0, 13100}, ScaleCase{1, 100.0, 6550},
-                                           ScaleCase{2, 100.0, 3280}, ScaleCase{3, 100.0, 1640},
-                                           ScaleCase{0, 1.0, 131}, ScaleCase{1, 1.1, 72},  // 72.05 → 72
-                                           ScaleCase{2, 0.5, 16},                          // 16.4 → 16
-                                           ScaleCase{3, 1000.0, 16400},
-                                           ScaleCase{0, 250.0, 32750},
-                                           ScaleCase{0, 300.0, 32767},    // 39300 saturates
+                                           ScaleCase{2, 100.0, 3280}, ScaleCase{3, 100.0, 1640}, ScaleCase{0, 1.0, 131},
+                                           ScaleCase{1, 1.1, 72},  // 72.05 → 72
+                                           ScaleCase{2, 0.5, 16},  // 16.4 → 16
+                                           ScaleCase{3, 1000.0, 16400}, ScaleCase{0, 250.0, 32750},
+                                           ScaleCase{0, 300.0, 32767},     // 39300 saturates
                                            ScaleCase{3, 2500.0, 32767}));  // 41000 saturates
 
 TEST(MockMpu6050Sampling, RegisterMapSensitivitiesAgreeWithTheSensorModel) {
@@ -105,8 +105,8 @@ TEST(MockMpu6050Sampling, RegisterMapSensitivitiesAgreeWithTheSensorModel) {
 
 TEST(MockMpu6050Sampling, TemperatureEncodingFollowsTheRegisterMapFormula) {
   // TEMP_OUT = round((T − 36.53) · 340), worked out by hand for each T.
-  const std::pair<double, std::int16_t> cases[] = {
-      {36.53, 0}, {25.0, -3920}, {0.0, -12420}, {85.0, 16480}, {-40.0, -26020}, {37.53, 340}};
+  const std::pair<double, std::int16_t> cases[] = {{36.53, 0},    {25.0, -3920},   {0.0, -12420},
+                                                   {85.0, 16480}, {-40.0, -26020}, {37.53, 340}};
   for (const auto& [t_c, raw] : cases) {
     ConstantSource source({0, 0, 0}, t_c);
     Rig rig(source);

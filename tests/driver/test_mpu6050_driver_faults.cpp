@@ -15,9 +15,9 @@ namespace {
 
 // A signal that changes from sample to sample, so every sample is recognisable.
 SinusoidSource movingSource() {
-  return SinusoidSource({SinusoidAxis{5.0, 100.0, 0.37, 0.0}, SinusoidAxis{-3.0, 80.0, 0.23, 1.0},
-                         SinusoidAxis{1.0, 60.0, 0.61, 2.0}},
-                        25.0);
+  return SinusoidSource(
+      {SinusoidAxis{5.0, 100.0, 0.37, 0.0}, SinusoidAxis{-3.0, 80.0, 0.23, 1.0}, SinusoidAxis{1.0, 60.0, 0.61, 2.0}},
+      25.0);
 }
 
 std::uint64_t lostIn(const Recorder& r) {
@@ -62,8 +62,8 @@ TEST(Mpu6050DriverFaults, RandomTransferErrorsAreRetriedAndFailedFifoBurstsAccou
   expectTotals(rig, c);
   expectSpanEqualsProduced(rig);
   const DriverCounters& k = rig.driver.counters();
-  EXPECT_GT(k.retries, 100u);               // ~3 register transfers per sample, 2 % fail
-  EXPECT_GT(k.fifo_transfer_errors, 10u);   // bursts are never retried...
+  EXPECT_GT(k.retries, 100u);                                   // ~3 register transfers per sample, 2 % fail
+  EXPECT_GT(k.fifo_transfer_errors, 10u);                       // bursts are never retried...
   EXPECT_EQ(rig.recorder.gaps.size(), k.fifo_transfer_errors);  // ...each costs a FIFO reset and a gap
   for (const auto& g : rig.recorder.gaps) EXPECT_EQ(g.cause, GapCause::TransferError);
   for (const auto& g : c.gaps) EXPECT_TRUE(g.chip_ran);
@@ -163,8 +163,8 @@ TEST(Mpu6050DriverFaults, PowerLossReinitialisesAndTheGapCountsWholePeriodsOfThe
   DriverRig rig(source);
   rig.startStreaming();
   FaultPlan plan;
-  plan.outages.push_back({rig.clock.nowNs() - rig.mock.epochNs() + 2 * kNsPerSecond + 3 * kNsPerMillisecond,
-                          kNsPerSecond, ENXIO, true});
+  plan.outages.push_back(
+      {rig.clock.nowNs() - rig.mock.epochNs() + 2 * kNsPerSecond + 3 * kNsPerMillisecond, kNsPerSecond, ENXIO, true});
   rig.mock.setFaultPlan(plan);
   rig.runFor(10 * kNsPerSecond);
   // The chip slept during the outage and its reset: it produced fewer samples than the hole
@@ -212,7 +212,8 @@ TEST(Mpu6050DriverFaults, ForcedFifoOverflowResetsTheFifoAndNoCopyIsDelivered) {
   DriverRig rig(source);
   rig.startStreaming();
   FaultPlan plan;
-  plan.forced_fifo_overflows_ns.push_back(rig.clock.nowNs() - rig.mock.epochNs() + 2 * kNsPerSecond + 5 * kNsPerMillisecond);
+  plan.forced_fifo_overflows_ns.push_back(rig.clock.nowNs() - rig.mock.epochNs() + 2 * kNsPerSecond +
+                                          5 * kNsPerMillisecond);
   rig.mock.setFaultPlan(plan);
   rig.runFor(5 * kNsPerSecond);
   // checkStream matches each delivered sample to a distinct mock sample in order: a copy

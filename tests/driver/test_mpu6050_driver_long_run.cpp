@@ -50,8 +50,11 @@ FaultPlan randomPlan(std::uint64_t seed, std::int64_t from, std::int64_t to) {
             p.outages.push_back({at, d, rng.uniform(0, 2) == 0 ? ENXIO : EREMOTEIO, rng.uniform(0, 3) == 0});
           });
   windows(std::max<std::int64_t>(1, minutes / 6), 50 * kNsPerMillisecond, 2 * kNsPerSecond,
-          [&](std::int64_t at, std::int64_t d) { p.stuck_data_ready.push_back({at, d, rng.uniform(0, 1) == 1}); });
-  for (std::int64_t i = 0; i < std::max<std::int64_t>(1, minutes / 12); ++i) p.brownouts_ns.push_back(rng.uniform(from, to));
+          [&](std::int64_t at, std::int64_t d) {
+            p.stuck_data_ready.push_back({at, d, rng.uniform(0, 1) == 1});
+          });
+  for (std::int64_t i = 0; i < std::max<std::int64_t>(1, minutes / 12); ++i)
+    p.brownouts_ns.push_back(rng.uniform(from, to));
   for (std::int64_t i = 0; i < std::max<std::int64_t>(1, minutes / 6); ++i) {
     p.forced_fifo_overflows_ns.push_back(rng.uniform(from, to));
   }
@@ -59,9 +62,9 @@ FaultPlan randomPlan(std::uint64_t seed, std::int64_t from, std::int64_t to) {
 }
 
 void runMixture(std::uint64_t seed, std::int64_t duration_ns, double ppm, double rate_hz) {
-  SinusoidSource source({SinusoidAxis{5.0, 100.0, 0.37, 0.0}, SinusoidAxis{-3.0, 80.0, 0.23, 1.0},
-                         SinusoidAxis{1.0, 60.0, 0.61, 2.0}},
-                        25.0);
+  SinusoidSource source(
+      {SinusoidAxis{5.0, 100.0, 0.37, 0.0}, SinusoidAxis{-3.0, 80.0, 0.23, 1.0}, SinusoidAxis{1.0, 60.0, 0.61, 2.0}},
+      25.0);
   RigOptions o;
   o.mock.clock_error_ppm = ppm;
   o.driver.sample_rate_hz = rate_hz;
@@ -101,19 +104,22 @@ void runMixture(std::uint64_t seed, std::int64_t duration_ns, double ppm, double
   EXPECT_EQ(inexact, 0u);
   EXPECT_GT(exact, 50u);
   // Delivered + lost covers the time streamed: the sequence span is the run in periods.
-  const double expected_slots = static_cast<double>(rig.recorder.samples.back().t_ns - rig.recorder.samples.front().t_ns) / p;
-  EXPECT_NEAR(static_cast<double>(c.total_seq - 1 - rig.recorder.samples.front().seq), expected_slots, 0.02 * expected_slots);
+  const double expected_slots =
+      static_cast<double>(rig.recorder.samples.back().t_ns - rig.recorder.samples.front().t_ns) / p;
+  EXPECT_NEAR(static_cast<double>(c.total_seq - 1 - rig.recorder.samples.front().seq), expected_slots,
+              0.02 * expected_slots);
 
-  std::printf("[ figures  ] seed %llu: %.0f s virtual in %.2f s wall; %zu samples, %zu gaps (%zu exact counts where "
-              "the chip ran, %zu off by one), %llu lost; retries %llu, recoveries %llu, overflows %llu, "
-              "misaligned %llu, silent resets %llu, device resets %llu, data-ready missed %llu, "
-              "max |t error| %.1f us\n",
-              static_cast<unsigned long long>(seed), static_cast<double>(duration_ns) / 1e9, wall_s,
-              rig.recorder.samples.size(), c.gaps.size(), exact, inexact, static_cast<unsigned long long>(lost),
-              static_cast<unsigned long long>(k.retries), static_cast<unsigned long long>(k.recoveries),
-              static_cast<unsigned long long>(k.fifo_overflows), static_cast<unsigned long long>(k.misaligned_bursts),
-              static_cast<unsigned long long>(k.silent_resets), static_cast<unsigned long long>(k.device_resets),
-              static_cast<unsigned long long>(k.data_ready_missed), c.max_abs_time_error_ns / 1e3);
+  std::printf(
+      "[ figures  ] seed %llu: %.0f s virtual in %.2f s wall; %zu samples, %zu gaps (%zu exact counts where "
+      "the chip ran, %zu off by one), %llu lost; retries %llu, recoveries %llu, overflows %llu, "
+      "misaligned %llu, silent resets %llu, device resets %llu, data-ready missed %llu, "
+      "max |t error| %.1f us\n",
+      static_cast<unsigned long long>(seed), static_cast<double>(duration_ns) / 1e9, wall_s,
+      rig.recorder.samples.size(), c.gaps.size(), exact, inexact, static_cast<unsigned long long>(lost),
+      static_cast<unsigned long long>(k.retries), static_cast<unsigned long long>(k.recoveries),
+      static_cast<unsigned long long>(k.fifo_overflows), static_cast<unsigned long long>(k.misaligned_bursts),
+      static_cast<unsigned long long>(k.silent_resets), static_cast<unsigned long long>(k.device_resets),
+      static_cast<unsigned long long>(k.data_ready_missed), c.max_abs_time_error_ns / 1e3);
 }
 
 // The hour runs at 20 Hz: the driver's logic does not depend on the rate, and the mock's

@@ -12,9 +12,9 @@ namespace gyrod::driver::test {
 namespace {
 
 SinusoidSource movingSource() {
-  return SinusoidSource({SinusoidAxis{5.0, 100.0, 0.37, 0.0}, SinusoidAxis{-3.0, 80.0, 0.23, 1.0},
-                         SinusoidAxis{1.0, 60.0, 0.61, 2.0}},
-                        25.0);
+  return SinusoidSource(
+      {SinusoidAxis{5.0, 100.0, 0.37, 0.0}, SinusoidAxis{-3.0, 80.0, 0.23, 1.0}, SinusoidAxis{1.0, 60.0, 0.61, 2.0}},
+      25.0);
 }
 
 // Timestamp errors (driver − truth) of the samples after `skip`.
@@ -120,11 +120,11 @@ TEST(Mpu6050DriverTimestamps, PollingModeTimestampsWithinAPeriodAndGapsWithinOne
   ASSERT_EQ(c.gaps.size(), 1u);
   EXPECT_EQ(c.gaps[0].gap.cause, GapCause::FifoOverflow);
   EXPECT_NEAR(rig.driver.estimatedSamplePeriodNs() / p, 1.0, 1e-3);
-  std::printf("[ figures  ] polling: max |timestamp error| %.2f ms (P = %.2f ms), gap %llu vs %llu produced, "
-              "period error %.2e\n",
-              c.max_abs_time_error_ns / 1e6, p / 1e6, static_cast<unsigned long long>(c.gaps[0].gap.count),
-              static_cast<unsigned long long>(c.gaps[0].produced_between),
-              rig.driver.estimatedSamplePeriodNs() / p - 1.0);
+  std::printf(
+      "[ figures  ] polling: max |timestamp error| %.2f ms (P = %.2f ms), gap %llu vs %llu produced, "
+      "period error %.2e\n",
+      c.max_abs_time_error_ns / 1e6, p / 1e6, static_cast<unsigned long long>(c.gaps[0].gap.count),
+      static_cast<unsigned long long>(c.gaps[0].produced_between), rig.driver.estimatedSamplePeriodNs() / p - 1.0);
 }
 
 }  // namespace

@@ -62,7 +62,7 @@ TEST(SampleClock, AfterAcquisitionTheAnchorEasesTowardAnObservationInsteadOfJump
 }
 
 TEST(SampleClock, PeriodsOutsideThePlausibleBoundAreNeverAdopted) {
-  SampleClock clock(config20ms());  // ±10 %
+  SampleClock clock(config20ms());                                                                       // ±10 %
   for (std::uint64_t k = 0; k <= 300; ++k) clock.observe(static_cast<std::int64_t>(k * 25'000'000), k);  // +25 %
   EXPECT_LE(std::fabs(clock.periodNs() / 20e6 - 1.0), 0.10 + 1e-12);
   EXPECT_GT(clock.rejections(), 0u);

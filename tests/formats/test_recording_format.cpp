@@ -22,8 +22,8 @@ namespace {
 class TempFile {
  public:
   explicit TempFile(const std::string& text) {
-    path_ = (fs::temp_directory_path() / ("gyrod-format-test-" + std::to_string(::getpid()) + "-" +
-                                          std::to_string(counter_++) + ".csv"))
+    path_ = (fs::temp_directory_path() /
+             ("gyrod-format-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter_++) + ".csv"))
                 .string();
     std::ofstream(path_, std::ios::binary) << text;
   }
@@ -82,8 +82,8 @@ TEST(RecordingFormat, TheLongestLinesFit) {
   const auto sample = formatSampleLine(line, big, big, big, big, std::numeric_limits<double>::infinity());
   EXPECT_EQ(sample.rfind("# NONFINITE ", 0), 0u);
   EXPECT_LT(sample.size(), line.bytes.size());
-  const auto g = formatGapLine(line, std::numeric_limits<std::uint64_t>::max(), big, 4294967295u,
-                               "abcdefghijklmnopqrstuvw");
+  const auto g =
+      formatGapLine(line, std::numeric_limits<std::uint64_t>::max(), big, 4294967295u, "abcdefghijklmnopqrstuvw");
   EXPECT_EQ(g.back(), '\n');
   EXPECT_LT(g.size(), line.bytes.size());
 }
@@ -91,15 +91,15 @@ TEST(RecordingFormat, TheLongestLinesFit) {
 TEST(RecordingFormat, WriterLinesReadBackWithGapAndDroppedRecords) {
   RecordingLine line;
   std::string text = recordingHeaderComments(1735732800, "", {"device mock, rate_hz 50"});
-  text += kColumnsLine;                                                  // line 3
-  text += formatSampleLine(line, 0.00, 0.125, -1.0 / 3.0, 2, 25.5);      // 4
-  text += formatSampleLine(line, 0.02, -0.0, 1e-300, 2, 25.5);           // 5
-  text += formatGapLine(line, 2, 0.04, 4, "fifo_overflow");              // 6
-  text += formatSampleLine(line, 0.12, 1, 2, 3, 25.5);                   // 7
-  text += formatDroppedLine(line, 3, "ring_full");                       // 8
-  text += formatSampleLine(line, 0.2, 1, 2, 3, std::nan(""));            // 9: a comment
-  text += formatSampleLine(line, 0.22, 1, 2, 3, 26);                     // 10
-  text += formatGapLine(line, 12, 0.24, 1, "bus_error");                 // 11
+  text += kColumnsLine;                                              // line 3
+  text += formatSampleLine(line, 0.00, 0.125, -1.0 / 3.0, 2, 25.5);  // 4
+  text += formatSampleLine(line, 0.02, -0.0, 1e-300, 2, 25.5);       // 5
+  text += formatGapLine(line, 2, 0.04, 4, "fifo_overflow");          // 6
+  text += formatSampleLine(line, 0.12, 1, 2, 3, 25.5);               // 7
+  text += formatDroppedLine(line, 3, "ring_full");                   // 8
+  text += formatSampleLine(line, 0.2, 1, 2, 3, std::nan(""));        // 9: a comment
+  text += formatSampleLine(line, 0.22, 1, 2, 3, 26);                 // 10
+  text += formatGapLine(line, 12, 0.24, 1, "bus_error");             // 11
   const TempFile f(text);
   const Recording rec = readRecordingCsv(f.path());
   ASSERT_EQ(rec.size(), 4u);

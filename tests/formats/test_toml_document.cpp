@@ -46,13 +46,18 @@ TEST(TomlDocument, FailuresPointAtTheLineOfTheKey) {
 TEST(TomlSection, UnknownKeysAndWrongValuesNameTheKey) {
   const TomlDocument doc("[s]\nspeed = \"fast\"\nlimit = 1.5\nlist = [1, -2]\n", "f.toml");
   const auto& table = *doc.root().get_as<toml::table>("s");
-  EXPECT_EQ(errorOf([&] { TomlSection(doc.file(), table, "s", {"speed", "limit"}); }),
+  EXPECT_EQ(errorOf([&] {
+              TomlSection(doc.file(), table, "s", {"speed", "limit"});
+            }),
             "f.toml:4: unknown key 'list' in [s] (valid keys: speed, limit); did you mean 'limit'?");
   const TomlSection s(doc.file(), table, "s", {"speed", "limit", "list"});
   EXPECT_EQ(errorOf([&] { (void)s.number("speed"); }),
             "f.toml:2: key 's.speed': must be a number (got string \"fast\")");
   EXPECT_EQ(errorOf([&] { (void)s.integer("limit"); }), "f.toml:3: key 's.limit': must be an integer (got float 1.5)");
-  EXPECT_EQ(errorOf([&] { (void)s.numbers("list", [](double v) { return v >= 0.0; }, "must be ≥ 0"); }),
+  EXPECT_EQ(errorOf([&] {
+              (void)s.numbers(
+                  "list", [](double v) { return v >= 0.0; }, "must be ≥ 0");
+            }),
             "f.toml:4: key 's.list': must be ≥ 0 (got -2)");
   EXPECT_EQ(s.number("limit"), 1.5);
   EXPECT_FALSE(s.number("absent"));

@@ -10,9 +10,9 @@
 #include <sstream>
 #include <thread>
 
+#include "formats/recording_csv.hpp"
 #include "gyrod_process.hpp"
 #include "processing/allan.hpp"
-#include "formats/recording_csv.hpp"
 #include "tools/run_command.hpp"
 
 using namespace gyrod::test;
@@ -149,10 +149,10 @@ TEST(Gyrod, StreamFilterAndAllanAgreeWithTheOfflineToolsOnItsOwnRecording) {
 
 TEST(Gyrod, GapsExplainEveryMissingSequenceNumberUnderFaults) {
   ScratchDir d;
-  const auto cfg = d.write(
-      "gyrod.toml", mockConfig(d.path(), 50.0,
-                               "[mock.faults]\nfifo_overflow_at_s = [5.0]\nsilent_reset_at_s = [15.0]\n"
-                               "vanish = [{ at_s = 25, duration_s = 1 }]\n"));
+  const auto cfg =
+      d.write("gyrod.toml", mockConfig(d.path(), 50.0,
+                                       "[mock.faults]\nfifo_overflow_at_s = [5.0]\nsilent_reset_at_s = [15.0]\n"
+                                       "vanish = [{ at_s = 25, duration_s = 1 }]\n"));
   GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt");
   LineClient watcher((d.path() / "gyrod.sock").string());
   ASSERT_TRUE(watcher.connected());

@@ -82,7 +82,10 @@ double bruteForceOverlappingAllanVariance(const std::vector<double>& y, std::siz
 TEST(AllanNbs14, ThousandPointSetMatchesPublishedValues) {
   const auto y = nbs14ThousandPoints();
   ASSERT_NEAR(y[0], 1234567890.0 / 2147483647.0, 1e-15);
-  struct Row { std::size_t m; double adev, oadev; };
+  struct Row {
+    std::size_t m;
+    double adev, oadev;
+  };
   for (const Row& r : {Row{1, 2.922319e-01, 2.922319e-01}, Row{10, 9.965736e-02, 9.159953e-02},
                        Row{100, 3.897804e-02, 3.241343e-02}}) {
     expectRoundsToPublished(std::sqrt(allanVariance(y, r.m)), r.adev, "ADEV m=" + std::to_string(r.m));
@@ -129,8 +132,8 @@ TEST(AllanEstimators, AgreeWithBruteForceDefinitions) {
 
 TEST(AllanEstimators, TooLongAveragingGivesNaN) {
   const auto y = whiteNoise(100, 1.0, 3);
-  EXPECT_FALSE(std::isnan(allanVariance(y, 50)));  // 2 clusters, 1 difference
-  EXPECT_TRUE(std::isnan(allanVariance(y, 51)));   // 1 cluster
+  EXPECT_FALSE(std::isnan(allanVariance(y, 50)));             // 2 clusters, 1 difference
+  EXPECT_TRUE(std::isnan(allanVariance(y, 51)));              // 1 cluster
   EXPECT_FALSE(std::isnan(overlappingAllanVariance(y, 50)));  // M − 2m + 1 = 1
   EXPECT_TRUE(std::isnan(overlappingAllanVariance(y, 51)));
   const std::vector<std::size_t> ms = {50, 51, 1000};
@@ -313,7 +316,7 @@ TEST(AllanClusterSizes, ExplicitTauListErrorsNameTheTau) {
   const std::string too_long = message({1.0, 12.5}, 0.02, 1000);  // m = 625 > 1000/2
   EXPECT_NE(too_long.find("12.5"), std::string::npos) << too_long;
   EXPECT_NE(too_long.find("too long"), std::string::npos) << too_long;
-  EXPECT_EQ(message({10.0}, 0.02, 1000), "no exception");  // m = 500 = M/2 is the last valid one
+  EXPECT_EQ(message({10.0}, 0.02, 1000), "no exception");                    // m = 500 = M/2 is the last valid one
   EXPECT_NE(message({0.005}, 0.01, 1000).find("0.005"), std::string::npos);  // half a sample
   EXPECT_NE(message({-1.0}, 0.01, 1000).find("-1"), std::string::npos);
   EXPECT_NE(message({1.0}, 0.0, 1000).find("tau0"), std::string::npos);
@@ -331,7 +334,7 @@ TEST(AllanNoiseId, WhiteRandomWalkAndWhitePhaseAreRecognised) {
     double s = 0.0;
     for (std::size_t i = 0; i < count; ++i) {
       s += white[i];
-      walk[i] = s;                              // rate random walk: α = −2
+      walk[i] = s;                               // rate random walk: α = −2
       white_phase[i] = white[i + 1] - white[i];  // rate = difference of white phase: α = +2
     }
     for (std::size_t m : {1u, 4u, 16u, 64u}) {

@@ -102,7 +102,8 @@ TEST(YuleWalker, LevinsonDurbinEqualsDirectSolve) {
     Eigen::VectorXd rhs(pp);
     for (Eigen::Index i = 0; i < pp; ++i) {
       rhs(i) = plainAutocovariance(x, static_cast<std::size_t>(i + 1));
-      for (Eigen::Index j = 0; j < pp; ++j) gamma(i, j) = plainAutocovariance(x, static_cast<std::size_t>(std::abs(i - j)));
+      for (Eigen::Index j = 0; j < pp; ++j)
+        gamma(i, j) = plainAutocovariance(x, static_cast<std::size_t>(std::abs(i - j)));
     }
     const Eigen::VectorXd phi = gamma.fullPivLu().solve(rhs);
     const double sigma2 = plainAutocovariance(x, 0) - phi.dot(rhs);

@@ -43,8 +43,8 @@ AxisModelCheck check(const GeneratedRecording& g, std::size_t axis, std::uint64_
 std::string describe(const AxisModelCheck& r) {
   std::string s;
   for (const DetectedEffect& e : r.effects)
-    s += std::string(modelEffectName(e.effect)) + ": statistic " + std::to_string(e.evidence.statistic) + ", threshold " +
-         std::to_string(e.evidence.threshold) + "\n";
+    s += std::string(modelEffectName(e.effect)) + ": statistic " + std::to_string(e.evidence.statistic) +
+         ", threshold " + std::to_string(e.evidence.threshold) + "\n";
   return s.empty() ? "(no effect)" : s;
 }
 

@@ -59,7 +59,8 @@ TEST(ModelCheckLines, AFixedSinusoidStaysOneComponent) {
   const double rate = 50.0, freq = 3.77, amp = 0.03;
   const std::size_t n = 15000;  // 5 min at 50 Hz
   std::vector<double> x = whiteNoise(n, rate, 0.5, 9);
-  for (std::size_t i = 0; i < n; ++i) x[i] += amp * std::sin(2.0 * std::numbers::pi * freq * static_cast<double>(i) / rate + 1.0);
+  for (std::size_t i = 0; i < n; ++i)
+    x[i] += amp * std::sin(2.0 * std::numbers::pi * freq * static_cast<double>(i) / rate + 1.0);
   ModelCheckOptions o;
   o.replicas = 40;  // the product default: with 16 the thresholds are too noisy for a clean "nothing else" check
   const AxisModelCheck r = checkAxisModel({x, rate, {}, {}}, o);

@@ -35,7 +35,8 @@ double allanVarianceByIntegral(double tau, R r) {
     return s * h / 3.0;
   };
   const double v = 2.0 / (tau * tau) * simpson(0.0, tau, [&](double u) { return (tau - u) * r(u); });
-  const double c = 1.0 / (tau * tau) * simpson(0.0, 2.0 * tau, [&](double u) { return std::min(u, 2.0 * tau - u) * r(u); });
+  const double c =
+      1.0 / (tau * tau) * simpson(0.0, 2.0 * tau, [&](double u) { return std::min(u, 2.0 * tau - u) * r(u); });
   return v - c;
 }
 
@@ -81,7 +82,8 @@ TEST(NoiseSimulatorExtras, DeterministicEffectsFollowTheirFormulas) {
     const SimulatedSample s = sim.next();
     const double t = i / 50.0;
     double expected = 0.02 * (30.0 + (20.0 - 30.0) * std::exp(-t / 100.0) - 22.0);
-    expected += 0.05 * std::sin(2.0 * std::numbers::pi * 1.3 * t + 0.4) + 0.01 * std::sin(2.0 * std::numbers::pi * 7.0 * t - 1.0);
+    expected += 0.05 * std::sin(2.0 * std::numbers::pi * 1.3 * t + 0.4) +
+                0.01 * std::sin(2.0 * std::numbers::pi * 7.0 * t - 1.0);
     expected += (t >= 10.0 ? 0.2 : 0.0) + (t >= 30.0 ? -0.05 : 0.0);
     ASSERT_NEAR(s.rate_dps[1], expected, 1e-12) << "sample " << i;
     ASSERT_EQ(s.rate_dps[0], 0.0);

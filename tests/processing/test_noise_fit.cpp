@@ -165,7 +165,8 @@ TEST(NoiseFit, UncertaintyShrinksAsOneOverRootEdf) {
 
 TEST(NoiseFit, BadCurvesThrow) {
   auto curve = exactCurve(visibleTerms());
-  EXPECT_THROW(fitNoiseTerms(curve, (std::size_t{1} << 40) + 1), std::invalid_argument);  // no point has that many terms
+  EXPECT_THROW(fitNoiseTerms(curve, (std::size_t{1} << 40) + 1),
+               std::invalid_argument);  // no point has that many terms
   curve[3].edf = std::nan("");
   EXPECT_THROW(fitNoiseTerms(curve), std::invalid_argument);
   curve = exactCurve(visibleTerms());

@@ -477,8 +477,8 @@ TEST(FlickerBank, ExactAllanVarianceIsFlatFromTau0ToHalfTheDuration) {
       lo = std::min(lo, ratio);
       hi = std::max(hi, ratio);
     }
-    std::printf("flicker bank tau0=%g duration=%g: %zu processes, sigma/target in [%.4f, %.4f]\n", c.tau0,
-                c.duration, bank.size(), lo, hi);
+    std::printf("flicker bank tau0=%g duration=%g: %zu processes, sigma/target in [%.4f, %.4f]\n", c.tau0, c.duration,
+                bank.size(), lo, hi);
     EXPECT_GT(lo, 0.98);
     EXPECT_LT(hi, 1.02);
   }
@@ -502,7 +502,10 @@ std::vector<double> simulateAxis(const SimulationModel& m, std::size_t n, std::u
 // The paper's unit conversions written out here (IEEE 952 Table 1), independent of
 // noise_terms.cpp: σ² coefficient c with σ²(τ) = c·τ^p, σ in °/s, τ in s.
 constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
-double qCoefficient(double q_urad) { const double q = q_urad * 1e-6 * kDegPerRad; return 3.0 * q * q; }
+double qCoefficient(double q_urad) {
+  const double q = q_urad * 1e-6 * kDegPerRad;
+  return 3.0 * q * q;
+}
 double nCoefficient(double n) { return (n / 60.0) * (n / 60.0); }
 double bCoefficient(double b) { return (0.6643 * b / 3600.0) * (0.6643 * b / 3600.0); }
 double kCoefficient(double k) { return (k / 216000.0) * (k / 216000.0) / 3.0; }
@@ -556,14 +559,12 @@ TEST(NoiseSimulatorAllan, EachTermAloneLiesInsideItsConfidenceIntervals) {
           case NoiseTerm::Quantization: truth = qCoefficient(c.value) / (tau * tau); break;
           case NoiseTerm::AngleRandomWalk: truth = nCoefficient(c.value) / tau; break;
           case NoiseTerm::BiasInstability: {
-            const std::vector<GaussMarkovComponent> bank = flickerGaussMarkovBank(
-                bCoefficient(c.value), tau0, static_cast<double>(c.samples) * tau0);
+            const std::vector<GaussMarkovComponent> bank =
+                flickerGaussMarkovBank(bCoefficient(c.value), tau0, static_cast<double>(c.samples) * tau0);
             truth = bankAllanVariance(bank, tau0, static_cast<long>(p.m));
             break;
           }
-          case NoiseTerm::RateRandomWalk:
-            truth = kCoefficient(c.value) * (tau + tau0 * tau0 / (2.0 * tau));
-            break;
+          case NoiseTerm::RateRandomWalk: truth = kCoefficient(c.value) * (tau + tau0 * tau0 / (2.0 * tau)); break;
           case NoiseTerm::RateRamp: truth = rCoefficient(c.value) * tau * tau; break;
         }
         if (c.term == NoiseTerm::RateRamp) {
@@ -586,11 +587,11 @@ namespace {
 // below make neighbouring terms equal).
 NoiseTerms fiveTermModel() {
   NoiseTerms t;
-  t.quantization_urad = 5.52;             // c = 3e-7 (°/s)²·s²
-  t.arw_deg_per_sqrt_h = 0.104;           // c ≈ 3e-6 (°/s)²·s
-  t.bias_instability_deg_per_h = 5.42;    // c ≈ 1e-6 (°/s)²
-  t.rrw_deg_per_h_sqrt_h = 37.4;          // c ≈ 1.5e-8 (°/s)²/s
-  t.rate_ramp_deg_per_h2 = 81.9;          // c ≈ 2e-11 (°/s)²/s²
+  t.quantization_urad = 5.52;           // c = 3e-7 (°/s)²·s²
+  t.arw_deg_per_sqrt_h = 0.104;         // c ≈ 3e-6 (°/s)²·s
+  t.bias_instability_deg_per_h = 5.42;  // c ≈ 1e-6 (°/s)²
+  t.rrw_deg_per_h_sqrt_h = 37.4;        // c ≈ 1.5e-8 (°/s)²/s
+  t.rate_ramp_deg_per_h2 = 81.9;        // c ≈ 2e-11 (°/s)²/s²
   return t;
 }
 }  // namespace
@@ -648,8 +649,8 @@ TEST(NoiseSimulatorAllan, BiasInstabilityIsFlatAtFactorTimesB) {
     std::printf("tau %7.1f s: mean sigma/(0.6643 B) = %.4f ± %.4f (exact bank %.4f)\n", ms[i] * tau0, ratio,
                 0.5 * s.standard_error / s.mean * ratio, std::sqrt(exact / target));
   }
-  std::printf("flicker flatness over tau in [%g, %g] s: sigma/(0.6643 B) in [%.4f, %.4f]\n", tau0,
-              ms.back() * tau0, lo, hi);
+  std::printf("flicker flatness over tau in [%g, %g] s: sigma/(0.6643 B) in [%.4f, %.4f]\n", tau0, ms.back() * tau0, lo,
+              hi);
   EXPECT_GT(lo, 0.95);
   EXPECT_LT(hi, 1.05);
 }

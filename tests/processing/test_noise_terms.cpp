@@ -9,9 +9,7 @@
 using namespace gyrod::processing;
 
 namespace {
-double sigmaDps(NoiseTerm t, double value, double tau_s) {
-  return std::sqrt(allanVarianceOfTerm(t, value, tau_s));
-}
+double sigmaDps(NoiseTerm t, double value, double tau_s) { return std::sqrt(allanVarianceOfTerm(t, value, tau_s)); }
 }  // namespace
 
 TEST(NoiseTerms, AngleRandomWalkEqualsSigmaAtOneHourInDegPerHour) {

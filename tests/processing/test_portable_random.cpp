@@ -236,12 +236,14 @@ TEST(PortableMath, LogWithinTwoUlpOfLibm) {
   double worst = 0.0;
   for (int i = 0; i < 200000; ++i) {
     // log-uniform over the whole normal range, plus the polar method's range (0, 1).
-    const double x = i % 2 ? g.uniform() + 0x1.0p-60 : std::ldexp(1.0 + g.uniform(), static_cast<int>(g.next() % 2000) - 1000);
+    const double x =
+        i % 2 ? g.uniform() + 0x1.0p-60 : std::ldexp(1.0 + g.uniform(), static_cast<int>(g.next() % 2000) - 1000);
     worst = std::max(worst, ulpDistance(portable::log(x), std::log(x)));
   }
   EXPECT_LE(worst, 2.0);
   EXPECT_EQ(portable::log(1.0), 0.0);
-  EXPECT_NEAR(portable::log(std::numeric_limits<double>::denorm_min()), std::log(std::numeric_limits<double>::denorm_min()), 1e-12);
+  EXPECT_NEAR(portable::log(std::numeric_limits<double>::denorm_min()),
+              std::log(std::numeric_limits<double>::denorm_min()), 1e-12);
   EXPECT_THROW(portable::log(0.0), std::invalid_argument);
   EXPECT_THROW(portable::log(-1.0), std::invalid_argument);
   EXPECT_THROW(portable::log(std::numeric_limits<double>::infinity()), std::invalid_argument);

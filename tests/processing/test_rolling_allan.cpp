@@ -56,7 +56,7 @@ std::vector<double> generate(Model model, std::size_t count, std::uint64_t seed)
       for (double& v : y) v = 1000.0 + n(gen);
       break;
     }
-    case Model::kBiasAwayFromFirstSample: {  // the reference (first sample) does not remove the bias:
+    case Model::kBiasAwayFromFirstSample: {           // the reference (first sample) does not remove the bias:
       std::normal_distribution<double> n(0.0, 1e-3);  // the phase grows by 1000 per sample
       for (double& v : y) v = 1000.0 + n(gen);
       if (!y.empty()) y[0] = 0.0;
@@ -232,8 +232,7 @@ TEST_P(RollingWindowVsBatch, EqualsBatchAtEveryCheckedTimeAndFactor) {
     if (boundary || count % 1009 == 0) {
       // since start on the whole history is the costlier check: at boundaries and every 10th
       expectMatchesBatch(rolling, std::span<const double>(y).first(count),
-                         modelName(GetParam()) + " after " + std::to_string(count),
-                         boundary || count % 10090 == 0);
+                         modelName(GetParam()) + " after " + std::to_string(count), boundary || count % 10090 == 0);
       if (HasFailure()) return;
     }
   }
@@ -334,8 +333,8 @@ TEST(RollingOverlappingAllan, TenMillionUpdatesStillEqualBatch) {
   std::size_t slot = 0;  // k % kRing
   for (std::size_t k = 0; k < kSamples; ++k, slot = slot + 1 == kRing ? 0 : slot + 1) {
     const double v = k == 0 ? 0.0 : (k <= kBurst ? burst(gen) : 1000.0 + small(gen));
-    const double previous = last[slot == 0 ? kRing - 1 : slot - 1];  // y_{k−1}
-    const double oldest = last[slot];                                 // y_{k−W−1}, about to be overwritten
+    const double previous = last[slot == 0 ? kRing - 1 : slot - 1];       // y_{k−1}
+    const double oldest = last[slot];                                     // y_{k−W−1}, about to be overwritten
     const double second_oldest = last[slot + 1 == kRing ? 0 : slot + 1];  // y_{k−W}
     if (k >= 1) naive_sum += (v - previous) * (v - previous);
     if (k >= kRing) naive_sum -= (second_oldest - oldest) * (second_oldest - oldest);
@@ -413,8 +412,8 @@ TEST(RollingOverlappingAllan, BadSamplesThrowAndLeaveTheStateUnchanged) {
   RollingOverlappingAllan rolling(128);
   for (std::size_t k = 0; k < 200; ++k) rolling.push(y[k]);
   const double before = rolling.windowVariance(0);
-  for (double bad : {std::nan(""), std::numeric_limits<double>::infinity(),
-                     -std::numeric_limits<double>::infinity(), 1e101, -1e101}) {
+  for (double bad : {std::nan(""), std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+                     1e101, -1e101}) {
     EXPECT_THROW(rolling.push(bad), std::invalid_argument) << bad;
   }
   EXPECT_EQ(rolling.totalCount(), 200u);

@@ -142,7 +142,7 @@ TEST(QuantizeToInt16, RoundsToNearestLsb) {
   EXPECT_EQ(quantizeToInt16(0.49 / lsb, lsb), 0);
   EXPECT_EQ(quantizeToInt16(0.51 / lsb, lsb), 1);
   EXPECT_EQ(quantizeToInt16(-0.51 / lsb, lsb), -1);
-  EXPECT_EQ(quantizeToInt16(0.5, 2.0), 1);    // exactly half an LSB: away from zero
+  EXPECT_EQ(quantizeToInt16(0.5, 2.0), 1);  // exactly half an LSB: away from zero
   EXPECT_EQ(quantizeToInt16(-0.5, 2.0), -1);
   EXPECT_EQ(quantizeToInt16(100.0, lsb), 13100);
   EXPECT_EQ(quantizeToInt16(-1.5, 1.0), -2);

@@ -104,7 +104,9 @@ TEST(ProtocolGap, FormatsAndRejectsMalformedGaps) {
   const std::size_t n = formatGapLine(GapEvent{41, 3, "fifo_overflow"}, buf);
   EXPECT_EQ(std::string(buf.data(), n), "{\"class\":\"GAP\",\"seq\":41,\"count\":3,\"reason\":\"fifo_overflow\"}\n");
   const std::string longest_reason(kMaxGapReasonBytes, 'z');
-  const std::size_t m = formatGapLine(GapEvent{std::numeric_limits<std::uint64_t>::max(), std::numeric_limits<std::uint64_t>::max(), longest_reason}, buf);
+  const std::size_t m = formatGapLine(
+      GapEvent{std::numeric_limits<std::uint64_t>::max(), std::numeric_limits<std::uint64_t>::max(), longest_reason},
+      buf);
   EXPECT_EQ(parseLine(buf.data(), m)["reason"], longest_reason);
   EXPECT_THROW(formatGapLine(GapEvent{1, 0, "bus_error"}, buf), std::invalid_argument);
   EXPECT_THROW(formatGapLine(GapEvent{1, 1, ""}, buf), std::invalid_argument);
@@ -224,7 +226,8 @@ TEST(ProtocolRequests, EachProblemIsNamed) {
       {R"({"cmd":"watch","enable":"yes"})", ErrorCode::BadType, "\"enable\" must be true or false, got string"},
       {R"({"cmd":"watch","enable":1})", ErrorCode::BadType, "\"enable\" must be true or false, got number"},
       {R"({"cmd":"watch","decimate":"3"})", ErrorCode::BadType, "\"decimate\" must be an integer, got string"},
-      {R"({"cmd":"watch","decimate":2.5})", ErrorCode::BadType, "\"decimate\" must be an integer, got a fractional number"},
+      {R"({"cmd":"watch","decimate":2.5})", ErrorCode::BadType,
+       "\"decimate\" must be an integer, got a fractional number"},
       {R"({"cmd":"watch","decimate":0})", ErrorCode::OutOfRange, "must be in 1..1000000, got 0"},
       {R"({"cmd":"watch","decimate":-4})", ErrorCode::OutOfRange, "got -4"},
       {R"({"cmd":"watch","decimate":1000001})", ErrorCode::OutOfRange, "got 1000001"},

@@ -151,9 +151,10 @@ TEST(GyroctlFilter, OutputMatchesAPlainReimplementationExactly) {
   const double A = -0.2855, Q = 0.0577, R = 0.0667;
   const std::size_t L = 20;
   const double thr = 0.3;
-  const auto r = runGyroctl("filter " + in.string() + " -o " + out.string() +
-                                " --mean-window 20 --mean-threshold 0.3 --ar-phi -0.2855 --kalman-q 0.0577 --kalman-r 0.0667",
-                            d.path());
+  const auto r =
+      runGyroctl("filter " + in.string() + " -o " + out.string() +
+                     " --mean-window 20 --mean-threshold 0.3 --ar-phi -0.2855 --kalman-q 0.0577 --kalman-r 0.0667",
+                 d.path());
   ASSERT_EQ(r.exit_status, 0) << r.err;
   std::vector<std::string> header;
   const auto cols = parseCsv(readWholeFile(out), header);
@@ -201,8 +202,9 @@ TEST(GyroctlFilter, NoDetrendPassesTheRawInputThrough) {
   ScratchDir d;
   const auto in = d.write("in.csv", "t,gx\n0,1.25\n0.02,1.5\n0.04,1.75\n0.06,2\n0.08,1.5\n0.1,1.25\n");
   const auto out = d.path() / "out.csv";
-  const auto r = runGyroctl("filter " + in.string() + " -o " + out.string() + " --no-detrend --ar-phi 0.5 --kalman-q 1 --kalman-r 1",
-                            d.path());
+  const auto r = runGyroctl(
+      "filter " + in.string() + " -o " + out.string() + " --no-detrend --ar-phi 0.5 --kalman-q 1 --kalman-r 1",
+      d.path());
   ASSERT_EQ(r.exit_status, 0) << r.err;
   std::vector<std::string> header;
   const auto cols = parseCsv(readWholeFile(out), header);
@@ -254,7 +256,8 @@ TEST(GyroctlAnalyze, WriteModelRoundTripsThroughSimulate) {
   ASSERT_NE(pos, std::string::npos);
   EXPECT_NEAR(std::stod(text.substr(text.find('=', pos) + 1)), n_fit, 1e-12 * n_fit);
   const auto sim2 = d.path() / "sim2.csv";
-  const auto r = runGyroctl("simulate --model " + model.string() + " --duration 600 --seed 8 -o " + sim2.string(), d.path());
+  const auto r =
+      runGyroctl("simulate --model " + model.string() + " --duration 600 --seed 8 -o " + sim2.string(), d.path());
   EXPECT_EQ(r.exit_status, 0) << r.err;
 }
 
@@ -262,15 +265,15 @@ TEST(GyroctlFilter, BiasSubtractsConstantsInsteadOfDetrending) {
   ScratchDir d;
   const auto in = d.write("in.csv", "t,gx,gy\n0,1.25,2\n0.02,1.5,2\n0.04,1.75,2.5\n");
   const auto out = d.path() / "out.csv";
-  const auto r = runGyroctl("filter " + in.string() + " -o " + out.string() +
-                                " --bias 1,2 --ar-phi 0.5 --kalman-q 1 --kalman-r 1",
-                            d.path());
+  const auto r = runGyroctl(
+      "filter " + in.string() + " -o " + out.string() + " --bias 1,2 --ar-phi 0.5 --kalman-q 1 --kalman-r 1", d.path());
   ASSERT_EQ(r.exit_status, 0) << r.err;
   std::vector<std::string> header;
   const auto cols = parseCsv(readWholeFile(out), header);
   EXPECT_EQ(cols[1], (std::vector<double>{0.25, 0.5, 0.75}));
   EXPECT_EQ(cols[4], (std::vector<double>{0, 0, 0.5}));
   EXPECT_EQ(runGyroctl("filter " + in.string() + " -o " + out.string() + " --bias 1", d.path()).exit_status, 2);
-  EXPECT_EQ(runGyroctl("filter " + in.string() + " -o " + out.string() + " --bias 1,2 --no-detrend", d.path()).exit_status,
-            2);
+  EXPECT_EQ(
+      runGyroctl("filter " + in.string() + " -o " + out.string() + " --bias 1,2 --no-detrend", d.path()).exit_status,
+      2);
 }

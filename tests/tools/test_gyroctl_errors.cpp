@@ -55,7 +55,8 @@ TEST(GyroctlErrors, HeaderWithoutSamples) {
 TEST(GyroctlErrors, TextWhereANumberShouldBeNamesTheLine) {
   ScratchDir d;
   const auto f = d.write("t.csv", "t,gx\n0,0.1\n0.02,abc\n0.04,0.2\n");
-  expectOneLineError(runGyroctl("analyze " + f.string(), d.path()), f.string() + ":3: column 'gx': 'abc' is not a number");
+  expectOneLineError(runGyroctl("analyze " + f.string(), d.path()),
+                     f.string() + ":3: column 'gx': 'abc' is not a number");
 }
 
 TEST(GyroctlErrors, NaNAndInfAreRejectedWithTheirLine) {
@@ -67,7 +68,8 @@ TEST(GyroctlErrors, NaNAndInfAreRejectedWithTheirLine) {
   expectOneLineError(runGyroctl("filter " + inf_file.string() + " -o " + (d.path() / "o.csv").string(), d.path()),
                      inf_file.string() + ":2: column 'gx': non-finite value '-inf'");
   const auto huge_file = d.write("huge.csv", "gx\n1e999\n");
-  expectOneLineError(runGyroctl("analyze " + huge_file.string(), d.path()), ":2: column 'gx': non-finite value '1e999'");
+  expectOneLineError(runGyroctl("analyze " + huge_file.string(), d.path()),
+                     ":2: column 'gx': non-finite value '1e999'");
 }
 
 TEST(GyroctlErrors, MissingColumn) {
@@ -103,7 +105,8 @@ TEST(GyroctlErrors, RateThatDisagreesWithT) {
 TEST(GyroctlErrors, TimeGoingBackwardsNamesTheLine) {
   ScratchDir d;
   const auto f = d.write("b.csv", "t,gx\n0,1\n0.02,1\n0.01,1\n");
-  expectOneLineError(runGyroctl("analyze " + f.string(), d.path()), f.string() + ":4: column 't' is not strictly increasing");
+  expectOneLineError(runGyroctl("analyze " + f.string(), d.path()),
+                     f.string() + ":4: column 't' is not strictly increasing");
 }
 
 TEST(GyroctlErrors, TooFewSamples) {
@@ -118,7 +121,8 @@ TEST(GyroctlErrors, TauThatIsNotAWholeNumberOfSamples) {
   const auto r = runGyroctl("analyze " + f.string() + " --taus 0.1,0.03", d.path());
   expectOneLineError(r, "--taus");
   EXPECT_NE(r.err.find("0.03"), std::string::npos) << r.err;
-  expectOneLineError(runGyroctl("analyze " + f.string() + " --taus 1,x", d.path()), "--taus: 'x' is not a positive number");
+  expectOneLineError(runGyroctl("analyze " + f.string() + " --taus 1,x", d.path()),
+                     "--taus: 'x' is not a positive number");
 }
 
 TEST(GyroctlErrors, BadOptionValuesExitTwo) {

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <numbers>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <string>
 
 #include "processing/hidden_effect_generator.hpp"
@@ -23,8 +23,8 @@ std::string recordingCsv(const gyrod::processing::GeneratedRecording& g) {
   std::string out = "t,gx,gy,gz,temp\n";
   char line[256];
   for (std::size_t i = 0; i < g.t.size(); ++i) {
-    std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g,%.17g,%.17g\n", g.t[i], g.axes[0][i], g.axes[1][i], g.axes[2][i],
-                  g.temp[i]);
+    std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g,%.17g,%.17g\n", g.t[i], g.axes[0][i], g.axes[1][i],
+                  g.axes[2][i], g.temp[i]);
     out += line;
   }
   return out;
@@ -34,7 +34,8 @@ std::string recordingCsv(const gyrod::processing::GeneratedRecording& g) {
 
 TEST(GyroctlModelCheck, JsonNamesTheHiddenSinusoidOnItsAxisOnly) {
   ScratchDir d;
-  const auto g = gyrod::processing::HiddenEffectGenerator(7).generate(300.0, 50.0, {gyrod::processing::ModelEffect::Sinusoid});
+  const auto g =
+      gyrod::processing::HiddenEffectGenerator(7).generate(300.0, 50.0, {gyrod::processing::ModelEffect::Sinusoid});
   const auto csv = d.write("rec.csv", recordingCsv(g));
   const auto r = runGyroctl("model-check " + csv.string() + " --json --replicas 16 --seed 3 --threads 2", d.path());
   ASSERT_EQ(r.exit_status, 0) << r.err;
@@ -42,8 +43,9 @@ TEST(GyroctlModelCheck, JsonNamesTheHiddenSinusoidOnItsAxisOnly) {
   const char* names[3] = {"gx", "gy", "gz"};
   for (std::size_t a = 0; a < 3; ++a) {
     const auto& axis = doc.at("axes").at(names[a]);
-    for (const char* key : {"adev_log_error_base", "adev_log_error_extended", "innovation_var_base", "innovation_var_extended",
-                            "ljung_box_p_base", "ljung_box_p_extended", "in_band_base", "in_band_extended"})
+    for (const char* key :
+         {"adev_log_error_base", "adev_log_error_extended", "innovation_var_base", "innovation_var_extended",
+          "ljung_box_p_base", "ljung_box_p_extended", "in_band_base", "in_band_extended"})
       EXPECT_TRUE(axis.at("gain").at(key).is_number()) << key;
     const auto& effects = axis.at("effects");
     ASSERT_TRUE(effects.is_array());
@@ -64,7 +66,8 @@ TEST(GyroctlModelCheck, ReportFolderHasMarkdownAndPlotScripts) {
   const auto g = gyrod::processing::HiddenEffectGenerator(5).generate(200.0, 50.0, {});
   const auto csv = d.write("rec.csv", recordingCsv(g));
   const auto dir = d.path() / "report";
-  const auto r = runGyroctl("model-check " + csv.string() + " --axis gy --replicas 8 --report " + dir.string(), d.path());
+  const auto r =
+      runGyroctl("model-check " + csv.string() + " --axis gy --replicas 8 --report " + dir.string(), d.path());
   ASSERT_EQ(r.exit_status, 0) << r.err;
   EXPECT_NE(r.out.find("checked in"), std::string::npos);
   const std::string md = readWholeFile(dir / "report.md");
@@ -185,7 +188,8 @@ TEST(GyroctlModelCheckWriteModel, NamesTheHiddenSinusoidAndSimulateAcceptsTheFil
   const double sigma = kArw / 60.0 * std::sqrt(kSimRate);
   const double eta = kSinAmp * kSinAmp / (2.0 * sigma * sigma);
   const double sd_amp = sigma * std::sqrt(2.0 / n);
-  const double sd_freq = kSimRate * std::sqrt(12.0 / (4.0 * std::numbers::pi * std::numbers::pi * eta * n * (n * n - 1.0)));
+  const double sd_freq =
+      kSimRate * std::sqrt(12.0 / (4.0 * std::numbers::pi * std::numbers::pi * eta * n * (n * n - 1.0)));
   const double sd_phase = std::sqrt(4.0 / (eta * n));
   const auto& x = m.axes[0].extra;
   ASSERT_EQ(x.sinusoids.size(), 1u) << text;
@@ -223,11 +227,12 @@ TEST(GyroctlModelCheckWriteModel, NamesTheHiddenSinusoidAndSimulateAcceptsTheFil
 
 TEST(GyroctlModelCheckWriteModel, SampleGapsAreACommentNotAnEffect) {
   ScratchDir d;
-  const auto g = gyrod::processing::HiddenEffectGenerator(13).generate(200.0, 50.0, {gyrod::processing::ModelEffect::SampleGaps});
+  const auto g =
+      gyrod::processing::HiddenEffectGenerator(13).generate(200.0, 50.0, {gyrod::processing::ModelEffect::SampleGaps});
   const auto csv = d.write("rec.csv", recordingCsv(g));
   const auto out = d.path() / "m.toml";
-  const auto r =
-      runGyroctl("model-check " + csv.string() + " --axis gx --replicas 8 --json --write-model " + out.string(), d.path());
+  const auto r = runGyroctl(
+      "model-check " + csv.string() + " --axis gx --replicas 8 --json --write-model " + out.string(), d.path());
   ASSERT_EQ(r.exit_status, 0) << r.err;
   const std::string text = readWholeFile(out);
   const std::string note = "# gx: sample_gaps found (" + std::to_string(g.hidden[0].count) + " gaps, " +

@@ -35,9 +35,8 @@ std::vector<std::vector<double>> parseCsv(const std::string& text, std::string& 
 TEST(GyroctlSimulate, WritesTimeThreeAxesAndTemperature) {
   ScratchDir d;
   const std::string out = (d.path() / "sim.csv").string();
-  const auto r = runGyroctl("simulate --arw 0.95 --bias-instability 0.6 --duration 4 --rate 50 --dlpf 4 --fs-sel 0 -o " +
-                                out,
-                            d.path());
+  const auto r = runGyroctl(
+      "simulate --arw 0.95 --bias-instability 0.6 --duration 4 --rate 50 --dlpf 4 --fs-sel 0 -o " + out, d.path());
   ASSERT_EQ(r.exit_status, 0) << r.err;
   std::string header;
   const auto rows = parseCsv(readWholeFile(out), header);

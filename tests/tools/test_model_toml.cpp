@@ -118,14 +118,16 @@ TEST(ModelToml, WrongTypesNameTheKey) {
   EXPECT_EQ(errorOf("\n\n[x]\nbias_dps = true\n"), "model.toml:4: x.bias_dps must be a number, got a boolean");
   EXPECT_EQ(errorOf("x = 3\n"), "model.toml:1: x must be a table ([x]), got an integer");
   EXPECT_EQ(errorOf("[x.ar]\nphi = 0.5\n"), "model.toml:2: x.ar.phi must be an array of numbers, got a float");
-  EXPECT_EQ(errorOf("[x.ar]\nphi = [0.5, \"a\"]\n"), "model.toml:2: x.ar.phi must contain numbers only, found a string");
+  EXPECT_EQ(errorOf("[x.ar]\nphi = [0.5, \"a\"]\n"),
+            "model.toml:2: x.ar.phi must contain numbers only, found a string");
 }
 
 TEST(ModelToml, BadValuesNameTheKey) {
   EXPECT_EQ(errorOf("rate_hz = 0\n"), "model.toml:1: rate_hz must be > 0, got 0");
   EXPECT_EQ(errorOf("dlpf = 7\n"), "model.toml:1: dlpf must be 0..6, got 7");
   EXPECT_EQ(errorOf("fs_sel = -1\n"), "model.toml:1: fs_sel must be 0..3, got -1");
-  EXPECT_EQ(errorOf("[z]\nrrw_deg_per_h_sqrt_h = -0.1\n"), "model.toml:2: z.rrw_deg_per_h_sqrt_h must be >= 0, got -0.1");
+  EXPECT_EQ(errorOf("[z]\nrrw_deg_per_h_sqrt_h = -0.1\n"),
+            "model.toml:2: z.rrw_deg_per_h_sqrt_h must be >= 0, got -0.1");
   EXPECT_EQ(errorOf("[z]\nbias_dps = nan\n"), "model.toml:2: z.bias_dps must be finite, got nan");
   EXPECT_EQ(errorOf("[temperature]\ntime_constant_s = 0\n"),
             "model.toml:2: temperature.time_constant_s must be > 0, got 0");

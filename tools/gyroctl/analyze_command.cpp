@@ -50,7 +50,8 @@ std::vector<double> parseTauList(const std::string& text) {
       used = 0;
     }
     if (used == 0 || used != item.size() || !std::isfinite(v) || v <= 0.0)
-      throw std::invalid_argument("--taus: '" + item + "' is not a positive number of seconds (use octave, dense or a list like 1,10,100)");
+      throw std::invalid_argument("--taus: '" + item +
+                                  "' is not a positive number of seconds (use octave, dense or a list like 1,10,100)");
     taus.push_back(v);
   }
   if (taus.empty()) throw std::invalid_argument("--taus: empty list");
@@ -79,11 +80,11 @@ json noiseTermsJson(const NoiseTerms& t) {
 json allanJson(const std::vector<AllanPoint>& curve) {
   json a = json::array();
   for (const auto& p : curve) {
-    json j = {{"tau_s", p.tau_s}, {"m", p.m},
-              {"adev", p.adev},   {"oadev", p.oadev},
+    json j = {{"tau_s", p.tau_s},       {"m", p.m},
+              {"adev", p.adev},         {"oadev", p.oadev},
               {"oadev_lo", p.oadev_lo}, {"oadev_hi", p.oadev_hi},
-              {"n", p.oadev_terms}, {"adev_n", p.adev_terms},
-              {"edf", p.edf}, {"noise_alpha", p.noise_alpha}};
+              {"n", p.oadev_terms},     {"adev_n", p.adev_terms},
+              {"edf", p.edf},           {"noise_alpha", p.noise_alpha}};
     if (!std::isfinite(p.adev)) j.erase("adev");  // fewer than two clusters: omitted, not null
     a.push_back(j);
   }
@@ -112,14 +113,21 @@ json axisJson(const AxisAnalysis& a) {
   j["noise_from_slopes"] = noiseTermsJson(a.noise_from_slopes);
   json ar = json::array();
   for (const auto& m : a.ar)
-    ar.push_back({{"order", m.order()}, {"phi", m.phi}, {"phi_std_error", m.phi_std_error},
-                  {"noise_var", m.noise_var}, {"aic", m.aic}, {"bic", m.bic}});
+    ar.push_back({{"order", m.order()},
+                  {"phi", m.phi},
+                  {"phi_std_error", m.phi_std_error},
+                  {"noise_var", m.noise_var},
+                  {"aic", m.aic},
+                  {"bic", m.bic}});
   j["ar"] = ar;
   j["ar_order_aic"] = a.ar_order_aic;
   j["ar_order_bic"] = a.ar_order_bic;
   j["mean_filter"] = {{"window", a.filter.mean_window}, {"threshold_dps", a.filter.mean_threshold_dps}};
-  j["kalman"] = {{"a", a.filter.kalman.a}, {"q", a.filter.kalman.q}, {"r", a.filter.kalman.r},
-                 {"p0", a.filter.kalman.p0}, {"steady_state_gain", a.steady_state_gain}};
+  j["kalman"] = {{"a", a.filter.kalman.a},
+                 {"q", a.filter.kalman.q},
+                 {"r", a.filter.kalman.r},
+                 {"p0", a.filter.kalman.p0},
+                 {"steady_state_gain", a.steady_state_gain}};
   j["variance"] = {{"raw", a.variance.raw}, {"mean", a.variance.mean}, {"kalman", a.variance.kalman}};
   j["peak_ratio"] = a.peak_ratio;
   j["allan_after_kalman"] = allanJson(a.allan_after_kalman);
@@ -137,27 +145,29 @@ void printAxisText(std::ostream& o, const std::string& name, const AxisAnalysis&
   char line[256];
   o << "\n== " << name << " ==\n";
   o << "Tests on the raw series (5 % level)\n";
-  std::snprintf(line, sizeof line, "  zero mean     mean = %.6g deg/s, z = %.3f  -> %s\n", a.zero_mean.mean, a.zero_mean.z,
-                a.zero_mean.zero_mean ? "zero mean" : "non-zero mean");
+  std::snprintf(line, sizeof line, "  zero mean     mean = %.6g deg/s, z = %.3f  -> %s\n", a.zero_mean.mean,
+                a.zero_mean.z, a.zero_mean.zero_mean ? "zero mean" : "non-zero mean");
   o << line;
-  std::snprintf(line, sizeof line, "  stationarity  reverse arrangements over %zu segments: u = %.4f (|u| < 1.96)  -> %s\n",
+  std::snprintf(line, sizeof line,
+                "  stationarity  reverse arrangements over %zu segments: u = %.4f (|u| < 1.96)  -> %s\n",
                 a.reverse_arrangements.segments, a.reverse_arrangements.u,
                 a.reverse_arrangements.stationary ? "stationary" : "not stationary");
   o << line;
-  std::snprintf(line, sizeof line, "  normality     chi2 = %.3f, dof = %zu, critical %.3f, p = %.3g  -> %s\n", a.normality.chi2,
-                a.normality.dof, a.normality.critical, a.normality.p_value, a.normality.normal ? "normal" : "not normal");
+  std::snprintf(line, sizeof line, "  normality     chi2 = %.3f, dof = %zu, critical %.3f, p = %.3g  -> %s\n",
+                a.normality.chi2, a.normality.dof, a.normality.critical, a.normality.p_value,
+                a.normality.normal ? "normal" : "not normal");
   o << line;
   if (a.trend_removed.offset != 0.0 || a.trend_removed.slope_per_s != 0.0) {
-    std::snprintf(line, sizeof line, "Removed: constant %.6g deg/s and trend %.6g deg/s per s\n", a.trend_removed.offset,
-                  a.trend_removed.slope_per_s);
+    std::snprintf(line, sizeof line, "Removed: constant %.6g deg/s and trend %.6g deg/s per s\n",
+                  a.trend_removed.offset, a.trend_removed.slope_per_s);
     o << line;
   }
 
   o << "\nAllan deviation (deg/s; overlapping with 68.3 % chi2 interval)\n";
   o << "      tau [s]        m         adev        oadev     oadev_lo     oadev_hi    terms  alpha\n";
   for (const auto& p : a.allan) {
-    std::snprintf(line, sizeof line, "  %11.4f %8zu %12.5g %12.5g %12.5g %12.5g %8zu %6d\n", p.tau_s, p.m, p.adev, p.oadev,
-                  p.oadev_lo, p.oadev_hi, p.oadev_terms, p.noise_alpha);
+    std::snprintf(line, sizeof line, "  %11.4f %8zu %12.5g %12.5g %12.5g %12.5g %8zu %6d\n", p.tau_s, p.m, p.adev,
+                  p.oadev, p.oadev_lo, p.oadev_hi, p.oadev_terms, p.noise_alpha);
     o << line;
   }
 
@@ -268,8 +278,9 @@ int runAnalyze(const AnalyzeOptions& opt) {
 
 void addAnalyzeCommand(CLI::App& app, CommandRunner& run) {
   auto opt = std::make_shared<AnalyzeOptions>();
-  auto* sub = app.add_subcommand("analyze", "The paper's tables for a static recording: tests, Allan deviation, "
-                                            "noise terms, AR/AIC, Kalman, terms after Kalman");
+  auto* sub = app.add_subcommand("analyze",
+                                 "The paper's tables for a static recording: tests, Allan deviation, "
+                                 "noise terms, AR/AIC, Kalman, terms after Kalman");
   sub->add_option("FILE", opt->file, "CSV with header t,gx,gy,gz,temp (any subset), or one column of bare numbers")
       ->required();
   sub->add_option("--rate", opt->rate_hz, "sample rate [Hz] (default: from t, else 50)");
@@ -279,11 +290,14 @@ void addAnalyzeCommand(CLI::App& app, CommandRunner& run) {
   sub->add_flag("--no-detrend", opt->no_detrend, "keep the constant and the linear trend");
   sub->add_flag("--json", opt->json, "one JSON document on stdout");
   sub->add_option("--mean-window", opt->mean_window, "mean filter window L [samples]")
-      ->default_val(20)->check(CLI::Range(std::size_t{1}, std::size_t{100000}));
+      ->default_val(20)
+      ->check(CLI::Range(std::size_t{1}, std::size_t{100000}));
   sub->add_option("--mean-threshold", opt->mean_threshold_dps, "gross-error threshold r [deg/s]")
-      ->default_val(0.3)->check(CLI::PositiveNumber);
+      ->default_val(0.3)
+      ->check(CLI::PositiveNumber);
   sub->add_option("--max-ar-order", opt->max_ar_order, "highest AR order for Table 3")
-      ->default_val(3)->check(CLI::Range(std::size_t{1}, std::size_t{8}));
+      ->default_val(3)
+      ->check(CLI::Range(std::size_t{1}, std::size_t{8}));
   sub->add_option("--write-model", opt->write_model,
                   "write the fitted model (noise terms and bias per axis) as TOML for gyroctl simulate --model");
   sub->callback([&run, opt] { run = [opt] { return runAnalyze(*opt); }; });

@@ -47,8 +47,8 @@ struct WatchOptions {
 };
 
 void printRateHeader() {
-  std::printf("%10s %12s  %10s %10s %10s  %10s %10s %10s  [deg/s]\n", "seq", "t [s]", "raw x", "raw y", "raw z", "kalman x",
-              "kalman y", "kalman z");
+  std::printf("%10s %12s  %10s %10s %10s  %10s %10s %10s  [deg/s]\n", "seq", "t [s]", "raw x", "raw y", "raw z",
+              "kalman x", "kalman y", "kalman z");
 }
 
 // A value the line left out comes back from the parser as NaN and shows as "-".
@@ -208,7 +208,8 @@ std::string gnuplotQuoted(const std::string& s) {
 void plotAllan(const std::string& file, const std::vector<double>& tau, const std::vector<Curve>& curves) {
   const auto gnuplot = findOnPath("gnuplot");
   if (!gnuplot)
-    throw std::runtime_error("--plot: gnuplot is not installed (apt-get install gnuplot-nox); the table above was printed, no plot was drawn");
+    throw std::runtime_error(
+        "--plot: gnuplot is not installed (apt-get install gnuplot-nox); the table above was printed, no plot was drawn");
   if (tau.empty()) throw std::runtime_error("--plot: no Allan deviation to plot yet");
   std::string script = "set terminal " + gnuplotTerminal(file) + "\nset output " + gnuplotQuoted(file) + "\n";
   script +=
@@ -236,7 +237,8 @@ void plotAllan(const std::string& file, const std::vector<double>& tau, const st
   if (pipe == nullptr) throw std::runtime_error("--plot: cannot start gnuplot");
   std::fwrite(script.data(), 1, script.size(), pipe);
   const int status = ::pclose(pipe);
-  if (status != 0) throw std::runtime_error("--plot: gnuplot failed (status " + std::to_string(status) + ") writing " + file);
+  if (status != 0)
+    throw std::runtime_error("--plot: gnuplot failed (status " + std::to_string(status) + ") writing " + file);
   std::fprintf(stderr, "wrote the Allan plot to %s\n", file.c_str());
 }
 
@@ -342,7 +344,8 @@ int runStatus(const CommonOptions& opt) {
 void addClientCommands(CLI::App& app, CommandRunner& run) {
   {
     auto opt = std::make_shared<WatchOptions>();
-    auto* sub = app.add_subcommand("watch", "Show gyrod's live samples: seq, t, raw and Kalman rate per axis (RATE lines)");
+    auto* sub =
+        app.add_subcommand("watch", "Show gyrod's live samples: seq, t, raw and Kalman rate per axis (RATE lines)");
     addCommonOptions(sub, opt->common);
     sub->add_flag("--json", opt->common.json, "print gyrod's lines unchanged (one JSON object per line)");
     sub->add_option("--decimate", opt->decimate, "receive every N-th sample")

@@ -11,8 +11,8 @@ using CommandRunner = std::function<int()>;
 
 // Exit statuses shared by all subcommands.
 inline constexpr int kExitOk = 0;
-inline constexpr int kExitUsage = 2;     // bad input file, bad option value
-inline constexpr int kExitFailure = 1;   // anything else
+inline constexpr int kExitUsage = 2;    // bad input file, bad option value
+inline constexpr int kExitFailure = 1;  // anything else
 
 void addAnalyzeCommand(CLI::App& app, CommandRunner& run);
 void addFilterCommand(CLI::App& app, CommandRunner& run);

@@ -10,7 +10,6 @@
 #include <cstdio>
 #include <cstring>
 
-
 namespace gyrod::gyroctl {
 namespace {
 
@@ -18,7 +17,7 @@ namespace {
 constexpr std::size_t kMaxServerLineBytes = 16 * 1024 * 1024;
 
 std::string socketGroupName(const std::string& path) {
-  struct stat st{};
+  struct stat st {};
   if (::stat(path.c_str(), &st) != 0) return {};
   if (const group* g = ::getgrgid(st.st_gid)) return g->gr_name;
   return std::to_string(st.st_gid);
@@ -26,8 +25,7 @@ std::string socketGroupName(const std::string& path) {
 
 [[noreturn]] void throwConnectError(const std::string& path, int err) {
   switch (err) {
-    case ENOENT:
-      throw DaemonConnectionError(path + ": no such socket (is gyrod running?)");
+    case ENOENT: throw DaemonConnectionError(path + ": no such socket (is gyrod running?)");
     case EACCES:
     case EPERM: {
       const std::string group = socketGroupName(path);
@@ -36,11 +34,11 @@ std::string socketGroupName(const std::string& path) {
                                   "': add your user to it and log in again, or use sudo)");
     }
     case ECONNREFUSED:
-      throw DaemonConnectionError(path + ": connection refused (the socket file exists but nothing listens on it: is gyrod running?)");
+      throw DaemonConnectionError(
+          path + ": connection refused (the socket file exists but nothing listens on it: is gyrod running?)");
     case ENOTDIR:
       throw DaemonConnectionError(path + ": no such socket (a part of the path is not a folder; is gyrod running?)");
-    default:
-      throw DaemonConnectionError(path + ": cannot connect: " + std::strerror(err));
+    default: throw DaemonConnectionError(path + ": cannot connect: " + std::strerror(err));
   }
 }
 
@@ -64,7 +62,8 @@ DaemonConnection DaemonConnection::open(const std::string& path, std::chrono::mi
   sockaddr_un addr{};
   addr.sun_family = AF_UNIX;
   if (path.empty() || path.size() >= sizeof addr.sun_path)
-    throw DaemonConnectionError("'" + path + "' cannot be a Unix socket path (1.." + std::to_string(sizeof addr.sun_path - 1) + " bytes)");
+    throw DaemonConnectionError("'" + path + "' cannot be a Unix socket path (1.." +
+                                std::to_string(sizeof addr.sun_path - 1) + " bytes)");
   std::memcpy(addr.sun_path, path.data(), path.size());
   protocol::Fd fd(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0));
   if (!fd) throw DaemonConnectionError(std::string("socket(AF_UNIX): ") + std::strerror(errno));

@@ -97,7 +97,8 @@ int runFilter(const FilterOptions& opt) {
     const auto& k = params[axis].kalman;
     std::fprintf(stderr, "%s: L = %zu, r = %g deg/s, A = %.6g, Q = %.6g, R = %.6g%s\n", rec.axis_names[axis].c_str(),
                  params[axis].mean_window, params[axis].mean_threshold_dps, k.a, k.q, k.r,
-                 opt.ar_phi || opt.kalman_q || opt.kalman_r ? " (some given on the command line)" : " (identified from the file)");
+                 opt.ar_phi || opt.kalman_q || opt.kalman_r ? " (some given on the command line)"
+                                                            : " (identified from the file)");
   }
   std::fprintf(stderr, "wrote %zu samples to %s\n", n, opt.output.c_str());
   return kExitOk;
@@ -107,14 +108,17 @@ int runFilter(const FilterOptions& opt) {
 
 void addFilterCommand(CLI::App& app, CommandRunner& run) {
   auto opt = std::make_shared<FilterOptions>();
-  auto* sub = app.add_subcommand("filter", "Run the daemon's per-sample chain offline: (detrend) -> mean filter -> Kalman");
+  auto* sub =
+      app.add_subcommand("filter", "Run the daemon's per-sample chain offline: (detrend) -> mean filter -> Kalman");
   sub->add_option("FILE", opt->file, "recording CSV (as for analyze)")->required();
   sub->add_option("-o,--output", opt->output, "output CSV: t, then gx,gx_mean,gx_kalman per axis")->required();
   sub->add_option("--rate", opt->rate_hz, "sample rate [Hz] (default: from t, else 50)");
   sub->add_option("--mean-window", opt->mean_window, "mean filter window L [samples]")
-      ->default_val(20)->check(CLI::Range(std::size_t{1}, std::size_t{100000}));
+      ->default_val(20)
+      ->check(CLI::Range(std::size_t{1}, std::size_t{100000}));
   sub->add_option("--mean-threshold", opt->mean_threshold_dps, "gross-error threshold r [deg/s]")
-      ->default_val(0.3)->check(CLI::PositiveNumber);
+      ->default_val(0.3)
+      ->check(CLI::PositiveNumber);
   sub->add_option("--ar-phi", opt->ar_phi, "Kalman A = phi1 (default: AR(1) fit of the mean-filtered series)");
   sub->add_option("--kalman-q", opt->kalman_q, "Kalman Q [(deg/s)^2] (default: AR(1) noise variance)");
   sub->add_option("--kalman-r", opt->kalman_r, "Kalman R [(deg/s)^2] (default: var(x - mean-filtered x))");

@@ -147,7 +147,8 @@ void addImportCommand(CLI::App& app, CommandRunner& run) {
   sub->add_option("-o,--output", opt->output, "CSV to write")->required();
   sub->add_option("--format", opt->format, "imucal (ImuCalibration logger) or auto")->default_val("auto");
   sub->add_option("--fs-sel", opt->fs_sel, "gyro full scale the recording was made at (0 = +-250 deg/s)")
-      ->default_val(0)->check(CLI::Range(0, 3));
+      ->default_val(0)
+      ->check(CLI::Range(0, 3));
   sub->callback([&run, opt] { run = [opt] { return runImport(*opt); }; });
 }
 

@@ -1,5 +1,6 @@
 #include "tools/gyroctl/input.hpp"
 
+#include <unistd.h>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -7,7 +8,6 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
-#include <unistd.h>
 
 namespace gyrod::gyroctl {
 
@@ -24,8 +24,8 @@ LoadedInput loadInput(const std::string& path, std::optional<double> rate_hz, co
     const double from_t = recording::sampleRateFromTimes(rec);
     if (rate_hz && std::abs(*rate_hz - from_t) > 0.01 * from_t) {
       std::ostringstream s;
-      s << path << ": --rate " << *rate_hz << " Hz disagrees with column 't' (median spacing "
-        << 1.0 / from_t << " s, i.e. " << from_t << " Hz)";
+      s << path << ": --rate " << *rate_hz << " Hz disagrees with column 't' (median spacing " << 1.0 / from_t
+        << " s, i.e. " << from_t << " Hz)";
       throw recording::RecordingError(s.str());
     }
     in.rate_hz = rate_hz ? *rate_hz : from_t;

@@ -11,7 +11,7 @@ namespace gyrod::gyroctl {
 struct LoadedInput {
   recording::Recording recording;
   double rate_hz = 0.0;
-  std::string rate_source;           // "t column", "--rate", "default"
+  std::string rate_source;                // "t column", "--rate", "default"
   std::vector<std::size_t> axis_indices;  // into recording.axes, in output order
 };
 

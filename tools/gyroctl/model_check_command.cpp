@@ -24,8 +24,8 @@
 
 #include "formats/model_toml.hpp"
 #include "processing/model_check.hpp"
-#include "processing/warm_up_fit.hpp"
 #include "processing/noise_terms.hpp"
+#include "processing/warm_up_fit.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
 
@@ -123,8 +123,8 @@ std::string evidenceText(const DetectedEffect& e) {
              fmt("%.3g", e.outlier_median_amplitude_dps) + " deg/s";
     case ModelEffect::Sinusoid: return sinusoidEvidenceText(v);
     case ModelEffect::TemperatureBias:
-      return "low-passed residual against the detrended temperature: slope " + fmt("%.4g", v.statistic) +
-             " deg/s/C, " + nullText(v) + " (two-sided on the distance); " + decisionText(v);
+      return "low-passed residual against the detrended temperature: slope " + fmt("%.4g", v.statistic) + " deg/s/C, " +
+             nullText(v) + " (two-sided on the distance); " + decisionText(v);
     case ModelEffect::BiasSteps:
       return "largest standardised Haar difference of the low-passed residual " + fmt("%.3g", v.statistic) + ", " +
              nullText(v) + "; " + decisionText(v);
@@ -175,7 +175,10 @@ json axisJson(const AxisModelCheck& r) {
                        {"evidence", evidenceText(e)}});
   json stats = json::array();
   for (const CheckStatistic& s : r.statistics)
-    stats.push_back({{"name", s.name}, {"value", s.value}, {"null_median", s.null_median}, {"threshold", s.threshold},
+    stats.push_back({{"name", s.name},
+                     {"value", s.value},
+                     {"null_median", s.null_median},
+                     {"threshold", s.threshold},
                      {"fired", s.fired}});
   return {{"effects", effects},
           {"gain", gainJson(r.gain)},
@@ -195,11 +198,14 @@ void printAxisText(std::ostream& o, const std::string& name, const AxisModelChec
   const ModelCheckGain& g = r.gain;
   char line[256];
   o << "  gain                    base        extended\n";
-  std::snprintf(line, sizeof line, "  adev log error    %12.4g    %12.4g\n", g.adev_log_error_base, g.adev_log_error_extended);
+  std::snprintf(line, sizeof line, "  adev log error    %12.4g    %12.4g\n", g.adev_log_error_base,
+                g.adev_log_error_extended);
   o << line;
-  std::snprintf(line, sizeof line, "  innovation var    %12.4g    %12.4g\n", g.innovation_var_base, g.innovation_var_extended);
+  std::snprintf(line, sizeof line, "  innovation var    %12.4g    %12.4g\n", g.innovation_var_base,
+                g.innovation_var_extended);
   o << line;
-  std::snprintf(line, sizeof line, "  Ljung-Box p       %12.4g    %12.4g\n", g.ljung_box_p_base, g.ljung_box_p_extended);
+  std::snprintf(line, sizeof line, "  Ljung-Box p       %12.4g    %12.4g\n", g.ljung_box_p_base,
+                g.ljung_box_p_extended);
   o << line;
   std::snprintf(line, sizeof line, "  in 90%% band       %12.3f    %12.3f\n", g.in_band_base, g.in_band_extended);
   o << line;
@@ -218,8 +224,8 @@ std::string shellQuoted(const std::filesystem::path& p) {
 }
 
 // Data files and gnuplot scripts for one axis; returns the plots made (file names).
-std::vector<std::string> writeAxisPlots(const std::filesystem::path& dir, const std::string& name, const AxisModelCheck& r,
-                                        bool run_gnuplot) {
+std::vector<std::string> writeAxisPlots(const std::filesystem::path& dir, const std::string& name,
+                                        const AxisModelCheck& r, bool run_gnuplot) {
   std::vector<std::string> made;
   {
     std::ostringstream d;
@@ -233,7 +239,8 @@ std::vector<std::string> writeAxisPlots(const std::filesystem::path& dir, const 
     g << "set terminal pngcairo size 900,600\nset output 'allan_" << name << ".png'\n"
       << "set logscale xy\nset grid\nset xlabel 'tau [s]'\nset ylabel 'Allan deviation [deg/s]'\n"
       << "set title 'Allan deviation, " << name << ": measured against 90 % bands of the replicas'\n"
-      << "plot 'allan_" << name << ".dat' u 1:4:5 w filledcurves lc rgb '#c0c0ff' fs transparent solid 0.5 t 'base 90 %', "
+      << "plot 'allan_" << name
+      << ".dat' u 1:4:5 w filledcurves lc rgb '#c0c0ff' fs transparent solid 0.5 t 'base 90 %', "
       << "'' u 1:7:8 w filledcurves lc rgb '#ffc080' fs transparent solid 0.5 t 'extended 90 %', "
       << "'' u 1:3 w l lc rgb 'blue' dt 2 t 'base median', '' u 1:6 w l lc rgb '#d06000' dt 2 t 'extended median', "
       << "'' u 1:2 w lp pt 7 ps 0.6 lc rgb 'black' t 'measured'\n";
@@ -301,7 +308,8 @@ void writeReport(const std::string& dir_text, const ModelCheckCliOptions& opt, c
   if (!plots) md << "\n(gnuplot is not installed: the plot data and scripts are written, the pictures are not.)\n";
   for (const auto& [name, r] : results) {
     md << "\n## " << name << "\n\n";
-    if (r.effects.empty()) md << "The base model holds: no effect found.\n";
+    if (r.effects.empty())
+      md << "The base model holds: no effect found.\n";
     else {
       md << "| effect | parameters | evidence |\n|---|---|---|\n";
       for (const DetectedEffect& e : r.effects)
@@ -353,10 +361,10 @@ std::optional<std::size_t> simulatorAxisFor(const std::string& column) {
 // Seconds from the first sample for each sample: from t when present, else i/rate.
 std::vector<double> secondsFromStart(const recording::Recording& rec, double rate_hz) {
   std::vector<double> s(rec.size());
-  for (std::size_t i = 0; i < s.size(); ++i) s[i] = rec.t.empty() ? static_cast<double>(i) / rate_hz : rec.t[i] - rec.t[0];
+  for (std::size_t i = 0; i < s.size(); ++i)
+    s[i] = rec.t.empty() ? static_cast<double>(i) / rate_hz : rec.t[i] - rec.t[0];
   return s;
 }
-
 
 // Mean of the noise-free curve over the recording's times: the temperature term's
 // reference, so that k·(T − reference) averages to zero and bias_dps stays the mean rate.
@@ -369,9 +377,9 @@ double meanOfCurve(const TemperatureModel& m, std::span<const double> secs) {
 // One axis's extended model: the refitted five terms plus each named effect as the
 // simulator's AxisExtraEffects (times and phases from the first sample, as the check fits
 // them); the effects without a simulator counterpart go into `notes`.
-AxisNoiseModel extendedAxisModel(const AxisModelCheck& r, std::span<const double> rate_dps, const recording::Recording& rec,
-                                 double rate_hz, double temperature_reference_c, const std::string& name,
-                                 std::vector<std::string>& notes) {
+AxisNoiseModel extendedAxisModel(const AxisModelCheck& r, std::span<const double> rate_dps,
+                                 const recording::Recording& rec, double rate_hz, double temperature_reference_c,
+                                 const std::string& name, std::vector<std::string>& notes) {
   AxisNoiseModel m;
   m.terms = r.extended_fit.value;
   long double sum = 0.0L;
@@ -394,9 +402,10 @@ AxisNoiseModel extendedAxisModel(const AxisModelCheck& r, std::span<const double
         for (std::size_t j = 0; j < e.times_s.size() && j < e.sizes_dps.size(); ++j) {
           // The check reports the step's time from t (when present); the simulator counts
           // samples from 0 at the nominal rate, so use the sample index.
-          const std::size_t i =
-              rec.t.empty() ? static_cast<std::size_t>(std::llround(e.times_s[j] * rate_hz))
-                            : static_cast<std::size_t>(std::lower_bound(rec.t.begin(), rec.t.end(), e.times_s[j]) - rec.t.begin());
+          const std::size_t i = rec.t.empty()
+                                    ? static_cast<std::size_t>(std::llround(e.times_s[j] * rate_hz))
+                                    : static_cast<std::size_t>(
+                                          std::lower_bound(rec.t.begin(), rec.t.end(), e.times_s[j]) - rec.t.begin());
           x.bias_steps.push_back({static_cast<double>(i) / rate_hz, e.sizes_dps[j]});
           bias -= e.sizes_dps[j] * (n - static_cast<double>(std::min<std::size_t>(i, rate_dps.size()))) / n;
         }
@@ -410,8 +419,8 @@ AxisNoiseModel extendedAxisModel(const AxisModelCheck& r, std::span<const double
                         " samples lost): not modelled, the simulator delivers every sample");
         break;
       case ModelEffect::Unexplained:
-        notes.push_back(name + ": unexplained mismatch at tau " + fmt("%.4g", e.where_lo) + " to " + fmt("%.4g", e.where_hi) +
-                        " s: not modelled, no catalogue effect explains it");
+        notes.push_back(name + ": unexplained mismatch at tau " + fmt("%.4g", e.where_lo) + " to " +
+                        fmt("%.4g", e.where_hi) + " s: not modelled, no catalogue effect explains it");
         break;
     }
   }
@@ -440,14 +449,16 @@ std::string extendedModelToml(const ModelCheckCliOptions& opt, const LoadedInput
   }
   validateSimulationModel(model);
   std::string head = "# Extended model of " + opt.file + " from gyroctl model-check (seed " + std::to_string(opt.seed) +
-                     ", " + std::to_string(opt.replicas) + " replicas): the five terms refitted with the named\n"
+                     ", " + std::to_string(opt.replicas) +
+                     " replicas): the five terms refitted with the named\n"
                      "# effects removed, plus those effects as [axis.extra] tables (docs/model-check.md).\n"
                      "# Axes checked:";
   for (const std::string& a : axes_written) head += " " + a;
   head += ".\n";
   if (!rec.temp.empty())
-    head += "# [temperature] is a warm-up curve fitted to the recording's temperature; the recording's own\n"
-            "# temperature (room cycles, steps) is not reproduced, only the temperature coefficient.\n";
+    head +=
+        "# [temperature] is a warm-up curve fitted to the recording's temperature; the recording's own\n"
+        "# temperature (room cycles, steps) is not reproduced, only the temperature coefficient.\n";
   for (const std::string& note : notes) head += "# " + note + "\n";
   return head + recording::modelToToml(model);
 }
@@ -517,10 +528,12 @@ void addModelCheckCommand(CLI::App& app, CommandRunner& run) {
   sub->add_option("--report", opt->report_dir, "write report.md with plots (gnuplot, when installed) into this folder");
   sub->add_option("--seed", opt->seed, "seed of the replicas")->default_val(1);
   sub->add_option("--replicas", opt->replicas, "replicas per round (the null distributions)")
-      ->default_val(40)->check(CLI::Range(std::size_t{8}, std::size_t{10000}));
+      ->default_val(40)
+      ->check(CLI::Range(std::size_t{8}, std::size_t{10000}));
   sub->add_option("--threads", opt->threads, "threads for the replicas (0: all cores)")->default_val(0);
-  sub->add_option("--write-model", opt->write_model,
-                  "write the extended model of every axis (terms and named effects) as TOML for gyroctl simulate --model");
+  sub->add_option(
+      "--write-model", opt->write_model,
+      "write the extended model of every axis (terms and named effects) as TOML for gyroctl simulate --model");
   sub->callback([&run, opt] { run = [opt] { return runModelCheck(*opt); }; });
 }
 

@@ -108,8 +108,8 @@ int runSimulate(const SimulateOptions& opt) {
 
 void addSimulateCommand(CLI::App& app, CommandRunner& run) {
   auto opt = std::make_shared<SimulateOptions>();
-  auto* sub = app.add_subcommand(
-      "simulate", "Write a simulated MPU6050 recording at rest (t,gx,gy,gz,temp) from a noise model");
+  auto* sub = app.add_subcommand("simulate",
+                                 "Write a simulated MPU6050 recording at rest (t,gx,gy,gz,temp) from a noise model");
   auto* model = sub->add_option("--model", opt->model_file, "model file (TOML, see docs/simulator.md)");
   auto* terms = sub->add_option_group("terms", "noise terms on all three axes (instead of --model)");
   auto* q = terms->add_option("--quantization", opt->quantization, "quantization noise Q [urad]");
