@@ -199,6 +199,7 @@ std::vector<std::string> Recorder::files() const {
   }
   std::sort(names.begin(), names.end());
   std::vector<std::string> paths;
+  paths.reserve(names.size());
   for (const auto& n : names) paths.push_back((fs::path(directory_) / n).string());
   return paths;
 }

@@ -87,7 +87,8 @@ double nominalSamplePeriodNs(const Mpu6050Config& c) {
 
 std::int64_t pollingPeriodNs(const Mpu6050Config& c) {
   const double fastest_period = nominalSamplePeriodNs(c) / (1.0 + c.max_clock_error);
-  const double frames = static_cast<double>(kCloneFifoSize / kFrameBytes);
+  // Whole frames only: a partial frame at the FIFO's end is no sample.
+  const double frames = static_cast<double>(kCloneFifoSize / kFrameBytes);  // NOLINT(bugprone-integer-division)
   double period = std::min(
       {frames * fastest_period / 4.0, 100e6, static_cast<double>(c.max_frames_per_wakeup) * fastest_period / 2.0});
   period = std::max(period, 1e6);

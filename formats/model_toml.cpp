@@ -253,7 +253,7 @@ void appendKeyValue(std::string& out, const std::string& key, double v) {
 processing::SimulationModel parseModelToml(std::string_view text, const std::string& source_name) {
   try {
     const formats::TomlDocument doc(text, source_name);
-    const SimulationModel model = ModelReader(doc).read(doc.root());
+    SimulationModel model = ModelReader(doc).read(doc.root());
     try {
       processing::validateSimulationModel(model);  // anything not already tied to a line
     } catch (const std::invalid_argument& e) {

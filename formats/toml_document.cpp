@@ -204,7 +204,7 @@ std::optional<std::vector<double>> TomlSection::numbers(std::string_view key, co
   return values;
 }
 
-std::vector<TomlSection> TomlSection::tables(std::string_view key, std::vector<std::string_view> keys) const {
+std::vector<TomlSection> TomlSection::tables(std::string_view key, const std::vector<std::string_view>& keys) const {
   std::vector<TomlSection> out;
   const auto* n = node(key);
   if (!n) return out;

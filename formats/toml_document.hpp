@@ -91,7 +91,7 @@ class TomlSection {
   std::optional<std::vector<double>> numbers(std::string_view key, const std::function<bool(double)>& ok,
                                              const std::string& requirement) const;
   // A sub-table, or an array of sub-tables (e.g. several bursts), each with `keys`.
-  std::vector<TomlSection> tables(std::string_view key, std::vector<std::string_view> keys) const;
+  std::vector<TomlSection> tables(std::string_view key, const std::vector<std::string_view>& keys) const;
 
  private:
   const std::string& file_;

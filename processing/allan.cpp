@@ -272,7 +272,8 @@ std::vector<std::size_t> clusterSizesForTaus(std::span<const double> taus_s, dou
                                   " s is not a whole number of samples (tau0 = " + formatNumber(tau0_s) + " s gives " +
                                   formatNumber(samples) + " samples)");
     }
-    if (whole > static_cast<double>(sample_count / 2)) {
+    // m may be at most floor(N/2): two clusters must fit.
+    if (whole > static_cast<double>(sample_count / 2)) {  // NOLINT(bugprone-integer-division)
       throw std::invalid_argument("clusterSizesForTaus: tau = " + formatNumber(tau) + " s (m = " + formatNumber(whole) +
                                   " samples) is too long for " + std::to_string(sample_count) +
                                   " samples: the overlapping estimator needs 2*m <= sample count");

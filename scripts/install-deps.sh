@@ -8,6 +8,7 @@ packages=(
   libspdlog-dev libi2c-dev libgpiod-dev libsystemd-dev
   libgtest-dev libbenchmark-dev
   gnuplot-nox systemd
+  clang-format clang-tidy
 )
 missing=()
 for p in "${packages[@]}"; do
