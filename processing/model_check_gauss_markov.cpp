@@ -11,6 +11,7 @@ GaussMarkovFound checkGaussMarkov(std::span<const double> xc, const Context& c, 
   const std::vector<AllanPoint> clean_curve = deterministic_found ? allanDeviationTable(xc, c.tau0, c.ms) : curve;
   gm.clean_fit = deterministic_found ? fitNoiseTerms(clean_curve) : out.base_fit;
   std::vector<double> clean_var;
+  clean_var.reserve(clean_curve.size());
   for (const AllanPoint& p : clean_curve) clean_var.push_back(p.oadev * p.oadev);
   gm.fit = fitGaussMarkovToAllan(c.taus, clean_var, c.edf, c.t_grid);
   std::vector<double> null_values;

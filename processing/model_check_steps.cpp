@@ -66,6 +66,7 @@ LowFrequencyNulls lowFrequencyNulls(const std::vector<SeriesStats>& reps, double
   if (temp) n.temp = summarizeNull(column(reps, &SeriesStats::temp_slope), alpha, true);
   if (!steps) return n;
   std::vector<double> maxes;
+  maxes.reserve(reps.size());
   for (const SeriesStats& r : reps) maxes.push_back(r.step_stat);
   n.steps = summarizeNull(maxes, alpha, false);
   return n;

@@ -76,6 +76,7 @@ int runFilter(const FilterOptions& opt) {
   for (const auto& name : rec.axis_names) out += "," + name + "," + name + "_mean," + name + "_kalman";
   out += '\n';
   std::vector<AxisFilterChain> chains;
+  chains.reserve(params.size());
   for (const auto& p : params) chains.emplace_back(p);
   for (std::size_t i = 0; i < n; ++i) {
     appendNumber(out, rec.t.empty() ? static_cast<double>(i) * dt : rec.t[i]);
