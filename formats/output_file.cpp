@@ -119,6 +119,31 @@ void refuseInputAsOutput(const std::string& target, const std::string& replaced,
   }
 }
 
+// ---- the stream's sink: write(2) keeping the first error -------------------------------
+
+ssize_t sinkWrite(void* cookie, const char* bytes, std::size_t size) {
+  auto* sink = static_cast<OutputSink*>(cookie);
+  std::size_t done = 0;
+  while (done < size) {
+    const ssize_t n = ::write(sink->fd, bytes + done, size - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      if (sink->first_error == 0) sink->first_error = n < 0 ? errno : EIO;
+      return done > 0 ? static_cast<ssize_t>(done) : -1;
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  return static_cast<ssize_t>(done);
+}
+
+int sinkClose(void* cookie) {
+  auto* sink = static_cast<OutputSink*>(cookie);
+  const int rc = ::close(sink->fd);
+  if (rc != 0 && sink->first_error == 0) sink->first_error = errno;
+  sink->fd = -1;
+  return rc;
+}
+
 }  // namespace
 
 std::string fileTypeName(mode_t mode) {
@@ -184,13 +209,16 @@ AtomicOutputFile::AtomicOutputFile(const std::string& target, const std::vector<
       [[maybe_unused]] const int ignored = ::fchown(fd, static_cast<uid_t>(-1), existing.st_gid);
     }
   }
-  file_ = ::fdopen(fd, "wb");
+  sink_.fd = fd;
+  file_ = ::fopencookie(&sink_, "wb", cookie_io_functions_t{nullptr, sinkWrite, nullptr, sinkClose});
   if (!file_) {
     const int e = errno;
     ::close(fd);
+    sink_.fd = -1;
     discard();
     throw std::runtime_error(target_ + ": cannot write " + temp_ + ": " + errnoText(e));
   }
+  std::setvbuf(file_, nullptr, _IOFBF, std::size_t{1} << 16);  // fewer write(2) calls for long outputs
 }
 
 AtomicOutputFile::~AtomicOutputFile() { discard(); }
@@ -215,7 +243,7 @@ bool AtomicOutputFile::failed() const { return file_ == nullptr || std::ferror(f
 
 std::uint64_t AtomicOutputFile::availableBytes() const {
   struct statvfs fs {};
-  if (!file_ || ::fstatvfs(::fileno(file_), &fs) != 0)
+  if (sink_.fd < 0 || ::fstatvfs(sink_.fd, &fs) != 0)
     throw std::runtime_error(target_ + ": cannot read the free space of its filesystem: " + errnoText(errno));
   return static_cast<std::uint64_t>(fs.f_bavail) * static_cast<std::uint64_t>(fs.f_frsize);
 }
@@ -227,12 +255,13 @@ void AtomicOutputFile::commit() {
     throw std::runtime_error(target_ + ": " + what + ": " + errnoText(e) + " (the target is unchanged)");
   };
   errno = 0;
-  if (std::fflush(file_) != 0 || std::ferror(file_)) fail("write failed", errno ? errno : EIO);
+  if (std::fflush(file_) != 0 || std::ferror(file_))
+    fail("write failed", sink_.first_error ? sink_.first_error : errno ? errno : EIO);
   // EINVAL: a filesystem without fsync (e.g. some FUSE mounts); the rename still orders it.
-  if (::fsync(::fileno(file_)) != 0 && errno != EINVAL) fail("fsync failed", errno);
+  if (::fsync(sink_.fd) != 0 && errno != EINVAL) fail("fsync failed", errno);
   const int closed = std::fclose(file_);
   file_ = nullptr;
-  if (closed != 0) fail("close failed", errno);
+  if (closed != 0) fail("close failed", sink_.first_error ? sink_.first_error : errno);
   if (::rename(temp_.c_str(), replaced_.c_str()) != 0) fail("cannot rename " + temp_ + " onto it", errno);
   unregisterTempFile(registry_slot_);
   registry_slot_ = -1;

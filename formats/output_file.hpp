@@ -40,6 +40,13 @@ std::string fileTypeName(mode_t mode);
 // OutputTargetError, or std::runtime_error when the folder cannot be examined.
 std::string checkOutputTarget(const std::string& target, const std::vector<std::string>& inputs);
 
+// Where AtomicOutputFile's stream writes (fopencookie): the reason of the first failed write
+// (ENOSPC, EIO, ...) is kept for the message, where errno would have lost it.
+struct OutputSink {
+  int fd = -1;
+  int first_error = 0;
+};
+
 class AtomicOutputFile {
  public:
   // Checks the target (checkOutputTarget) and creates the temporary file beside it.
@@ -47,6 +54,8 @@ class AtomicOutputFile {
   ~AtomicOutputFile();  // removes the temporary file unless commit() succeeded
   AtomicOutputFile(const AtomicOutputFile&) = delete;
   AtomicOutputFile& operator=(const AtomicOutputFile&) = delete;
+  AtomicOutputFile(AtomicOutputFile&&) = delete;  // the stream points at sink_
+  AtomicOutputFile& operator=(AtomicOutputFile&&) = delete;
 
   std::FILE* stream() { return file_; }
   void write(std::string_view bytes);
@@ -66,6 +75,7 @@ class AtomicOutputFile {
   std::string target_;    // as the user gave it, for messages
   std::string replaced_;  // the path renamed onto (the link's target for a symbolic link)
   std::string temp_;
+  OutputSink sink_;
   std::FILE* file_ = nullptr;
   int registry_slot_ = -1;
 };

@@ -4,6 +4,7 @@
 #include "formats/output_file.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/mount.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -204,4 +205,52 @@ TEST_F(OutputFileTest, SigtermAndSigintRemoveTheTemporaryFile) {
     EXPECT_EQ(readAll(out), "precious\n");
     EXPECT_EQ(countStartingWith("out.csv.tmp-gyroctl"), 0u) << "signal " << sig;
   }
+}
+
+// ---- a full disk: a 64 KiB tmpfs where the test may mount one (root), skipped elsewhere ----
+
+namespace {
+
+class TinyFilesystem {
+ public:
+  explicit TinyFilesystem(const fs::path& dir) : dir_(dir) {
+    fs::create_directories(dir_);
+    mounted_ = ::mount("tmpfs", dir_.c_str(), "tmpfs", 0, "size=64k") == 0;
+  }
+  ~TinyFilesystem() {
+    if (mounted_) ::umount2(dir_.c_str(), MNT_DETACH);
+  }
+  TinyFilesystem(const TinyFilesystem&) = delete;
+  TinyFilesystem& operator=(const TinyFilesystem&) = delete;
+  bool mounted() const { return mounted_; }
+
+ private:
+  fs::path dir_;
+  bool mounted_ = false;
+};
+
+}  // namespace
+
+TEST_F(OutputFileTest, AFullDiskFailsTheCommitAndKeepsTheTarget) {
+  TinyFilesystem tiny(dir_ / "tiny");
+  if (!tiny.mounted()) GTEST_SKIP() << "cannot mount a tmpfs here (not root)";
+  const auto out = write("tiny/out.csv", "precious\n");
+  {
+    AtomicOutputFile f(out, {});
+    EXPECT_LT(f.availableBytes(), 70000u);
+    f.write(std::string(200000, 'x'));
+    try {
+      f.commit();
+      ADD_FAILURE() << "200 kB committed on a 64 KiB filesystem";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(out + ": write failed: No space left on device (the target is unchanged)"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_EQ(readAll(out), "precious\n");
+  std::size_t temps = 0;
+  for (const auto& e : fs::directory_iterator(dir_ / "tiny"))
+    if (e.path().filename().string().find(".tmp-gyroctl") != std::string::npos) ++temps;
+  EXPECT_EQ(temps, 0u);
 }

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/mount.h>
 #include <sys/stat.h>
 #include <sys/statvfs.h>
 #include <sys/wait.h>
@@ -331,4 +332,26 @@ TEST(GyroctlInputMessages, FilterNeedsEnoughSamplesToIdentifyTheFilter) {
   const auto enough = d.write("enough.csv", noiseCsv(100, 5));
   r = runGyroctl("filter " + enough.string() + " -o " + out.string(), d.path());
   EXPECT_EQ(r.exit_status, 0) << r.err;
+}
+
+// The same refusal against a real small filesystem, where the test may mount one (root).
+TEST(GyroctlOutputFiles, SimulateOnASmallFilesystem) {
+  ScratchDir d;
+  const auto tiny = d.path() / "tiny";
+  fs::create_directories(tiny);
+  if (::mount("tmpfs", tiny.c_str(), "tmpfs", 0, "size=64k") != 0) GTEST_SKIP() << "cannot mount a tmpfs here";
+  const auto out = tiny / "sim.csv";
+  // 100 s at 50 Hz: 5000 lines, up to 625 kB, on 64 KiB.
+  auto r = runGyroctl("simulate --arw 1 --duration 100 -o " + out.string(), d.path());
+  EXPECT_EQ(r.exit_status, 2) << r.err;
+  EXPECT_NE(r.err.find(out.string() + ": 5000 samples need up to 625 kB (125 bytes a line) but its filesystem has "),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_EQ(tempFilesIn(tiny), 0u);
+  // 2 s: 100 lines, up to 12.5 kB: written.
+  r = runGyroctl("simulate --arw 1 --duration 2 -o " + out.string(), d.path());
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(out));
+  ::umount2(tiny.c_str(), MNT_DETACH);
 }
