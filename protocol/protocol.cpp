@@ -1,9 +1,13 @@
 #include "protocol/protocol.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstring>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
 
 namespace gyrod::protocol {
 namespace {
@@ -128,6 +132,7 @@ std::string_view errorCodeName(ErrorCode code) {
     case ErrorCode::BadType: return "bad_type";
     case ErrorCode::UnknownCommand: return "unknown_cmd";
     case ErrorCode::UnknownField: return "unknown_field";
+    case ErrorCode::DuplicateField: return "duplicate_field";
     case ErrorCode::OutOfRange: return "out_of_range";
     case ErrorCode::LineTooLong: return "line_too_long";
     case ErrorCode::TooManyClients: return "too_many_clients";
@@ -245,8 +250,24 @@ std::string requestLine(const Request& request) {
 }
 
 Request parseRequest(std::string_view line) {
-  const json j = json::parse(line.begin(), line.end(), nullptr, /*allow_exceptions=*/false);
+  // JSON parsers keep the last of two equal keys; a request naming "cmd" twice is ambiguous,
+  // so the first repeated key of the request object is noted and the request refused.
+  std::vector<std::string> keys;
+  std::optional<std::string> duplicate;
+  const json::parser_callback_t noteDuplicateKeys = [&](int depth, json::parse_event_t event, json& parsed) {
+    if (event == json::parse_event_t::key && depth == 1 && !duplicate) {
+      const std::string& key = parsed.get_ref<const std::string&>();
+      if (std::find(keys.begin(), keys.end(), key) != keys.end())
+        duplicate = key;
+      else
+        keys.push_back(key);
+    }
+    return true;
+  };
+  const json j = json::parse(line.begin(), line.end(), noteDuplicateKeys, /*allow_exceptions=*/false);
   if (j.is_discarded()) throw ProtocolError(ErrorCode::NotJson, "the line is not valid JSON");
+  if (duplicate && j.is_object())
+    throw ProtocolError(ErrorCode::DuplicateField, "field \"" + *duplicate + "\" appears more than once");
   if (!j.is_object())
     throw ProtocolError(ErrorCode::NotObject, std::string("expected a JSON object, got ") + jsonTypeName(j));
   const auto cmd_it = j.find("cmd");

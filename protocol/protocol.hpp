@@ -79,6 +79,7 @@ enum class ErrorCode {
   BadType,         // a field has the wrong JSON type
   UnknownCommand,  // "cmd" names no command
   UnknownField,    // a field the command does not take (catches typos)
+  DuplicateField,  // a field given twice ({"cmd":"watch","cmd":"status"}): which one was meant?
   OutOfRange,      // a number outside its range (decimate)
   LineTooLong,     // over kMaxRequestLineBytes; the client is then disconnected
   TooManyClients,  // the server is full; the client is then disconnected

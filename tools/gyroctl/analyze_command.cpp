@@ -9,6 +9,7 @@
 #include <string>
 
 #include "formats/model_toml.hpp"
+#include "formats/output_file.hpp"
 #include "processing/axis_analysis.hpp"
 #include "processing/noise_terms.hpp"
 #include "tools/gyroctl/commands.hpp"
@@ -218,6 +219,8 @@ void printAxisText(std::ostream& o, const std::string& name, const AxisAnalysis&
 }
 
 int runAnalyze(const AnalyzeOptions& opt) {
+  // A target that cannot be written fails now, not after the analysis.
+  if (!opt.write_model.empty()) formats::checkOutputTarget(opt.write_model, {opt.file});
   LoadedInput in = loadInput(opt.file, opt.rate_hz, opt.axis);
   const auto& rec = in.recording;
   if (rec.size() < kMinimumSamples) {
@@ -267,7 +270,7 @@ int runAnalyze(const AnalyzeOptions& opt) {
       printAxisText(std::cout, rec.axis_names[idx], a);
   }
   if (!opt.write_model.empty()) {
-    writeFileAtomically(opt.write_model, recording::modelToToml(model));
+    formats::writeFileAtomically(opt.write_model, recording::modelToToml(model), {opt.file});
     if (!opt.json) std::printf("\nModel written to %s\n", opt.write_model.c_str());
   }
   if (opt.json) std::cout << doc.dump(1) << '\n';

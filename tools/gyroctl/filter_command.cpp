@@ -6,6 +6,7 @@
 #include <sstream>
 #include <string>
 
+#include "formats/output_file.hpp"
 #include "processing/detrend.hpp"
 #include "processing/filter_chain.hpp"
 #include "tools/gyroctl/commands.hpp"
@@ -27,6 +28,12 @@ struct FilterOptions {
   std::vector<double> bias_dps;  // --bias: subtract these constants instead of detrending
 };
 
+// Identifying the Kalman filter from the file (the AR(1) fit of the mean-filtered series and
+// the residual variance) needs as many samples as analyze's tables: from fewer, A, Q and R are
+// noise. With --ar-phi, --kalman-q and --kalman-r all given nothing is identified, and the
+// chain runs sample by sample as gyrod does, on any number of samples.
+constexpr std::size_t kMinSamplesToIdentify = 100;
+
 // 17 significant digits: every double survives the text round trip exactly.
 void appendNumber(std::string& out, double v) {
   char buf[32];
@@ -38,6 +45,7 @@ int runFilter(const FilterOptions& opt) {
   if (opt.kalman_q && !(*opt.kalman_q >= 0.0)) throw std::invalid_argument("--kalman-q must be >= 0");
   if (opt.kalman_r && !(*opt.kalman_r >= 0.0)) throw std::invalid_argument("--kalman-r must be >= 0");
   if (opt.ar_phi && !std::isfinite(*opt.ar_phi)) throw std::invalid_argument("--ar-phi must be a finite number");
+  formats::checkOutputTarget(opt.output, {opt.file});  // before the work, and again when writing
   LoadedInput in = loadInput(opt.file, opt.rate_hz, "all");
   const auto& rec = in.recording;
   if (!opt.bias_dps.empty() && opt.bias_dps.size() != rec.axes.size()) {
@@ -50,6 +58,13 @@ int runFilter(const FilterOptions& opt) {
     if (!std::isfinite(b)) throw std::invalid_argument("--bias values must be finite numbers");
   const std::size_t n = rec.size();
   const double dt = 1.0 / in.rate_hz;
+  const bool identifies = !(opt.ar_phi && opt.kalman_q && opt.kalman_r);
+  if (identifies && n < kMinSamplesToIdentify) {
+    std::ostringstream s;
+    s << opt.file << ": " << n << " samples are too few to identify the filter (need at least " << kMinSamplesToIdentify
+      << ", or give --ar-phi, --kalman-q and --kalman-r)";
+    throw recording::RecordingError(s.str());
+  }
 
   std::vector<std::vector<double>> chain_input;
   std::vector<FilterChainParameters> params;
@@ -92,7 +107,7 @@ int runFilter(const FilterOptions& opt) {
     }
     out += '\n';
   }
-  writeFileAtomically(opt.output, out);
+  formats::writeFileAtomically(opt.output, out, {opt.file});
 
   for (std::size_t axis = 0; axis < params.size(); ++axis) {
     const auto& k = params[axis].kalman;

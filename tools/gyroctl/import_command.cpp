@@ -4,14 +4,17 @@
 // Arduino). Header lines "Fs,<Hz>", "Logging Type,<n>", "Initialization time,<s>",
 // "Waiting time,<s>", then the column names (ax,ay,az,gx,gy,gz), then one line per
 // sample of raw signed 16-bit counts. No timestamps: t = i / Fs (the chip's sample clock).
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "formats/output_file.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
 
@@ -59,8 +62,10 @@ bool parseLong(const std::string& s, long& v) {
 }
 
 int runImport(const ImportOptions& opt) {
+  formats::checkOutputTarget(opt.output, {opt.file});  // before the work, and again when writing
+  requireNotADirectory(opt.file);
   std::ifstream in(opt.file);
-  if (!in) throw recording::RecordingError(opt.file + ": cannot open");
+  if (!in) throw recording::RecordingError(opt.file + ": cannot open: " + std::strerror(errno));
   std::string line;
   std::size_t line_no = 0;
   auto next = [&]() -> bool {
@@ -132,7 +137,7 @@ int runImport(const ImportOptions& opt) {
     ++samples;
   }
   if (samples == 0) fail(opt.file, line_no, "no samples after the header");
-  writeFileAtomically(opt.output, out);
+  formats::writeFileAtomically(opt.output, out, {opt.file});
   std::fprintf(stderr, "imported %zu samples at %g Hz (FS_SEL %d, %g LSB per deg/s) into %s\n", samples, fs, opt.fs_sel,
                lsb, opt.output.c_str());
   return kExitOk;

@@ -1,11 +1,11 @@
 #include "tools/gyroctl/input.hpp"
 
-#include <unistd.h>
+#include <sys/stat.h>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
@@ -18,6 +18,7 @@ LoadedInput loadInput(const std::string& path, std::optional<double> rate_hz, co
     s << "--rate " << *rate_hz << ": the sample rate must be a positive number of Hz";
     throw std::invalid_argument(s.str());
   }
+  requireNotADirectory(path);
   in.recording = recording::readRecordingCsv(path);
   const auto& rec = in.recording;
   if (!rec.t.empty()) {
@@ -56,23 +57,10 @@ LoadedInput loadInput(const std::string& path, std::optional<double> rate_hz, co
   return in;
 }
 
-void writeFileAtomically(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::runtime_error(path + ": cannot write: " + std::strerror(errno));
-    out << text;
-    out.flush();
-    if (!out) {
-      std::remove(tmp.c_str());
-      throw std::runtime_error(path + ": write failed: " + std::strerror(errno));
-    }
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const int e = errno;
-    std::remove(tmp.c_str());
-    throw std::runtime_error(path + ": cannot replace: " + std::strerror(e));
-  }
+void requireNotADirectory(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
+    throw recording::RecordingError(path + ": cannot read: it is a directory, not a file");
 }
 
 }  // namespace gyrod::gyroctl

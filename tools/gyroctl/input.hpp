@@ -19,8 +19,8 @@ struct LoadedInput {
 // axis: "all" or a column name. Throws RecordingError naming the file and the problem.
 LoadedInput loadInput(const std::string& path, std::optional<double> rate_hz, const std::string& axis);
 
-// Writes `text` to `path` through a temporary file in the same folder and a rename, so
-// an existing file is replaced only by a complete one. Throws std::runtime_error.
-void writeFileAtomically(const std::string& path, const std::string& text);
+// Refuses a directory as an input file, saying so (reading one would look like an empty
+// file). FIFOs and devices stay readable: `analyze /dev/stdin` works.
+void requireNotADirectory(const std::string& path);
 
 }  // namespace gyrod::gyroctl

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "formats/model_toml.hpp"
+#include "formats/output_file.hpp"
 #include "processing/model_check.hpp"
 #include "processing/noise_terms.hpp"
 #include "processing/warm_up_fit.hpp"
@@ -213,7 +214,10 @@ void printAxisText(std::ostream& o, const std::string& name, const AxisModelChec
 
 // ---- report ----------------------------------------------------------------------------
 
-void writeText(const std::filesystem::path& p, const std::string& text) { writeFileAtomically(p.string(), text); }
+// `input`: the recording checked, which no report file may overwrite.
+void writeText(const std::filesystem::path& p, const std::string& text, const std::string& input) {
+  formats::writeFileAtomically(p.string(), text, {input});
+}
 
 bool gnuplotInstalled() { return std::system("command -v gnuplot >/dev/null 2>&1") == 0; }
 
@@ -225,7 +229,7 @@ std::string shellQuoted(const std::filesystem::path& p) {
 
 // Data files and gnuplot scripts for one axis; returns the plots made (file names).
 std::vector<std::string> writeAxisPlots(const std::filesystem::path& dir, const std::string& name,
-                                        const AxisModelCheck& r, bool run_gnuplot) {
+                                        const AxisModelCheck& r, bool run_gnuplot, const std::string& input) {
   std::vector<std::string> made;
   {
     std::ostringstream d;
@@ -234,7 +238,7 @@ std::vector<std::string> writeAxisPlots(const std::filesystem::path& dir, const 
       d << r.allan_base.tau_s[j] << ' ' << r.allan_base.measured[j] << ' ' << r.allan_base.median[j] << ' '
         << r.allan_base.lo[j] << ' ' << r.allan_base.hi[j] << ' ' << r.allan_extended.median[j] << ' '
         << r.allan_extended.lo[j] << ' ' << r.allan_extended.hi[j] << '\n';
-    writeText(dir / ("allan_" + name + ".dat"), d.str());
+    writeText(dir / ("allan_" + name + ".dat"), d.str(), input);
     std::ostringstream g;
     g << "set terminal pngcairo size 900,600\nset output 'allan_" << name << ".png'\n"
       << "set logscale xy\nset grid\nset xlabel 'tau [s]'\nset ylabel 'Allan deviation [deg/s]'\n"
@@ -244,7 +248,7 @@ std::vector<std::string> writeAxisPlots(const std::filesystem::path& dir, const 
       << "'' u 1:7:8 w filledcurves lc rgb '#ffc080' fs transparent solid 0.5 t 'extended 90 %', "
       << "'' u 1:3 w l lc rgb 'blue' dt 2 t 'base median', '' u 1:6 w l lc rgb '#d06000' dt 2 t 'extended median', "
       << "'' u 1:2 w lp pt 7 ps 0.6 lc rgb 'black' t 'measured'\n";
-    writeText(dir / ("allan_" + name + ".gp"), g.str());
+    writeText(dir / ("allan_" + name + ".gp"), g.str(), input);
     made.push_back("allan_" + name + ".png");
   }
   {
@@ -254,7 +258,7 @@ std::vector<std::string> writeAxisPlots(const std::filesystem::path& dir, const 
       if (std::isfinite(r.spectrum_measured[j]) && std::isfinite(r.spectrum_base_median[j]))
         d << r.spectrum_freq_hz[j] << ' ' << r.spectrum_measured[j] << ' ' << r.spectrum_base_median[j] << ' '
           << r.spectrum_measured_peak[j] << '\n';
-    writeText(dir / ("spectrum_" + name + ".dat"), d.str());
+    writeText(dir / ("spectrum_" + name + ".dat"), d.str(), input);
     std::ostringstream g;
     g << "set terminal pngcairo size 900,600\nset output 'spectrum_" << name << ".png'\n"
       << "set logscale xy\nset grid\nset xlabel 'frequency [Hz]'\nset ylabel 'PSD [(deg/s)^2/Hz]'\n"
@@ -262,7 +266,7 @@ std::vector<std::string> writeAxisPlots(const std::filesystem::path& dir, const 
       << "plot 'spectrum_" << name << ".dat' u 1:4 w l lc rgb '#a0a0a0' t 'measured, largest bin of each band', "
       << "'' u 1:2 w lp pt 7 ps 0.5 lc rgb 'black' t 'measured (band average)', "
       << "'' u 1:3 w l lc rgb 'blue' t 'base model (median of replicas)'\n";
-    writeText(dir / ("spectrum_" + name + ".gp"), g.str());
+    writeText(dir / ("spectrum_" + name + ".gp"), g.str(), input);
     made.push_back("spectrum_" + name + ".png");
   }
   if (!r.block_temperature_c.empty()) {
@@ -270,13 +274,13 @@ std::vector<std::string> writeAxisPlots(const std::filesystem::path& dir, const 
     d << "# temperature_c low_passed_residual_dps (block means)\n";
     for (std::size_t j = 0; j < r.block_temperature_c.size(); ++j)
       d << r.block_temperature_c[j] << ' ' << r.block_residual_dps[j] << '\n';
-    writeText(dir / ("temperature_" + name + ".dat"), d.str());
+    writeText(dir / ("temperature_" + name + ".dat"), d.str(), input);
     std::ostringstream g;
     g << "set terminal pngcairo size 900,600\nset output 'temperature_" << name << ".png'\n"
       << "set grid\nset xlabel 'temperature [C]'\nset ylabel 'low-passed residual [deg/s]'\n"
       << "set title 'Residual (detrended, block means) against temperature, " << name << "'\n"
       << "plot 'temperature_" << name << ".dat' u 1:2 w p pt 7 ps 0.3 lc rgb 'black' notitle\n";
-    writeText(dir / ("temperature_" + name + ".gp"), g.str());
+    writeText(dir / ("temperature_" + name + ".gp"), g.str(), input);
     made.push_back("temperature_" + name + ".png");
   }
   if (run_gnuplot) {
@@ -330,16 +334,17 @@ void writeReport(const std::string& dir_text, const ModelCheckCliOptions& opt, c
       md << "- " << s.name << ": " << fmt("%.4g", s.value) << " (null median " << fmt("%.4g", s.null_median)
          << ", threshold " << fmt("%.4g", s.threshold) << ")" << (s.fired ? " **fired**" : "") << "\n";
     md << "\n";
-    for (const std::string& png : writeAxisPlots(dir, name, r, plots)) md << "![" << png << "](" << png << ")\n";
+    for (const std::string& png : writeAxisPlots(dir, name, r, plots, opt.file))
+      md << "![" << png << "](" << png << ")\n";
   }
-  writeText(dir / "report.md", md.str());
+  writeText(dir / "report.md", md.str(), opt.file);
 }
 
 // ---- --write-model: the extended model as a simulation model file -----------------------
 
 // Fails before the check runs (it can take minutes) when OUT cannot be written; the
 // file itself is written atomically at the end.
-void requireWritableTarget(const std::string& path) {
+void requireWritableTarget(const std::string& path, const std::string& input) {
   const std::filesystem::path p(path);
   std::error_code ec;
   if (std::filesystem::is_directory(p, ec)) throw std::runtime_error(path + ": cannot write the model: it is a folder");
@@ -347,6 +352,7 @@ void requireWritableTarget(const std::string& path) {
   if (!std::filesystem::is_directory(folder, ec))
     throw std::runtime_error(path + ": cannot write the model: " + folder.string() +
                              (std::filesystem::exists(folder, ec) ? " is not a folder" : ": folder does not exist"));
+  formats::checkOutputTarget(path, {input});  // a FIFO, a device, the input itself
   if (::access(folder.c_str(), W_OK) != 0)
     throw std::runtime_error(path + ": cannot write the model in " + folder.string() + ": " + std::strerror(errno));
 }
@@ -465,7 +471,7 @@ std::string extendedModelToml(const ModelCheckCliOptions& opt, const LoadedInput
 
 int runModelCheck(const ModelCheckCliOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
-  if (!opt.write_model.empty()) requireWritableTarget(opt.write_model);
+  if (!opt.write_model.empty()) requireWritableTarget(opt.write_model, opt.file);
   const LoadedInput in = loadInput(opt.file, opt.rate_hz, opt.axis);
   const auto& rec = in.recording;
   if (rec.size() < kModelCheckMinSamples) {
@@ -507,7 +513,7 @@ int runModelCheck(const ModelCheckCliOptions& opt) {
     if (!opt.json) std::printf("report written to %s/report.md\n", opt.report_dir.c_str());
   }
   if (!opt.write_model.empty()) {
-    writeFileAtomically(opt.write_model, extendedModelToml(opt, in, results));
+    formats::writeFileAtomically(opt.write_model, extendedModelToml(opt, in, results), {opt.file});
     if (!opt.json) std::printf("extended model written to %s\n", opt.write_model.c_str());
   }
   return kExitOk;

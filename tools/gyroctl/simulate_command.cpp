@@ -1,15 +1,16 @@
 // gyroctl simulate: a recording of the simulated gyro at rest (docs/simulator.md), as the
 // CSV that analyze/filter read: t,gx,gy,gz,temp.
-#include <cerrno>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
+#include <iterator>
 #include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
 
 #include "formats/model_toml.hpp"
+#include "formats/output_file.hpp"
 #include "processing/noise_simulator.hpp"
 #include "tools/gyroctl/commands.hpp"
 
@@ -28,43 +29,45 @@ struct SimulateOptions {
   std::string output;
 };
 
-// Writes through a temporary file in the same folder and a rename, streaming: the
-// recording is never held in memory, and an existing OUT is replaced only by a complete one.
-class AtomicOutput {
- public:
-  explicit AtomicOutput(const std::string& path) : path_(path), temp_(path + ".tmp-gyroctl") {
-    file_ = std::fopen(temp_.c_str(), "wb");
-    if (!file_) throw std::runtime_error(temp_ + ": cannot create: " + std::strerror(errno));
-  }
-  ~AtomicOutput() {
-    if (file_) {
-      std::fclose(file_);
-      std::remove(temp_.c_str());
-    }
-  }
-  AtomicOutput(const AtomicOutput&) = delete;
-  AtomicOutput& operator=(const AtomicOutput&) = delete;
-  std::FILE* get() { return file_; }
-  void commit() {
-    const bool write_failed = std::ferror(file_) != 0;
-    const bool close_failed = std::fclose(file_) != 0;
-    file_ = nullptr;
-    if (write_failed || close_failed) {
-      std::remove(temp_.c_str());
-      throw std::runtime_error(path_ + ": write failed");
-    }
-    std::error_code ec;
-    std::filesystem::rename(temp_, path_, ec);
-    if (ec) {
-      std::remove(temp_.c_str());
-      throw std::runtime_error(path_ + ": cannot replace: " + ec.message());
-    }
-  }
+// The bound on what simulate writes (README "gyroctl simulate"): at most this long, and
+// never more than the target's filesystem has free, so a mistyped --duration cannot fill a disk.
+constexpr double kMaxSimulateDurationS = 1e7;  // about 116 days
+// A line is five %.17g numbers: each at most 24 characters ("-1.2345678901234567e-308"),
+// four commas and a newline. The estimate is an upper bound, real lines are a little shorter.
+constexpr std::uint64_t kMaxSimulateLineBytes = 5 * 24 + 5;
+constexpr std::size_t kSamplesBetweenWriteChecks = 1 << 16;
 
- private:
-  std::string path_, temp_;
-  std::FILE* file_ = nullptr;
-};
+std::string byteCount(double bytes) {
+  const char* units[] = {"bytes", "kB", "MB", "GB", "TB", "PB", "EB"};
+  std::size_t u = 0;
+  while (bytes >= 1000.0 && u + 1 < std::size(units)) {
+    bytes /= 1000.0;
+    ++u;
+  }
+  char buf[48];
+  std::snprintf(buf, sizeof buf, u == 0 ? "%.0f %s" : "%.3g %s", bytes, units[u]);
+  return buf;
+}
+
+void requireDurationWithinBound(double duration_s) {
+  if (duration_s > kMaxSimulateDurationS) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "--duration %g s is longer than simulate writes (at most %g s)", duration_s,
+                  kMaxSimulateDurationS);
+    throw std::invalid_argument(buf);
+  }
+}
+
+// Refuses before writing when the recording cannot fit on the target's filesystem.
+void requireRoomFor(std::size_t samples, const formats::AtomicOutputFile& out) {
+  const double needed = static_cast<double>(samples) * static_cast<double>(kMaxSimulateLineBytes) + 64.0;
+  const std::uint64_t available = out.availableBytes();
+  if (needed > static_cast<double>(available))
+    throw std::invalid_argument(out.target() + ": " + std::to_string(samples) + " samples need up to " +
+                                byteCount(needed) + " (" + std::to_string(kMaxSimulateLineBytes) +
+                                " bytes a line) but its filesystem has " + byteCount(static_cast<double>(available)) +
+                                " free");
+}
 
 int runSimulate(const SimulateOptions& opt) {
   SimulationModel model;
@@ -85,12 +88,16 @@ int runSimulate(const SimulateOptions& opt) {
   if (opt.dlpf) model.dlpf_cfg = *opt.dlpf;
   if (opt.fs_sel) model.fs_sel = *opt.fs_sel;
 
+  requireDurationWithinBound(opt.duration_s);
   NoiseSimulator sim(model, opt.duration_s, opt.seed);  // validates; std::invalid_argument → exit 2
-  AtomicOutput out(opt.output);
-  std::FILE* f = out.get();
-  std::fputs("t,gx,gy,gz,temp\n", f);
+  formats::AtomicOutputFile out(opt.output, {opt.model_file});
   const std::size_t n = sim.sampleCount();
+  requireRoomFor(n, out);
+  std::FILE* f = out.stream();
+  std::fputs("t,gx,gy,gz,temp\n", f);
   for (std::size_t i = 0; i < n; ++i) {
+    // Stop at the first failed write (a full disk) instead of computing the rest.
+    if (i % kSamplesBetweenWriteChecks == 0 && out.failed()) break;
     const SimulatedSample s = sim.next();
     // 17 significant digits: every double survives the text round trip exactly.
     std::fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g\n", s.t_s, s.rate_dps[0], s.rate_dps[1], s.rate_dps[2],
@@ -118,7 +125,9 @@ void addSimulateCommand(CLI::App& app, CommandRunner& run) {
   auto* k = terms->add_option("--rrw", opt->rrw, "rate random walk K [deg/h^1.5]");
   auto* r = terms->add_option("--rate-ramp", opt->rate_ramp, "rate ramp R [deg/h^2]");
   for (CLI::Option* o : {q, n, b, k, r}) o->excludes(model);
-  sub->add_option("--duration", opt->duration_s, "length [s]")->required()->check(CLI::PositiveNumber);
+  sub->add_option("--duration", opt->duration_s, "length [s], at most 1e7 and what fits on the target's disk")
+      ->required()
+      ->check(CLI::PositiveNumber);
   sub->add_option("--rate", opt->rate_hz, "output rate [Hz] (default: the model file's, else 50)");
   sub->add_option("--seed", opt->seed, "random seed (same seed, same file on every machine)")->default_val(1);
   sub->add_option("--dlpf", opt->dlpf, "DLPF_CFG 0..6 (default: the model file's, else no DLPF)");
