@@ -80,6 +80,9 @@ std::optional<ListeningSocket> adoptActivatedSocket(std::string_view name = kAct
 // Socket activation if systemd passed a socket, otherwise bindListeningSocket(options).
 ListeningSocket openListeningSocket(const SocketOptions& options);
 
+// O_NONBLOCK and FD_CLOEXEC on `fd`; throws std::system_error.
+void setNonBlockingCloseOnExec(int fd);
+
 // What the daemon answers to "allan" and "status". Not on the per-sample path: may
 // allocate. An exception thrown here becomes an ERROR "internal" line for that client.
 class ServerContent {
