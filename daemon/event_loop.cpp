@@ -177,10 +177,10 @@ std::size_t EventLoop::runOnce(std::chrono::milliseconds timeout) {
     throw errnoError("epoll_wait");
   }
   const auto turn_start = std::chrono::steady_clock::now();
+  // Taken before the events are dispatched: what they defer waits for the next turn.
+  running_deferred_.swap(deferred_);
   for (int i = 0; i < n; ++i)
     dispatch(events_[static_cast<std::size_t>(i)].data.u64, events_[static_cast<std::size_t>(i)].events);
-  // Swapped out first, so that work deferred by these callbacks waits for the next turn.
-  running_deferred_.swap(deferred_);
   for (auto& callback : running_deferred_) callback();
   running_deferred_.clear();
   longest_turn_ =

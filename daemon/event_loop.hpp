@@ -73,7 +73,7 @@ class EventLoop {
 
   // ---- deferred work -----------------------------------------------------------------
   // Runs `callback` once, after the events of the next turn (the wait of that turn does not
-  // block). Callbacks deferred while deferred callbacks run go to the turn after.
+  // block). What is deferred during a turn never runs in that same turn.
   void defer(std::function<void()> callback);
 
   // ---- running -----------------------------------------------------------------------
