@@ -1,5 +1,7 @@
 #include "daemon/noise_refit_worker.hpp"
 
+#include <pthread.h>
+#include <sched.h>
 #include <spdlog/spdlog.h>
 #include <sys/eventfd.h>
 #include <unistd.h>
@@ -68,6 +70,10 @@ void NoiseRefitWorker::onAxisDone() {
 }
 
 void NoiseRefitWorker::threadMain() {
+  // Seconds of arithmetic must never compete with the loop: when gyrod runs SCHED_FIFO, a
+  // thread of the same priority would keep the loop off a single CPU until it finished.
+  const sched_param normal{};
+  ::pthread_setschedparam(::pthread_self(), SCHED_OTHER, &normal);
   std::unique_lock lock(mutex_);
   while (true) {
     wake_.wait(lock, [this] { return work_ || stop_; });
