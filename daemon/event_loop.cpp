@@ -4,6 +4,7 @@
 #include <sys/signalfd.h>
 #include <sys/timerfd.h>
 
+#include <algorithm>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -162,15 +163,29 @@ void EventLoop::dispatch(SourceId id, std::uint32_t events) {
   }
 }
 
+void EventLoop::defer(std::function<void()> callback) {
+  if (!callback) throw std::invalid_argument("EventLoop::defer: empty callback");
+  deferred_.push_back(std::move(callback));
+}
+
 std::size_t EventLoop::runOnce(std::chrono::milliseconds timeout) {
-  const int timeout_ms = timeout.count() < 0 ? -1 : static_cast<int>(timeout.count());
+  int timeout_ms = timeout.count() < 0 ? -1 : static_cast<int>(timeout.count());
+  if (!deferred_.empty()) timeout_ms = 0;
   const int n = ::epoll_wait(epoll_.get(), events_.data(), static_cast<int>(events_.size()), timeout_ms);
   if (n < 0) {
     if (errno == EINTR) return 0;
     throw errnoError("epoll_wait");
   }
+  const auto turn_start = std::chrono::steady_clock::now();
+  // Taken before the events are dispatched: what they defer waits for the next turn.
+  running_deferred_.swap(deferred_);
   for (int i = 0; i < n; ++i)
     dispatch(events_[static_cast<std::size_t>(i)].data.u64, events_[static_cast<std::size_t>(i)].events);
+  for (auto& callback : running_deferred_) callback();
+  running_deferred_.clear();
+  longest_turn_ =
+      std::max(longest_turn_,
+               std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - turn_start));
   return static_cast<std::size_t>(n);
 }
 

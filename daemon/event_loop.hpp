@@ -10,6 +10,9 @@
 // while the loop is dispatching: an event for a source removed earlier in the same batch is
 // not delivered. The loop owns the timerfds and signalfds it creates; it never owns an fd
 // passed to addFd (that stays with the caller's protocol::Fd).
+// Deferred work (defer): a source that has more to do than one turn should take (a client
+// with a backlog of requests) does a bounded share and asks to be called again after the
+// events of the next turn, whose wait then does not block.
 // Exceptions thrown by a callback propagate out of run()/runOnce(): sources that must not
 // stop the daemon (clients) handle their own errors.
 #include <sys/epoll.h>
@@ -68,6 +71,11 @@ class EventLoop {
   // Blocks `signals` (as above) and delivers them through a signalfd to `callback`.
   SourceId addSignals(std::initializer_list<int> signals, SignalCallback callback);
 
+  // ---- deferred work -----------------------------------------------------------------
+  // Runs `callback` once, after the events of the next turn (the wait of that turn does not
+  // block). What is deferred during a turn never runs in that same turn.
+  void defer(std::function<void()> callback);
+
   // ---- running -----------------------------------------------------------------------
   // Dispatches events until stop() is called (by a callback). EINTR is retried.
   void run();
@@ -76,6 +84,9 @@ class EventLoop {
   std::size_t runOnce(std::chrono::milliseconds timeout);
   void stop() noexcept { stopped_ = true; }
   bool stopped() const noexcept { return stopped_; }
+  // The longest time one turn spent dispatching (events and deferred work, not the wait):
+  // how long a sample could have waited for the loop.
+  std::chrono::nanoseconds longestTurn() const noexcept { return longest_turn_; }
 
  private:
   enum class Kind { Fd, Timer, Signal };
@@ -100,6 +111,8 @@ class EventLoop {
   std::unordered_map<SourceId, std::shared_ptr<Source>> sources_;
   std::unordered_map<int, SourceId> fd_sources_;  // only Kind::Fd sources
   std::vector<epoll_event> events_;
+  std::vector<std::function<void()>> deferred_, running_deferred_;
+  std::chrono::nanoseconds longest_turn_{0};
 };
 
 }  // namespace gyrod::daemon

@@ -94,7 +94,9 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
     : config_(config),
       config_file_(std::move(config_file)),
       device_(makeDeviceParts(config)),
-      pipeline_(pipelineSettings(config)) {
+      pipeline_(pipelineSettings(config)),
+      noise_refit_(loop_, pipeline_, config.device.rate_hz, [this] { allan_reply_.invalidate(); }),
+      allan_reply_([this] { return allanReport(); }) {
   start_real_ns_ = monotonicNowNs();
   last_pump_real_ns_ = start_real_ns_;
 
@@ -146,7 +148,9 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
 
   const auto refit = std::chrono::duration_cast<std::chrono::nanoseconds>(
       std::chrono::duration<double>(config_.allan.refit_interval_s));
-  loop_.addPeriodicTimer(refit, [this](std::uint64_t) { pipeline_.refitNoiseTerms(); });
+  // The refit runs off the loop (daemon/noise_refit_worker.hpp); the ALLAN reply is cached
+  // between refits (daemon/allan_reply_cache.hpp), so no client request waits on either.
+  loop_.addPeriodicTimer(refit, [this](std::uint64_t) { noise_refit_.startCycle(); });
 
   if (::sd_watchdog_enabled(0, &watchdog_usec_) > 0 && watchdog_usec_ > 0) {
     loop_.addPeriodicTimer(std::chrono::microseconds(watchdog_usec_ / 2), [this](std::uint64_t) { petWatchdog(); });
@@ -173,7 +177,9 @@ int Gyrod::run() {
   loop_.run();
   ::sd_notify(0, "STOPPING=1");
   if (recorder_) recorder_->stop();
-  spdlog::info("stopped after {} samples, {} gaps ({} samples lost)", samples_published_, gaps_, missing_samples_);
+  spdlog::info("stopped after {} samples, {} gaps ({} samples lost); longest loop turn {} us", samples_published_,
+               gaps_, missing_samples_,
+               std::chrono::duration_cast<std::chrono::microseconds>(loop_.longestTurn()).count());
   return 0;
 }
 
@@ -299,18 +305,15 @@ void Gyrod::reload() {
 }
 
 AllanReport Gyrod::allanReport() {
-  const AllanStreams s = pipeline_.allanSnapshot();
+  AllanWindowDeviations d = pipeline_.allanWindowDeviations();
   AllanReport report;
-  report.tau0_s = s.tau0_s;
-  report.window_s = s.window_s;
-  for (const auto& p : s.raw[0].window) report.tau_s.push_back(p.tau_s);
+  report.tau0_s = d.tau0_s;
+  report.window_s = d.window_s;
+  report.tau_s = std::move(d.tau_s);
   report.samples = std::min<std::uint64_t>(pipeline_.samplesProcessed(),
-                                           static_cast<std::uint64_t>(std::llround(s.window_s / s.tau0_s)));
+                                           static_cast<std::uint64_t>(std::llround(d.window_s / d.tau0_s)));
   for (std::size_t axis = 0; axis < kAxes; ++axis) {
-    const std::array<const processing::RollingOverlappingAllan::Snapshot*, 3> streams = {&s.raw[axis], &s.mean[axis],
-                                                                                         &s.kalman[axis]};
-    for (std::size_t k = 0; k < 3; ++k)
-      for (const auto& p : streams[k]->window) report.curves[axis][k].adev_dps.push_back(p.oadev);
+    for (std::size_t k = 0; k < 3; ++k) report.curves[axis][k].adev_dps = std::move(d.oadev[axis][k]);
     if (const auto& fit = pipeline_.noiseTerms()[axis]) report.curves[axis][0].noise = fit->value;
   }
   return report;

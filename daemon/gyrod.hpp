@@ -10,9 +10,11 @@
 #include <optional>
 #include <string>
 
+#include "daemon/allan_reply_cache.hpp"
 #include "daemon/config.hpp"
 #include "daemon/device_backend.hpp"
 #include "daemon/event_loop.hpp"
+#include "daemon/noise_refit_worker.hpp"
 #include "daemon/recorder.hpp"
 #include "daemon/sample_pipeline.hpp"
 #include "daemon/unix_socket_server.hpp"
@@ -38,6 +40,7 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   void onStatus(const driver::DeviceStatus& status) override;
   // ServerContent
   AllanReport allanReport() override;
+  std::string allanReplyLine() override { return allan_reply_.line(); }
   StatusReport statusReport() override;
 
  private:
@@ -55,6 +58,8 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   DeviceParts device_;
   std::unique_ptr<driver::Mpu6050Driver> driver_;
   SamplePipeline pipeline_;
+  NoiseRefitWorker noise_refit_;
+  AllanReplyCache allan_reply_;
   std::unique_ptr<UnixSocketServer> server_;
   std::unique_ptr<Recorder> recorder_;
   Fd driver_timer_;  // absolute CLOCK_MONOTONIC deadline of the driver (real-time clocks)

@@ -180,19 +180,44 @@ AllanStreams SamplePipeline::allanSnapshot() const {
   return s;
 }
 
+AllanWindowDeviations SamplePipeline::allanWindowDeviations() const {
+  AllanWindowDeviations d;
+  d.tau0_s = 1.0 / settings_.rate_hz;
+  d.window_s = static_cast<double>(settings_.allan_window_samples) / settings_.rate_hz;
+  for (const std::size_t m : allan_raw_[0].clusterSizes()) d.tau_s.push_back(static_cast<double>(m) * d.tau0_s);
+  for (std::size_t axis = 0; axis < kAxes; ++axis) {
+    const std::array<const RollingOverlappingAllan*, 3> streams = {&allan_raw_[axis], &allan_mean_[axis],
+                                                                   &allan_kalman_[axis]};
+    for (std::size_t k = 0; k < 3; ++k)
+      for (std::size_t i = 0; i < d.tau_s.size(); ++i)
+        d.oadev[axis][k].push_back(std::sqrt(streams[k]->windowVariance(i)));
+  }
+  return d;
+}
+
+NoiseRefit refitNoiseTerms(const RollingOverlappingAllan& raw_stream, double tau0_s) {
+  NoiseRefit refit;
+  const auto snap = raw_stream.snapshot(tau0_s);
+  std::size_t usable = 0;
+  for (const auto& p : snap.window) usable += (p.oadev_terms >= 2 && std::isfinite(p.oadev)) ? 1 : 0;
+  if (usable < 3) return refit;  // too early for a fit of five terms to mean anything
+  refit.too_early = false;
+  try {
+    refit.fit = processing::fitNoiseTerms(snap.window);
+  } catch (const std::exception&) {
+    // e.g. a constant signal: nothing to fit
+  }
+  return refit;
+}
+
+void SamplePipeline::applyNoiseRefit(std::size_t axis, const NoiseRefit& refit) {
+  if (!refit.too_early) noise_terms_.at(axis) = refit.fit;
+}
+
 void SamplePipeline::refitNoiseTerms() {
   const double tau0 = 1.0 / settings_.rate_hz;
-  for (std::size_t axis = 0; axis < kAxes; ++axis) {
-    const auto snap = allan_raw_[axis].snapshot(tau0);
-    std::size_t usable = 0;
-    for (const auto& p : snap.window) usable += (p.oadev_terms >= 2 && std::isfinite(p.oadev)) ? 1 : 0;
-    if (usable < 3) continue;  // too early for a fit of five terms to mean anything
-    try {
-      noise_terms_[axis] = processing::fitNoiseTerms(snap.window);
-    } catch (const std::exception&) {
-      noise_terms_[axis].reset();  // e.g. a constant signal: nothing to fit
-    }
-  }
+  for (std::size_t axis = 0; axis < kAxes; ++axis)
+    applyNoiseRefit(axis, daemon::refitNoiseTerms(allan_raw_[axis], tau0));
 }
 
 }  // namespace gyrod::daemon

@@ -61,6 +61,26 @@ struct AllanStreams {
   std::array<processing::RollingOverlappingAllan::Snapshot, kAxes> raw, mean, kalman;
 };
 
+// The window's overlapping Allan deviation of every stream at every τ, read from the
+// rolling sums in O(number of τ): the numbers of allanSnapshot()'s window points, without
+// their noise identification (O(window) per τ). What the ALLAN reply carries.
+struct AllanWindowDeviations {
+  double tau0_s = 0.0;
+  double window_s = 0.0;
+  std::vector<double> tau_s;
+  std::array<std::array<std::vector<double>, 3>, kAxes> oadev;  // [axis][raw, mean, kalman]
+};
+
+// One axis's noise refit: too early (fewer than 3 usable τ: keep the previous fit), or the
+// fit (empty when nothing can be fitted, e.g. a constant signal).
+struct NoiseRefit {
+  bool too_early = true;
+  std::optional<processing::NoiseTermFit> fit;
+};
+// The refit of refitNoiseTerms for one raw stream; a free function so that it can run on a
+// copy of the stream's state, off the event loop (seconds at a 1 h window at 1 kHz).
+NoiseRefit refitNoiseTerms(const processing::RollingOverlappingAllan& raw_stream, double tau0_s);
+
 class SamplePipeline {
  public:
   // Throws std::invalid_argument for settings that cannot work (rate ≤ 0, still period
@@ -79,8 +99,12 @@ class SamplePipeline {
 
   // Not per sample (allocates): the Allan curves of the window and since start.
   AllanStreams allanSnapshot() const;
+  AllanWindowDeviations allanWindowDeviations() const;
   // Refit the five noise terms on the window of each raw axis (fitNoiseTerms).
   void refitNoiseTerms();
+  // The same in parts: the raw stream of an axis, and the result of refitNoiseTerms on it.
+  const processing::RollingOverlappingAllan& rawAllan(std::size_t axis) const { return allan_raw_.at(axis); }
+  void applyNoiseRefit(std::size_t axis, const NoiseRefit& refit);
   const std::array<std::optional<processing::NoiseTermFit>, kAxes>& noiseTerms() const { return noise_terms_; }
 
   PipelinePhase phase() const { return phase_; }

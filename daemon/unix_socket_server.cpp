@@ -1,5 +1,7 @@
 #include "daemon/unix_socket_server.hpp"
 
+#include "daemon/client_output_buffer.hpp"
+
 #include <fcntl.h>
 #include <grp.h>
 #include <sys/socket.h>
@@ -11,6 +13,7 @@
 #include <spdlog/spdlog.h>
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -22,223 +25,13 @@ namespace gyrod::daemon {
 using namespace protocol;
 namespace {
 
-constexpr int kListenBacklog = 64;
 constexpr int kMaxAcceptsPerWake = 16;
 constexpr int kMaxReadsPerWake = 8;
 constexpr std::size_t kMinClientBufferBytes = 4096;
 // Room for the longest accepted line plus "\r\n".
 constexpr std::size_t kInputBufferBytes = kMaxRequestLineBytes + 2;
 
-std::string singleQuoted(std::string_view s) { return "'" + std::string(s) + "'"; }
-
-sockaddr_un socketAddress(const std::string& path) {
-  sockaddr_un addr{};
-  addr.sun_family = AF_UNIX;
-  if (path.empty()) throw std::invalid_argument("socket path is empty");
-  if (path.size() >= sizeof addr.sun_path)
-    throw std::invalid_argument("socket path " + singleQuoted(path) + " is " + std::to_string(path.size()) +
-                                " bytes long; a Unix socket path must be shorter than " +
-                                std::to_string(sizeof addr.sun_path));
-  std::memcpy(addr.sun_path, path.data(), path.size());
-  return addr;
-}
-
-void setNonBlockingCloseOnExec(int fd) {
-  const int fl = ::fcntl(fd, F_GETFL);
-  if (fl < 0 || ::fcntl(fd, F_SETFL, fl | O_NONBLOCK) != 0) throw errnoError("fcntl(O_NONBLOCK)");
-  const int fdfl = ::fcntl(fd, F_GETFD);
-  if (fdfl < 0 || ::fcntl(fd, F_SETFD, fdfl | FD_CLOEXEC) != 0) throw errnoError("fcntl(FD_CLOEXEC)");
-}
-
-gid_t groupId(const std::string& name) {
-  std::vector<char> buf(16384);
-  group gr{};
-  group* found = nullptr;
-  const int rc = ::getgrnam_r(name.c_str(), &gr, buf.data(), buf.size(), &found);
-  if (rc != 0) throw std::system_error(rc, std::generic_category(), "getgrnam_r(" + singleQuoted(name) + ")");
-  if (found == nullptr) throw std::invalid_argument("socket group " + singleQuoted(name) + " does not exist");
-  return gr.gr_gid;
-}
-
-// Is someone accepting connections on the socket file at `path`? Only a refused
-// connection proves the file stale; anything else (success, busy backlog, no permission)
-// is treated as "in use" or reported.
-bool socketIsLive(const std::string& path) {
-  const Fd probe(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
-  if (!probe) throw errnoError("socket(AF_UNIX) for probing " + singleQuoted(path));
-  const sockaddr_un addr = socketAddress(path);
-  if (::connect(probe.get(), reinterpret_cast<const sockaddr*>(&addr), sizeof addr) == 0) return true;
-  if (errno == ECONNREFUSED) return false;
-  if (errno == EAGAIN || errno == EINPROGRESS) return true;  // a full backlog: alive but busy
-  throw errnoError("connect(" + singleQuoted(path) + ") to check whether the socket is in use");
-}
-
-// Preallocated ring of bytes: whole lines in, any prefix out (partial writes).
-class RingBuffer {
- public:
-  explicit RingBuffer(std::size_t capacity) : data_(new char[capacity]), capacity_(capacity) {}
-  std::size_t size() const noexcept { return size_; }
-  std::size_t free() const noexcept { return capacity_ - size_; }
-  bool empty() const noexcept { return size_ == 0; }
-  // Caller checks free() first.
-  void append(const char* p, std::size_t n) noexcept {
-    const std::size_t tail = (head_ + size_) % capacity_;
-    const std::size_t first = std::min(n, capacity_ - tail);
-    std::memcpy(data_.get() + tail, p, first);
-    std::memcpy(data_.get(), p + first, n - first);
-    size_ += n;
-  }
-  // The buffered bytes as at most two pieces, oldest first.
-  int pieces(std::array<iovec, 2>& iov) const noexcept {
-    if (size_ == 0) return 0;
-    const std::size_t first = std::min(size_, capacity_ - head_);
-    iov[0] = {data_.get() + head_, first};
-    if (first == size_) return 1;
-    iov[1] = {data_.get(), size_ - first};
-    return 2;
-  }
-  // Drops the n oldest bytes; returns how many '\n' they contained (lines completed).
-  std::size_t consume(std::size_t n) noexcept {
-    std::size_t newlines = 0;
-    std::size_t left = n;
-    while (left > 0) {
-      const std::size_t piece = std::min(left, capacity_ - head_);
-      const char* p = data_.get() + head_;
-      const char* end = p + piece;
-      while ((p = static_cast<const char*>(std::memchr(p, '\n', static_cast<std::size_t>(end - p)))) != nullptr) {
-        ++newlines;
-        ++p;
-      }
-      head_ = (head_ + piece) % capacity_;
-      left -= piece;
-    }
-    size_ -= n;
-    if (size_ == 0) head_ = 0;
-    return newlines;
-  }
-
- private:
-  std::unique_ptr<char[]> data_;
-  std::size_t capacity_;
-  std::size_t head_ = 0;
-  std::size_t size_ = 0;
-};
-
 }  // namespace
-
-// ---- listening socket --------------------------------------------------------------------
-
-ListeningSocket bindListeningSocket(const SocketOptions& options) {
-  namespace fs = std::filesystem;
-  const sockaddr_un addr = socketAddress(options.path);
-  if ((options.mode & ~mode_t{0777}) != 0)
-    throw std::invalid_argument("socket mode " + std::to_string(options.mode) + " has bits outside 0777");
-  // (gid_t)-1 tells chown() to leave the group as it is.
-  const gid_t gid = options.group ? groupId(*options.group) : static_cast<gid_t>(-1);
-
-  const fs::path parent = fs::path(options.path).parent_path();
-  if (!parent.empty()) {
-    std::error_code ec;
-    if (!fs::exists(parent, ec)) {
-      fs::create_directories(parent, ec);
-      if (ec) throw std::system_error(ec, "cannot create the socket folder " + singleQuoted(parent.string()));
-      fs::permissions(parent, fs::perms(0755), ec);
-    }
-  }
-
-  struct stat st {};
-  if (::lstat(options.path.c_str(), &st) == 0) {
-    if (!S_ISSOCK(st.st_mode))
-      throw std::runtime_error(options.path + " exists and is not a socket; refusing to replace it");
-    if (socketIsLive(options.path))
-      throw std::runtime_error(options.path + " is already in use by a running server (is gyrod already running?)");
-    if (::unlink(options.path.c_str()) != 0)
-      throw errnoError("unlink(" + singleQuoted(options.path) + ") of a stale socket");
-    spdlog::info("removed stale socket file {}", options.path);
-  } else if (errno != ENOENT) {
-    throw errnoError("lstat(" + singleQuoted(options.path) + ")");
-  }
-
-  ListeningSocket ls;
-  ls.fd.reset(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
-  if (!ls.fd) throw errnoError("socket(AF_UNIX)");
-  // The file bind() creates gets its mode from the umask: keep it owner-only until the
-  // configured mode and group are in place, so nobody else can connect in between.
-  const mode_t old_umask = ::umask(0177);
-  const int bind_rc = ::bind(ls.fd.get(), reinterpret_cast<const sockaddr*>(&addr), sizeof addr);
-  const int bind_errno = errno;
-  ::umask(old_umask);
-  if (bind_rc != 0) {
-    errno = bind_errno;
-    throw errnoError("bind(" + singleQuoted(options.path) + ")");
-  }
-  ls.path = options.path;
-  auto removeOnError = [&] { ::unlink(options.path.c_str()); };
-  if (options.group && ::chown(options.path.c_str(), static_cast<uid_t>(-1), gid) != 0) {
-    const auto err =
-        errnoError("chown(" + singleQuoted(options.path) + ", group " + singleQuoted(*options.group) + ")");
-    removeOnError();
-    throw err;
-  }
-  if (::chmod(options.path.c_str(), options.mode) != 0) {
-    const auto err = errnoError("chmod(" + singleQuoted(options.path) + ")");
-    removeOnError();
-    throw err;
-  }
-  if (::stat(options.path.c_str(), &st) != 0 || ::listen(ls.fd.get(), kListenBacklog) != 0) {
-    const auto err = errnoError("listen(" + singleQuoted(options.path) + ")");
-    removeOnError();
-    throw err;
-  }
-  ls.device = st.st_dev;
-  ls.inode = st.st_ino;
-  return ls;
-}
-
-std::optional<ListeningSocket> adoptActivatedSocket(std::string_view name) {
-  char** names = nullptr;
-  const int n = ::sd_listen_fds_with_names(/*unset_environment=*/0, &names);
-  std::vector<std::string> fd_names;
-  if (names != nullptr) {
-    for (char** p = names; *p != nullptr; ++p) {
-      fd_names.emplace_back(*p);
-      std::free(*p);
-    }
-    std::free(names);
-  }
-  if (n < 0) throw std::system_error(-n, std::generic_category(), "sd_listen_fds_with_names");
-  if (n == 0) return std::nullopt;
-
-  int chosen = -1;
-  for (int i = 0; i < n && static_cast<std::size_t>(i) < fd_names.size(); ++i)
-    if (fd_names[static_cast<std::size_t>(i)] == name) chosen = SD_LISTEN_FDS_START + i;
-  if (chosen < 0 && n == 1) chosen = SD_LISTEN_FDS_START;
-  if (chosen < 0) {
-    std::string list;
-    for (const auto& s : fd_names) list += (list.empty() ? "" : ", ") + s;
-    throw std::runtime_error("systemd passed " + std::to_string(n) + " sockets (" + list + ") but none is named " +
-                             singleQuoted(name) + " (set FileDescriptorName=" + std::string(name) +
-                             " in the socket unit)");
-  }
-  if (::sd_is_socket_unix(chosen, SOCK_STREAM, /*listening=*/1, nullptr, 0) <= 0)
-    throw std::runtime_error("fd " + std::to_string(chosen) +
-                             " passed by systemd is not a listening Unix stream socket");
-  ListeningSocket ls;
-  ls.fd.reset(chosen);
-  ls.activated = true;
-  setNonBlockingCloseOnExec(chosen);
-  return ls;
-}
-
-ListeningSocket openListeningSocket(const SocketOptions& options) {
-  if (auto activated = adoptActivatedSocket()) {
-    spdlog::info("using the socket passed by systemd (fd {})", activated->fd.get());
-    return std::move(*activated);
-  }
-  ListeningSocket ls = bindListeningSocket(options);
-  spdlog::info("listening on {}", ls.path);
-  return ls;
-}
 
 // ---- clients -------------------------------------------------------------------------------
 
@@ -248,15 +41,19 @@ struct UnixSocketServer::Client {
   Fd fd;
   std::uint64_t id;
   std::optional<std::int64_t> pid, uid;
-  RingBuffer out;
+  ClientOutputBuffer out;
   std::unique_ptr<char[]> in;
+  std::size_t in_start = 0;  // first byte of in not yet handled
   std::size_t in_used = 0;
   bool watch = false;
   std::uint32_t decimate = 1;
-  std::uint32_t countdown = 0;  // RATE lines to skip before the next one is sent
-  bool closing = false;         // no more input; close once the output is flushed
-  bool dead = false;            // to be removed by reapDeadClients()
-  bool epollout = false;        // EPOLLOUT currently requested
+  std::uint32_t countdown = 0;        // RATE lines to skip before the next one is sent
+  bool closing = false;               // no more input; close once the output is flushed
+  bool dead = false;                  // to be removed by reapDeadClients()
+  bool deferred = false;              // requests left for a later turn (input not watched meanwhile)
+  std::uint32_t events = EPOLLIN;     // the epoll events requested now
+  std::string held_reply;             // a reply waiting for room in out (input paused meanwhile)
+  std::int64_t last_progress_ns = 0;  // when a reply was held or output last left
   std::uint64_t lines_queued = 0;
   std::uint64_t lines_sent = 0;
 };
@@ -270,6 +67,8 @@ UnixSocketServer::UnixSocketServer(EventLoop& loop, ListeningSocket listening, S
         "UnixSocketServer: client_buffer_bytes = " + std::to_string(options_.client_buffer_bytes) +
         " is below the minimum of " + std::to_string(kMinClientBufferBytes));
   if (options_.max_clients == 0) throw std::invalid_argument("UnixSocketServer: max_clients must be >= 1");
+  if (options_.max_requests_per_turn == 0)
+    throw std::invalid_argument("UnixSocketServer: max_requests_per_turn must be >= 1");
   // Reserved once, so that adding and removing clients never reallocates the list.
   clients_.reserve(options_.max_clients);
   setNonBlockingCloseOnExec(listening_.fd.get());
@@ -278,6 +77,7 @@ UnixSocketServer::UnixSocketServer(EventLoop& loop, ListeningSocket listening, S
 
 UnixSocketServer::~UnixSocketServer() {
   if (accept_pause_timer_) loop_.removeSource(*accept_pause_timer_);
+  if (stall_check_timer_) loop_.removeSource(*stall_check_timer_);
   for (const auto& c : clients_) loop_.removeFd(c->fd.get());
   clients_.clear();
   loop_.removeFd(listening_.fd.get());
@@ -345,44 +145,78 @@ void UnixSocketServer::onClientEvents(Client& c, std::uint32_t events) {
   if (events & EPOLLERR) {
     c.dead = true;
   } else {
-    if ((events & EPOLLIN) && !c.closing) readRequests(c);
+    if ((events & EPOLLIN) && !c.closing && !c.deferred && c.held_reply.empty()) serveRequests(c);
     if ((events & EPOLLHUP) && !(events & EPOLLIN)) c.dead = true;  // both directions closed
     if ((events & EPOLLOUT) && !c.dead) flush(c);
   }
   reapDeadClients();
 }
 
-void UnixSocketServer::readRequests(Client& c) {
-  for (int i = 0; i < kMaxReadsPerWake && !c.closing && !c.dead; ++i) {
+void UnixSocketServer::serveRequests(Client& c) {
+  std::size_t budget = options_.max_requests_per_turn;
+  int reads = 0;
+  while (!c.closing && !c.dead && c.held_reply.empty()) {
+    const char* first = c.in.get() + c.in_start;
+    if (const void* nl = std::memchr(first, '\n', c.in_used - c.in_start)) {
+      if (budget == 0) return deferRequests(c);
+      --budget;
+      const auto end = static_cast<std::size_t>(static_cast<const char*>(nl) - c.in.get());
+      std::size_t line_end = end;
+      if (line_end > c.in_start && c.in[line_end - 1] == '\r') --line_end;
+      const std::string_view line(first, line_end - c.in_start);
+      c.in_start = end + 1;
+      handleLine(c, line);
+      continue;
+    }
+    // No whole line left: keep the partial one at the front and read more.
+    std::memmove(c.in.get(), first, c.in_used - c.in_start);
+    c.in_used -= c.in_start;
+    c.in_start = 0;
+    if (c.in_used == kInputBufferBytes) {
+      handleLine(c, std::string_view(c.in.get(), c.in_used));  // reports the over-long line
+      break;
+    }
+    if (reads++ == kMaxReadsPerWake) return deferRequests(c);
     const ssize_t n = ::recv(c.fd.get(), c.in.get() + c.in_used, kInputBufferBytes - c.in_used, 0);
     if (n == 0) {  // the client will send nothing more; answer what it asked, then close
       beginClose(c);
       return;
     }
     if (n < 0) {
-      if (errno == EAGAIN || errno == EWOULDBLOCK) return;
       if (errno == EINTR) continue;
-      spdlog::info("client {}: read failed: {}", c.id, std::strerror(errno));
-      c.dead = true;
-      return;
+      if (errno != EAGAIN && errno != EWOULDBLOCK) {
+        spdlog::info("client {}: read failed: {}", c.id, std::strerror(errno));
+        c.dead = true;
+        return;
+      }
+      break;  // all read and answered: wait for more input
     }
     c.in_used += static_cast<std::size_t>(n);
-    std::size_t start = 0;
-    while (!c.closing && !c.dead) {
-      const void* nl = std::memchr(c.in.get() + start, '\n', c.in_used - start);
-      if (nl == nullptr) break;
-      const std::size_t end = static_cast<std::size_t>(static_cast<const char*>(nl) - c.in.get());
-      std::size_t line_end = end;
-      if (line_end > start && c.in[line_end - 1] == '\r') --line_end;
-      handleLine(c, std::string_view(c.in.get() + start, line_end - start));
-      start = end + 1;
-    }
-    std::memmove(c.in.get(), c.in.get() + start, c.in_used - start);
-    c.in_used -= start;
-    if (c.in_used == kInputBufferBytes && !c.closing && !c.dead) {
-      handleLine(c, std::string_view(c.in.get(), c.in_used));  // reports the over-long line
-    }
   }
+  if (!c.dead) updateInterest(c);
+}
+
+void UnixSocketServer::deferRequests(Client& c) {
+  c.deferred = true;
+  updateInterest(c);  // its input is served from the deferred pass, not from epoll, meanwhile
+  if (deferred_requests_pending_) return;
+  deferred_requests_pending_ = true;
+  loop_.defer([this, alive = std::weak_ptr<bool>(alive_)] {
+    if (!alive.expired()) serveDeferredRequests();
+  });
+}
+
+void UnixSocketServer::serveDeferredRequests() {
+  deferred_requests_pending_ = false;
+  // By index: serving never adds or removes clients (reaping waits until the end).
+  for (std::size_t i = 0; i < clients_.size(); ++i) {
+    Client& c = *clients_[i];
+    if (!c.deferred || c.dead) continue;
+    c.deferred = false;
+    if (c.held_reply.empty() && !c.closing) serveRequests(c);
+    if (!c.dead) updateInterest(c);
+  }
+  reapDeadClients();
 }
 
 void UnixSocketServer::handleLine(Client& c, std::string_view line) {
@@ -400,16 +234,16 @@ void UnixSocketServer::handleLine(Client& c, std::string_view line) {
       c.watch = w->enable;
       c.decimate = w->decimate;
       c.countdown = 0;  // the next sample is sent, then every decimate-th
-      queueLine(c, watchLine(c.watch, c.decimate));
+      queueReply(c, watchLine(c.watch, c.decimate));
     } else if (std::holds_alternative<AllanRequest>(request)) {
       std::string reply;
       try {
-        reply = allanLine(content_.allanReport());
+        reply = content_.allanReplyLine();
       } catch (const std::exception& e) {
         spdlog::error("ALLAN reply for client {} failed: {}", c.id, e.what());
         reply = errorLine(ErrorCode::Internal, std::string("the daemon could not produce ALLAN: ") + e.what());
       }
-      queueLine(c, reply);
+      queueReply(c, std::move(reply));
     } else {
       std::string reply;
       try {
@@ -418,11 +252,36 @@ void UnixSocketServer::handleLine(Client& c, std::string_view line) {
         spdlog::error("STATUS reply for client {} failed: {}", c.id, e.what());
         reply = errorLine(ErrorCode::Internal, std::string("the daemon could not produce STATUS: ") + e.what());
       }
-      queueLine(c, reply);
+      queueReply(c, std::move(reply));
     }
   } catch (const ProtocolError& e) {
-    queueLine(c, errorLine(e.code(), e.what()));
+    queueReply(c, errorLine(e.code(), e.what()));
   }
+}
+
+namespace {
+// Room a reply may take in a client's buffer: a watching client keeps a quarter of it for
+// the RATE lines that arrive while it reads its replies.
+bool replyFits(std::size_t reply_bytes, std::size_t free_bytes, std::size_t capacity, bool watching) {
+  return reply_bytes + (watching ? capacity / 4 : 0) <= free_bytes;
+}
+std::int64_t steadyNowNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+}  // namespace
+
+void UnixSocketServer::queueReply(Client& c, std::string reply) {
+  if (c.dead) return;
+  // Only an empty buffer too small for the reply would hold it forever: drop at once then.
+  if (replyFits(reply.size(), c.out.free(), c.out.capacity(), c.watch) || reply.size() > c.out.capacity()) {
+    queueLine(c, reply);
+    return;
+  }
+  c.held_reply = std::move(reply);
+  c.last_progress_ns = steadyNowNs();
+  updateInterest(c);
+  if (!stall_check_timer_) armStallCheck(options_.stalled_reply_timeout);
 }
 
 void UnixSocketServer::queueLine(Client& c, const char* data, std::size_t size) {
@@ -435,11 +294,12 @@ void UnixSocketServer::queueLine(Client& c, const char* data, std::size_t size) 
   ++c.lines_queued;
   // Write at once unless the socket is already known to be full (EPOLLOUT pending): most
   // lines then leave in the same wake-up, and the buffer only holds what the kernel refused.
-  if (!c.epollout) flush(c);
+  if (!(c.events & EPOLLOUT)) flush(c);
 }
 
 void UnixSocketServer::flush(Client& c) {
   std::array<iovec, 2> iov{};
+  bool progress = false;
   while (!c.out.empty()) {
     msghdr msg{};
     msg.msg_iov = iov.data();
@@ -447,6 +307,7 @@ void UnixSocketServer::flush(Client& c) {
     const ssize_t n = ::sendmsg(c.fd.get(), &msg, MSG_NOSIGNAL | MSG_DONTWAIT);
     if (n > 0) {
       c.lines_sent += c.out.consume(static_cast<std::size_t>(n));
+      progress = true;
       continue;
     }
     if (n < 0 && errno == EINTR) continue;
@@ -454,6 +315,18 @@ void UnixSocketServer::flush(Client& c) {
     // EPIPE, ECONNRESET: the client has gone away.
     c.dead = true;
     return;
+  }
+  if (progress && !c.held_reply.empty()) {
+    c.last_progress_ns = steadyNowNs();
+    if (replyFits(c.held_reply.size(), c.out.free(), c.out.capacity(), c.watch)) {
+      // Room again: the held reply goes out and the client's requests resume next turn.
+      c.out.append(c.held_reply.data(), c.held_reply.size());
+      ++c.lines_queued;
+      c.held_reply.clear();
+      deferRequests(c);
+      flush(c);
+      return;
+    }
   }
   if (c.closing && c.out.empty()) {
     c.dead = true;
@@ -463,11 +336,12 @@ void UnixSocketServer::flush(Client& c) {
 }
 
 void UnixSocketServer::updateInterest(Client& c) {
-  const bool want_out = !c.out.empty();
-  if (want_out == c.epollout && !c.closing) return;
-  const std::uint32_t events = (c.closing ? 0u : std::uint32_t{EPOLLIN}) | (want_out ? std::uint32_t{EPOLLOUT} : 0u);
+  const bool read_input = !c.closing && !c.deferred && c.held_reply.empty();
+  const std::uint32_t events =
+      (read_input ? std::uint32_t{EPOLLIN} : 0u) | (c.out.empty() ? 0u : std::uint32_t{EPOLLOUT});
+  if (events == c.events) return;
   loop_.modifyFd(c.fd.get(), events);
-  c.epollout = want_out;
+  c.events = events;
 }
 
 void UnixSocketServer::beginClose(Client& c) {
@@ -481,7 +355,8 @@ void UnixSocketServer::beginClose(Client& c) {
 }
 
 void UnixSocketServer::dropSlowClient(Client& c, std::size_t line_size) {
-  const std::uint64_t lost = c.lines_queued - c.lines_sent + 1;  // unsent lines, the one that did not fit
+  // Unsent lines, the one that did not fit and a held reply.
+  const std::uint64_t lost = c.lines_queued - c.lines_sent + 1 + (c.held_reply.empty() ? 0 : 1);
   ++clients_dropped_;
   lines_dropped_ += lost;
   spdlog::warn(
@@ -489,6 +364,39 @@ void UnixSocketServer::dropSlowClient(Client& c, std::size_t line_size) {
       "disconnecting it ({} lines not delivered)",
       c.id, c.pid.value_or(-1), options_.client_buffer_bytes, line_size, lost);
   c.dead = true;
+}
+
+void UnixSocketServer::armStallCheck(std::chrono::nanoseconds delay) {
+  stall_check_timer_ =
+      loop_.addOneShotTimer(std::max(delay, std::chrono::nanoseconds(1'000'000)), [this](std::uint64_t) {
+        stall_check_timer_.reset();
+        dropStalledClients();
+      });
+}
+
+void UnixSocketServer::dropStalledClients() {
+  const std::int64_t now = steadyNowNs();
+  const std::int64_t timeout_ns = std::chrono::nanoseconds(options_.stalled_reply_timeout).count();
+  std::optional<std::int64_t> next_due;
+  for (const auto& client : clients_) {
+    Client& c = *client;
+    if (c.dead || c.held_reply.empty()) continue;
+    const std::int64_t due = c.last_progress_ns + timeout_ns;
+    if (due > now) {
+      next_due = std::min(next_due.value_or(due), due);
+      continue;
+    }
+    ++clients_dropped_;
+    const std::uint64_t lost = c.lines_queued - c.lines_sent + 1;
+    lines_dropped_ += lost;
+    spdlog::warn(
+        "client {} (pid {}) is not reading: a reply has waited {} ms for room in its {} byte buffer; "
+        "disconnecting it ({} lines not delivered)",
+        c.id, c.pid.value_or(-1), options_.stalled_reply_timeout.count(), options_.client_buffer_bytes, lost);
+    c.dead = true;
+  }
+  if (next_due) armStallCheck(std::chrono::nanoseconds(*next_due - now));
+  reapDeadClients();
 }
 
 void UnixSocketServer::reapDeadClients() {

@@ -3,15 +3,25 @@
 // of protocol/protocol.hpp, and a bounded output buffer per client.
 //
 // Backpressure policy (gpsd's weakness to avoid: slow clients silently losing data): each
-// client has a preallocated output buffer of ServerOptions::client_buffer_bytes. A line
-// that does not fit means the client has stopped reading for longer than the buffer
-// covers (256 KiB: 750–1 300 RATE lines of 200–350 bytes, 15–25 s at 50 Hz): it is
-// disconnected, logged and counted (STATUS: clients_dropped, lines_dropped). No client
-// ever sees a gap because of another client. A dropped client has received a prefix of
-// its stream; its last line may be incomplete if the kernel had taken part of it
-// (docs/protocol.md: a line without its newline at EOF is to be discarded).
+// client has a preallocated output buffer of ServerOptions::client_buffer_bytes.
+//  - RATE and GAP lines: a line that does not fit means the client has stopped reading for
+//    longer than the buffer covers (256 KiB: 750–1 300 RATE lines of 200–350 bytes, 15–25 s
+//    at 50 Hz): it is disconnected, logged and counted (STATUS: clients_dropped,
+//    lines_dropped). No client ever sees a gap because of another client.
+//  - Replies to requests: a reply that does not fit (a watching client keeps a quarter of
+//    its buffer for RATE lines) is held, and the client's input is not read until its
+//    output drains enough to take it: a client that pipelines requests faster than it reads
+//    replies is slowed down, not dropped. Only a client whose held reply has waited
+//    ServerOptions::stalled_reply_timeout without any byte of output leaving is dropped.
+//  - The event loop never waits on a client: each turn a client gets at most
+//    ServerOptions::max_requests_per_turn requests answered; the rest of its input is read
+//    and answered on later turns (EventLoop::defer).
+// A dropped client has received a prefix of its stream; its last line may be incomplete if
+// the kernel had taken part of it (docs/protocol.md: a line without its newline at EOF is
+// to be discarded).
 #include <sys/types.h>
 
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -70,12 +80,18 @@ std::optional<ListeningSocket> adoptActivatedSocket(std::string_view name = kAct
 // Socket activation if systemd passed a socket, otherwise bindListeningSocket(options).
 ListeningSocket openListeningSocket(const SocketOptions& options);
 
+// O_NONBLOCK and FD_CLOEXEC on `fd`; throws std::system_error.
+void setNonBlockingCloseOnExec(int fd);
+
 // What the daemon answers to "allan" and "status". Not on the per-sample path: may
 // allocate. An exception thrown here becomes an ERROR "internal" line for that client.
 class ServerContent {
  public:
   virtual ~ServerContent() = default;
   virtual AllanReport allanReport() = 0;
+  // The whole ALLAN reply line. By default allanReport() formatted on each request; gyrod
+  // serves a line cached at each noise refit instead (daemon/allan_reply_cache.hpp).
+  virtual std::string allanReplyLine() { return protocol::allanLine(allanReport()); }
   virtual StatusReport statusReport() = 0;
 };
 
@@ -83,6 +99,10 @@ struct ServerOptions {
   std::string release = GYROD_RELEASE;           // VERSION "release" (the project version)
   std::size_t client_buffer_bytes = 256 * 1024;  // per client, preallocated
   std::size_t max_clients = 32;                  // more are refused with ERROR too_many_clients
+  std::size_t max_requests_per_turn = 16;        // per client per loop turn; the rest waits
+  // A client whose reply has waited this long for room, with none of its output read
+  // meanwhile, is dropped as not reading.
+  std::chrono::milliseconds stalled_reply_timeout = std::chrono::seconds(10);
 };
 
 class UnixSocketServer {
@@ -114,8 +134,13 @@ class UnixSocketServer {
   void onListenerReadable();
   void acceptClient(Fd fd);
   void onClientEvents(Client& c, std::uint32_t events);
-  void readRequests(Client& c);
+  // Answers at most max_requests_per_turn requests of c, reading its socket as needed.
+  void serveRequests(Client& c);
+  void deferRequests(Client& c);
+  void serveDeferredRequests();
   void handleLine(Client& c, std::string_view line);
+  // A reply goes into c's buffer if it fits, else it is held and c's input pauses.
+  void queueReply(Client& c, std::string reply);
   // Appends a whole line to c's buffer, or drops c if it does not fit.
   void queueLine(Client& c, const char* data, std::size_t size);
   void queueLine(Client& c, const std::string& line) { queueLine(c, line.data(), line.size()); }
@@ -123,6 +148,8 @@ class UnixSocketServer {
   void updateInterest(Client& c);
   void beginClose(Client& c);
   void dropSlowClient(Client& c, std::size_t line_size);
+  void armStallCheck(std::chrono::nanoseconds delay);
+  void dropStalledClients();
   void reapDeadClients();
   ServerStatus serverStatusFor(const Client* self) const;
 
@@ -136,6 +163,10 @@ class UnixSocketServer {
   std::uint64_t clients_dropped_ = 0;
   std::uint64_t lines_dropped_ = 0;
   std::optional<EventLoop::SourceId> accept_pause_timer_;
+  std::optional<EventLoop::SourceId> stall_check_timer_;
+  bool deferred_requests_pending_ = false;
+  // Deferred callbacks may outlive the server in the loop: they check this first.
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
 
 }  // namespace gyrod::daemon

@@ -173,3 +173,19 @@ TEST(EventLoop, CallbackExceptionsReachTheCaller) {
       },
       std::runtime_error);
 }
+
+TEST(EventLoop, DeferredWorkRunsAfterTheNextTurnsEventsWithoutWaiting) {
+  EventLoop loop;
+  std::vector<int> order;
+  loop.defer([&] {
+    order.push_back(1);
+    loop.defer([&] { order.push_back(2); });  // deferred during a turn: the next turn
+  });
+  const auto start = std::chrono::steady_clock::now();
+  loop.runOnce(10s);  // does not wait: work is deferred
+  EXPECT_EQ(order, std::vector<int>({1}));
+  loop.runOnce(10s);
+  EXPECT_EQ(order, std::vector<int>({1, 2}));
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 5s);
+  EXPECT_GT(loop.longestTurn().count(), 0);
+}

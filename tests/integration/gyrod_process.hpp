@@ -83,6 +83,7 @@ class LineClient {
     if (fd_ >= 0) ::close(fd_);
   }
   bool connected() const { return fd_ >= 0; }
+  int fd() const { return fd_; }
   bool send(const std::string& line) const {
     return ::send(fd_, line.data(), line.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(line.size());
   }

@@ -1,0 +1,80 @@
+// The noise refit off the event loop gives exactly what SamplePipeline::refitNoiseTerms
+// gives on the loop, for the state at the moment the cycle started.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <random>
+
+#include "daemon/noise_refit_worker.hpp"
+
+using namespace gyrod::daemon;
+using namespace std::chrono_literals;
+
+namespace {
+
+PipelineSettings settings() {
+  PipelineSettings p;
+  p.rate_hz = 50.0;
+  p.bias_origin = BiasOrigin::Config;
+  p.bias_dps = {1.5, -0.25, 0.125};
+  p.kalman = {-0.2855, 0.0577, 0.0667};
+  p.allan_window_samples = 4096;
+  return p;
+}
+
+void feed(SamplePipeline& p, std::uint64_t first, std::uint64_t count, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  double walk = 0.0;
+  for (std::uint64_t k = first; k < first + count; ++k) {
+    walk += 0.002 * noise(rng);
+    p.process(k, static_cast<double>(k) / 50.0, {1.5 + walk + noise(rng), -0.25 + noise(rng), 0.125 - walk}, 25.0);
+  }
+}
+
+}  // namespace
+
+TEST(NoiseRefitWorker, GivesExactlyTheNoiseTermsOfTheRefitOnTheLoop) {
+  SamplePipeline on_loop(settings()), off_loop(settings());
+  feed(on_loop, 0, 3000, 1);
+  feed(off_loop, 0, 3000, 1);
+  on_loop.refitNoiseTerms();
+
+  EventLoop loop;
+  int cycles = 0;
+  NoiseRefitWorker worker(loop, off_loop, 50.0, [&] { ++cycles; });
+  EXPECT_FALSE(off_loop.noiseTerms()[0].has_value());
+  ASSERT_TRUE(worker.startCycle());
+  EXPECT_TRUE(worker.busy());
+  EXPECT_FALSE(worker.startCycle());  // one cycle at a time
+  feed(off_loop, 3000, 500, 2);       // samples keep coming during the cycle; axis 0 was copied before them
+  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  while (cycles == 0 && std::chrono::steady_clock::now() < deadline) loop.runOnce(10ms);
+  ASSERT_EQ(cycles, 1);
+  EXPECT_FALSE(worker.busy());
+
+  const auto& expected = on_loop.noiseTerms()[0];
+  const auto& got = off_loop.noiseTerms()[0];
+  ASSERT_TRUE(expected.has_value());
+  ASSERT_TRUE(got.has_value());
+  for (const auto term : gyrod::processing::kAllNoiseTerms) {
+    EXPECT_EQ(got->value.get(term), expected->value.get(term));
+    EXPECT_EQ(got->uncertainty.get(term), expected->uncertainty.get(term));
+  }
+  EXPECT_EQ(got->points_used, expected->points_used);
+  for (std::size_t axis = 1; axis < kAxes; ++axis) EXPECT_TRUE(off_loop.noiseTerms()[axis].has_value()) << axis;
+}
+
+TEST(NoiseRefitWorker, TooEarlyKeepsNothingAndStillCompletesTheCycle) {
+  SamplePipeline p(settings());
+  feed(p, 0, 3, 1);
+  EventLoop loop;
+  int cycles = 0;
+  NoiseRefitWorker worker(loop, p, 50.0, [&] { ++cycles; });
+  ASSERT_TRUE(worker.startCycle());
+  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  while (cycles == 0 && std::chrono::steady_clock::now() < deadline) loop.runOnce(10ms);
+  EXPECT_EQ(cycles, 1);
+  for (std::size_t axis = 0; axis < kAxes; ++axis) EXPECT_FALSE(p.noiseTerms()[axis].has_value());
+  EXPECT_TRUE(worker.startCycle());  // and the next cycle can start
+}
