@@ -3,12 +3,13 @@
 #include <algorithm>
 #include <array>
 #include <cerrno>
-#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <sstream>
 #include <string_view>
+
+#include "formats/csv_fields.hpp"
 
 namespace gyrod::recording {
 namespace {
@@ -21,37 +22,6 @@ constexpr std::array<std::string_view, 5> kKnownColumns = {"t", "gx", "gy", "gz"
   if (line > 0) s << ':' << line;
   s << ": " << cause;
   throw RecordingError(s.str());
-}
-
-std::string_view trim(std::string_view s) {
-  const auto first = s.find_first_not_of(" \t\r");
-  if (first == std::string_view::npos) return {};
-  const auto last = s.find_last_not_of(" \t\r");
-  return s.substr(first, last - first + 1);
-}
-
-std::vector<std::string_view> splitFields(std::string_view line) {
-  std::vector<std::string_view> fields;
-  std::size_t start = 0;
-  while (true) {
-    const auto comma = line.find(',', start);
-    fields.push_back(
-        trim(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start)));
-    if (comma == std::string_view::npos) break;
-    start = comma + 1;
-  }
-  return fields;
-}
-
-// Parses a whole field as a double; nullopt when it is not a number at all.
-std::optional<double> parseNumber(std::string_view field) {
-  if (field.empty()) return std::nullopt;
-  if (field.front() == '+') field.remove_prefix(1);
-  double value = 0.0;
-  const auto [end, ec] = std::from_chars(field.data(), field.data() + field.size(), value);
-  if (ec == std::errc::result_out_of_range) return HUGE_VAL;  // reported as non-finite
-  if (ec != std::errc() || end != field.data() + field.size()) return std::nullopt;
-  return value;
 }
 
 bool isSkippable(std::string_view line) { return line.empty() || line.front() == '#'; }
@@ -94,7 +64,7 @@ Recording readRecordingCsv(const std::string& path) {
   std::string_view first;
   while (std::getline(in, raw)) {
     ++line_no;
-    first = trim(raw);
+    first = trimField(raw);
     if (!skippable(first)) break;
   }
   if (isSkippable(first)) fail(path, 0, "empty file: no header and no samples");
@@ -165,7 +135,7 @@ Recording readRecordingCsv(const std::string& path) {
   if (bare_numbers) consume(first);
   while (std::getline(in, raw)) {
     ++line_no;
-    const auto line = trim(raw);
+    const auto line = trimField(raw);
     if (skippable(line)) continue;
     if (bare_numbers && line.find(',') != std::string_view::npos)
       fail(path, line_no, "more than one column in a file of bare numbers (add a header t,gx,gy,gz,temp)");

@@ -1,5 +1,6 @@
-// gyroctl simulate: a recording of the simulated gyro at rest (docs/simulator.md), as the
-// CSV that analyze/filter read: t,gx,gy,gz,temp.
+// gyroctl simulate: a recording of the simulated gyro (docs/simulator.md), as the CSV that
+// analyze/filter read: t,gx,gy,gz,temp; with --motion, turned by a motion spec
+// (formats/motion_spec.hpp) and followed by the truth wx,wy,wz that any stream can be scored on.
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -10,6 +11,7 @@
 #include <string>
 
 #include "formats/model_toml.hpp"
+#include "formats/motion_spec.hpp"
 #include "processing/noise_simulator.hpp"
 #include "tools/gyroctl/commands.hpp"
 
@@ -25,6 +27,7 @@ struct SimulateOptions {
   std::optional<double> rate_hz;
   std::uint64_t seed = 1;
   std::optional<int> dlpf, fs_sel;
+  std::string motion;  // empty: at rest, and no truth columns (the output stays as it always was)
   std::string output;
 };
 
@@ -85,16 +88,23 @@ int runSimulate(const SimulateOptions& opt) {
   if (opt.dlpf) model.dlpf_cfg = *opt.dlpf;
   if (opt.fs_sel) model.fs_sel = *opt.fs_sel;
 
-  NoiseSimulator sim(model, opt.duration_s, opt.seed);  // validates; std::invalid_argument → exit 2
+  // Both validate: std::invalid_argument (bad model or profile text) and RecordingError (bad
+  // motion CSV) → exit 2.
+  const bool with_motion = !opt.motion.empty();
+  NoiseSimulator sim = with_motion
+                           ? NoiseSimulator(model, opt.duration_s, opt.seed, recording::motionFromSpec(opt.motion))
+                           : NoiseSimulator(model, opt.duration_s, opt.seed);
   AtomicOutput out(opt.output);
   std::FILE* f = out.get();
-  std::fputs("t,gx,gy,gz,temp\n", f);
+  std::fputs(with_motion ? "t,gx,gy,gz,temp,wx,wy,wz\n" : "t,gx,gy,gz,temp\n", f);
   const std::size_t n = sim.sampleCount();
   for (std::size_t i = 0; i < n; ++i) {
     const SimulatedSample s = sim.next();
     // 17 significant digits: every double survives the text round trip exactly.
-    std::fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g\n", s.t_s, s.rate_dps[0], s.rate_dps[1], s.rate_dps[2],
+    std::fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g", s.t_s, s.rate_dps[0], s.rate_dps[1], s.rate_dps[2],
                  s.temperature_c);
+    if (with_motion) std::fprintf(f, ",%.17g,%.17g,%.17g", s.true_rate_dps[0], s.true_rate_dps[1], s.true_rate_dps[2]);
+    std::fputc('\n', f);
   }
   out.commit();
   std::fprintf(stderr, "wrote %zu samples at %g Hz (%s%s, seed %llu) to %s\n", n, model.rate_hz,
@@ -108,8 +118,10 @@ int runSimulate(const SimulateOptions& opt) {
 
 void addSimulateCommand(CLI::App& app, CommandRunner& run) {
   auto opt = std::make_shared<SimulateOptions>();
-  auto* sub = app.add_subcommand("simulate",
-                                 "Write a simulated MPU6050 recording at rest (t,gx,gy,gz,temp) from a noise model");
+  auto* sub =
+      app.add_subcommand("simulate",
+                         "Write a simulated MPU6050 recording (t,gx,gy,gz,temp; with --motion also the truth wx,wy,wz) "
+                         "from a noise model");
   auto* model = sub->add_option("--model", opt->model_file, "model file (TOML, see docs/simulator.md)");
   auto* terms = sub->add_option_group("terms", "noise terms on all three axes (instead of --model)");
   auto* q = terms->add_option("--quantization", opt->quantization, "quantization noise Q [urad]");
@@ -123,6 +135,9 @@ void addSimulateCommand(CLI::App& app, CommandRunner& run) {
   sub->add_option("--seed", opt->seed, "random seed (same seed, same file on every machine)")->default_val(1);
   sub->add_option("--dlpf", opt->dlpf, "DLPF_CFG 0..6 (default: the model file's, else no DLPF)");
   sub->add_option("--fs-sel", opt->fs_sel, "FS_SEL 0..3: quantise and saturate (default: the model file's, else not)");
+  sub->add_option("--motion", opt->motion,
+                  "true rotation: profiles such as step:axis=z,at=5,rate=10 (summed with +), or a CSV t,wx,wy,wz; "
+                  "adds the truth columns wx,wy,wz (docs/simulator.md)");
   sub->add_option("-o,--output", opt->output, "output CSV")->required();
   sub->callback([&run, opt] { run = [opt] { return runSimulate(*opt); }; });
 }
