@@ -14,7 +14,7 @@
 namespace gyrod::recording {
 namespace {
 
-constexpr std::array<std::string_view, 5> kKnownColumns = {"t", "gx", "gy", "gz", "temp"};
+constexpr std::array<std::string_view, 8> kKnownColumns = {"t", "gx", "gy", "gz", "temp", "wx", "wy", "wz"};
 
 [[noreturn]] void fail(const std::string& path, std::size_t line, const std::string& cause) {
   std::ostringstream s;
@@ -69,7 +69,7 @@ Recording readRecordingCsv(const std::string& path) {
   }
   if (isSkippable(first)) fail(path, 0, "empty file: no header and no samples");
 
-  enum class Role { T, Axis, Temp };
+  enum class Role { T, Axis, Temp, Truth };
   std::vector<std::pair<Role, std::size_t>> roles;  // per column: what it feeds, axis index
   bool bare_numbers = false;
   std::size_t header_line = line_no;
@@ -87,7 +87,7 @@ Recording readRecordingCsv(const std::string& path) {
     bool have_t = false, have_temp = false;
     for (auto name : names) {
       if (std::find(kKnownColumns.begin(), kKnownColumns.end(), name) == kKnownColumns.end())
-        fail(path, line_no, "unknown column '" + std::string(name) + "' (expected any of t,gx,gy,gz,temp)");
+        fail(path, line_no, "unknown column '" + std::string(name) + "' (expected any of t,gx,gy,gz,temp,wx,wy,wz)");
       for (std::size_t j = 0; j < roles.size(); ++j)
         if (names[j] == name) fail(path, line_no, "column '" + std::string(name) + "' appears twice");
       if (name == "t") {
@@ -96,6 +96,9 @@ Recording readRecordingCsv(const std::string& path) {
       } else if (name == "temp") {
         roles.push_back({Role::Temp, 0});
         have_temp = true;
+      } else if (const auto truth = std::find(kTruthColumns.begin(), kTruthColumns.end(), name);
+                 truth != kTruthColumns.end()) {
+        roles.push_back({Role::Truth, static_cast<std::size_t>(truth - kTruthColumns.begin())});
       } else {
         roles.push_back({Role::Axis, rec.axis_names.size()});
         rec.axis_names.emplace_back(name);
@@ -116,10 +119,11 @@ Recording readRecordingCsv(const std::string& path) {
     }
     rec.line_numbers.push_back(line_no);
     for (std::size_t c = 0; c < fields.size(); ++c) {
-      const std::string column = bare_numbers                   ? std::string("value")
-                                 : roles[c].first == Role::T    ? std::string("t")
-                                 : roles[c].first == Role::Temp ? std::string("temp")
-                                                                : rec.axis_names[roles[c].second];
+      const std::string column = bare_numbers                    ? std::string("value")
+                                 : roles[c].first == Role::T     ? std::string("t")
+                                 : roles[c].first == Role::Temp  ? std::string("temp")
+                                 : roles[c].first == Role::Truth ? std::string(kTruthColumns[roles[c].second])
+                                                                 : rec.axis_names[roles[c].second];
       const auto value = parseNumber(fields[c]);
       if (!value) fail(path, line_no, "column '" + column + "': '" + std::string(fields[c]) + "' is not a number");
       if (!std::isfinite(*value))
@@ -128,6 +132,7 @@ Recording readRecordingCsv(const std::string& path) {
         case Role::T: rec.t.push_back(*value); break;
         case Role::Temp: rec.temp.push_back(*value); break;
         case Role::Axis: rec.axes[roles[c].second].push_back(*value); break;
+        case Role::Truth: rec.true_rate[roles[c].second].push_back(*value); break;
       }
     }
   };

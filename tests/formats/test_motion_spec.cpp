@@ -142,3 +142,12 @@ TEST(MotionSpecFile, MissingFileIsNamed) {
     EXPECT_EQ(std::string(e.what()).rfind("/nonexistent/motion.csv: cannot open", 0), 0u) << e.what();
   }
 }
+
+TEST_F(MotionCsv, RecordingReaderKeepsTheTruthColumnsApart) {
+  const Recording rec = readRecordingCsv(write("t,gx,gy,gz,temp,wx,wy,wz\n0,1,2,3,25,4,5,6\n0.02,1,2,3,25,7,8,9\n"));
+  EXPECT_EQ(rec.axis_names, (std::vector<std::string>{"gx", "gy", "gz"}));
+  EXPECT_EQ(rec.true_rate[0], (std::vector<double>{4.0, 7.0}));
+  EXPECT_EQ(rec.true_rate[2], (std::vector<double>{6.0, 9.0}));
+  EXPECT_TRUE(readRecordingCsv(write("t,gz\n0,1\n")).true_rate[0].empty());
+  EXPECT_THROW(readRecordingCsv(write("t,wx\n0,1\n")), RecordingError);  // the truth alone is no recording
+}

@@ -172,3 +172,21 @@ TEST(GyroctlSimulateMotion, BadSpecsExitTwoNamingTheProblem) {
     EXPECT_FALSE(std::filesystem::exists(out)) << spec;
   }
 }
+
+TEST(GyroctlSimulateMotion, OfflineToolsReadTheFileWithItsTruth) {
+  ScratchDir d;
+  const std::string sim = (d.path() / "sim.csv").string(), filtered = (d.path() / "f.csv").string();
+  ASSERT_EQ(runGyroctl("simulate --arw 1 --duration 20 --rate 50 --dlpf 4 --fs-sel 0 "
+                       "--motion 'sine:axis=x,freq=1,amp=20' -o " +
+                           sim,
+                       d.path())
+                .exit_status,
+            0);
+  auto r = runGyroctl("filter " + sim + " -o " + filtered, d.path());
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const Table f = parseCsv(readWholeFile(filtered));
+  EXPECT_EQ(f.header, "t,gx,gx_mean,gx_kalman,gy,gy_mean,gy_kalman,gz,gz_mean,gz_kalman");
+  EXPECT_EQ(f.rows.size(), 1000u);
+  r = runGyroctl("analyze " + sim, d.path());
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+}
