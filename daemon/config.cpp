@@ -10,6 +10,8 @@
 #include <sstream>
 
 #include "driver/mpu6050_config.hpp"
+#include "formats/motion_spec.hpp"
+#include "formats/recording_csv.hpp"
 #include "formats/toml_document.hpp"
 
 namespace gyrod::daemon {
@@ -225,6 +227,23 @@ void readLog(const Section& s, LogConfig& l) {
   if (auto v = s.choice("level", kLogLevelNames)) l.level = kLogLevels[*v];
 }
 
+// Validated here, as every other key, so that a bad spec stops gyrod at start with the
+// file and line of the key (a motion CSV's own errors name its file and line as well).
+void readMockMotion(const Section& s, MockConfig& m) {
+  const auto v = s.string("motion");
+  if (!v || v->empty()) return;
+  if (m.source == MockSource::Replay)
+    s.failValue("motion", "applies to source = \"simulator\" only (a replayed recording already holds its motion)");
+  try {
+    (void)recording::motionFromSpec(*v);
+  } catch (const std::invalid_argument& e) {
+    s.failValue("motion", e.what());
+  } catch (const recording::RecordingError& e) {
+    s.failValue("motion", e.what());
+  }
+  m.motion = *v;
+}
+
 void readMock(const Section& s, MockConfig& m) {
   if (auto v = s.choice("source", kMockSourceNames)) m.source = *v == 0 ? MockSource::Simulator : MockSource::Replay;
   if (auto v = s.string("replay_file")) m.replay_file = *v;
@@ -238,6 +257,7 @@ void readMock(const Section& s, MockConfig& m) {
     if (!(*v > 0.0 && *v <= 1000.0)) s.failValue("speed", "must be > 0 and ≤ 1000 (1 = real time)");
     m.speed = *v;
   }
+  readMockMotion(s, m);
   if (!s.has("faults")) return;
   if (!s.node("faults")->is_table()) s.failType(*s.node("faults"), "faults", "must be a table");
   const Section f(s.file(), *s.node("faults")->as_table(), s.qualified("faults"),
@@ -348,7 +368,7 @@ GyrodConfig readConfig(const formats::TomlDocument& doc) {
   readRecord(section("record", {"path", "rotate_mb", "rotate_minutes", "flush_interval_s", "fsync_each_flush", "keep"}),
              config.record);
   readLog(section("log", {"level"}), config.log);
-  readMock(section("mock", {"source", "replay_file", "seed", "speed", "faults"}), config.mock);
+  readMock(section("mock", {"source", "replay_file", "seed", "speed", "motion", "faults"}), config.mock);
   return config;
 }
 

@@ -129,6 +129,9 @@ struct MockConfig {
   std::string replay_file;  // recording CSV (t,gx,gy,gz,temp) when source = replay
   std::uint64_t seed = 1;
   double speed = 1.0;  // 1 = real time; 10 = ten times faster
+  // The board's true rotation as a motion spec (formats/motion_spec.hpp: profiles such as
+  // "constant:axis=z,rate=30,start=10", or a CSV t,wx,wy,wz); empty = at rest. Simulator only.
+  std::string motion;
   MockFaults faults;
   bool operator==(const MockConfig&) const = default;
 };

@@ -10,6 +10,7 @@
 #include "driver/mpu6050_config.hpp"
 #include "driver/polling_data_ready.hpp"
 #include "formats/model_toml.hpp"
+#include "formats/motion_spec.hpp"
 #include "formats/recording_csv.hpp"
 
 namespace gyrod::daemon {
@@ -107,7 +108,10 @@ DeviceParts makeDeviceParts(const GyrodConfig& config) {
     } else {
       const processing::SimulationModel model =
           config.filter.model.empty() ? defaultMockModel() : recording::readModelToml(config.filter.model);
-      b.source = std::make_unique<driver::SimulatorSignalSource>(model, config.device.dlpf, mc.seed);
+      const processing::MotionProfile motion =
+          mc.motion.empty() ? processing::MotionProfile{} : recording::motionFromSpec(mc.motion);
+      b.source = std::make_unique<driver::SimulatorSignalSource>(
+          model, config.device.dlpf, mc.seed, driver::SimulatorSignalSource::kDefaultHorizonS, motion);
     }
     std::unique_ptr<driver::VirtualClock> virtual_clock;
     if (mc.speed == 1.0) {
@@ -130,9 +134,11 @@ DeviceParts makeDeviceParts(const GyrodConfig& config) {
     std::ostringstream d;
     d << "mock MPU6050 (" << toString(mc.source) << ", seed " << mc.seed << ", ";
     if (mc.speed == 1.0)
-      d << "real time)";
+      d << "real time";
     else
-      d << mc.speed << "x real time)";
+      d << mc.speed << "x real time";
+    if (!mc.motion.empty()) d << ", motion " << mc.motion;
+    d << ')';
     b.description = d.str();
     return b;
   }

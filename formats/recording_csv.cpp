@@ -3,17 +3,18 @@
 #include <algorithm>
 #include <array>
 #include <cerrno>
-#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <sstream>
 #include <string_view>
 
+#include "formats/csv_fields.hpp"
+
 namespace gyrod::recording {
 namespace {
 
-constexpr std::array<std::string_view, 5> kKnownColumns = {"t", "gx", "gy", "gz", "temp"};
+constexpr std::array<std::string_view, 8> kKnownColumns = {"t", "gx", "gy", "gz", "temp", "wx", "wy", "wz"};
 
 [[noreturn]] void fail(const std::string& path, std::size_t line, const std::string& cause) {
   std::ostringstream s;
@@ -21,37 +22,6 @@ constexpr std::array<std::string_view, 5> kKnownColumns = {"t", "gx", "gy", "gz"
   if (line > 0) s << ':' << line;
   s << ": " << cause;
   throw RecordingError(s.str());
-}
-
-std::string_view trim(std::string_view s) {
-  const auto first = s.find_first_not_of(" \t\r");
-  if (first == std::string_view::npos) return {};
-  const auto last = s.find_last_not_of(" \t\r");
-  return s.substr(first, last - first + 1);
-}
-
-std::vector<std::string_view> splitFields(std::string_view line) {
-  std::vector<std::string_view> fields;
-  std::size_t start = 0;
-  while (true) {
-    const auto comma = line.find(',', start);
-    fields.push_back(
-        trim(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start)));
-    if (comma == std::string_view::npos) break;
-    start = comma + 1;
-  }
-  return fields;
-}
-
-// Parses a whole field as a double; nullopt when it is not a number at all.
-std::optional<double> parseNumber(std::string_view field) {
-  if (field.empty()) return std::nullopt;
-  if (field.front() == '+') field.remove_prefix(1);
-  double value = 0.0;
-  const auto [end, ec] = std::from_chars(field.data(), field.data() + field.size(), value);
-  if (ec == std::errc::result_out_of_range) return HUGE_VAL;  // reported as non-finite
-  if (ec != std::errc() || end != field.data() + field.size()) return std::nullopt;
-  return value;
 }
 
 bool isSkippable(std::string_view line) { return line.empty() || line.front() == '#'; }
@@ -94,12 +64,12 @@ Recording readRecordingCsv(const std::string& path) {
   std::string_view first;
   while (std::getline(in, raw)) {
     ++line_no;
-    first = trim(raw);
+    first = trimField(raw);
     if (!skippable(first)) break;
   }
   if (isSkippable(first)) fail(path, 0, "empty file: no header and no samples");
 
-  enum class Role { T, Axis, Temp };
+  enum class Role { T, Axis, Temp, Truth };
   std::vector<std::pair<Role, std::size_t>> roles;  // per column: what it feeds, axis index
   bool bare_numbers = false;
   std::size_t header_line = line_no;
@@ -117,7 +87,7 @@ Recording readRecordingCsv(const std::string& path) {
     bool have_t = false, have_temp = false;
     for (auto name : names) {
       if (std::find(kKnownColumns.begin(), kKnownColumns.end(), name) == kKnownColumns.end())
-        fail(path, line_no, "unknown column '" + std::string(name) + "' (expected any of t,gx,gy,gz,temp)");
+        fail(path, line_no, "unknown column '" + std::string(name) + "' (expected any of t,gx,gy,gz,temp,wx,wy,wz)");
       for (std::size_t j = 0; j < roles.size(); ++j)
         if (names[j] == name) fail(path, line_no, "column '" + std::string(name) + "' appears twice");
       if (name == "t") {
@@ -126,6 +96,9 @@ Recording readRecordingCsv(const std::string& path) {
       } else if (name == "temp") {
         roles.push_back({Role::Temp, 0});
         have_temp = true;
+      } else if (const auto truth = std::find(kTruthColumns.begin(), kTruthColumns.end(), name);
+                 truth != kTruthColumns.end()) {
+        roles.push_back({Role::Truth, static_cast<std::size_t>(truth - kTruthColumns.begin())});
       } else {
         roles.push_back({Role::Axis, rec.axis_names.size()});
         rec.axis_names.emplace_back(name);
@@ -146,10 +119,11 @@ Recording readRecordingCsv(const std::string& path) {
     }
     rec.line_numbers.push_back(line_no);
     for (std::size_t c = 0; c < fields.size(); ++c) {
-      const std::string column = bare_numbers                   ? std::string("value")
-                                 : roles[c].first == Role::T    ? std::string("t")
-                                 : roles[c].first == Role::Temp ? std::string("temp")
-                                                                : rec.axis_names[roles[c].second];
+      const std::string column = bare_numbers                    ? std::string("value")
+                                 : roles[c].first == Role::T     ? std::string("t")
+                                 : roles[c].first == Role::Temp  ? std::string("temp")
+                                 : roles[c].first == Role::Truth ? std::string(kTruthColumns[roles[c].second])
+                                                                 : rec.axis_names[roles[c].second];
       const auto value = parseNumber(fields[c]);
       if (!value) fail(path, line_no, "column '" + column + "': '" + std::string(fields[c]) + "' is not a number");
       if (!std::isfinite(*value))
@@ -158,6 +132,7 @@ Recording readRecordingCsv(const std::string& path) {
         case Role::T: rec.t.push_back(*value); break;
         case Role::Temp: rec.temp.push_back(*value); break;
         case Role::Axis: rec.axes[roles[c].second].push_back(*value); break;
+        case Role::Truth: rec.true_rate[roles[c].second].push_back(*value); break;
       }
     }
   };
@@ -165,7 +140,7 @@ Recording readRecordingCsv(const std::string& path) {
   if (bare_numbers) consume(first);
   while (std::getline(in, raw)) {
     ++line_no;
-    const auto line = trim(raw);
+    const auto line = trimField(raw);
     if (skippable(line)) continue;
     if (bare_numbers && line.find(',') != std::string_view::npos)
       fail(path, line_no, "more than one column in a file of bare numbers (add a header t,gx,gy,gz,temp)");

@@ -1,6 +1,7 @@
 #pragma once
 // Recording files: CSV with a header naming any of the columns t,gx,gy,gz,temp
-// (seconds, °/s, °/s, °/s, °C), or a file of bare numbers (one column, one axis). Lines
+// (seconds, °/s, °/s, °/s, °C) and, in what `gyroctl simulate --motion` writes, the true
+// rates wx,wy,wz (°/s), or a file of bare numbers (one column, one axis). Lines
 // starting with '#' are comments; the "# GAP" and "# DROPPED" lines gyrod writes
 // (recording_format.hpp) are returned as LostSamples records, and a line that only looks
 // like one (say "# GAP at 12 s") stays an ordinary comment, as every '#' line always was.
@@ -27,6 +28,9 @@ struct Recording {
   std::vector<std::string> axis_names;    // "gx", "gy", "gz" in file order (or "x" for bare numbers)
   std::vector<std::vector<double>> axes;  // one vector per axis_names entry
   std::vector<double> temp;               // empty when absent
+  // The truth wx, wy, wz of a simulated recording with motion, per axis; empty when absent
+  // (gyrod's recordings never have it: the chip cannot know it).
+  std::array<std::vector<double>, 3> true_rate;
   std::vector<std::size_t> line_numbers;  // file line of each sample, for error messages
   std::vector<LostSamples> lost;          // the GAP and DROPPED lines, in file order
   std::size_t size() const { return axes.empty() ? 0 : axes.front().size(); }
@@ -35,6 +39,8 @@ struct Recording {
 
 // The gyro columns in axis order: gx is the x axis (0), gy the y axis (1), gz the z axis (2).
 inline constexpr std::array<std::string_view, 3> kGyroColumns = {"gx", "gy", "gz"};
+// The truth columns in axis order (gyroctl simulate --motion).
+inline constexpr std::array<std::string_view, 3> kTruthColumns = {"wx", "wy", "wz"};
 // The name Recording gives the one column of a file of bare numbers.
 inline constexpr std::string_view kBareNumbersColumn = "x";
 // The axis (0 = x, 1 = y, 2 = z) a recording column measures: gx, gy, gz, and the column

@@ -1,6 +1,7 @@
 #include "driver/mock/simulator_signal_source.hpp"
 
 #include <stdexcept>
+#include <utility>
 
 #include "driver/mpu6050_registers.hpp"
 
@@ -21,8 +22,11 @@ processing::SimulationModel modelAtInternalRate(processing::SimulationModel mode
 }  // namespace
 
 SimulatorSignalSource::SimulatorSignalSource(const processing::SimulationModel& model, int dlpf_cfg, std::uint64_t seed,
-                                             double horizon_s)
-    : simulator_(std::make_unique<processing::NoiseSimulator>(modelAtInternalRate(model, dlpf_cfg), horizon_s, seed)) {}
+                                             double horizon_s, processing::MotionProfile motion)
+    : simulator_(motion.atRest() ? std::make_unique<processing::NoiseSimulator>(modelAtInternalRate(model, dlpf_cfg),
+                                                                                horizon_s, seed)
+                                 : std::make_unique<processing::NoiseSimulator>(modelAtInternalRate(model, dlpf_cfg),
+                                                                                horizon_s, seed, std::move(motion))) {}
 
 AnalogSample SimulatorSignalSource::nextTick(double /*t_s*/) {
   const processing::SimulatedSample s = simulator_->nextAnalog();

@@ -1,7 +1,9 @@
 #pragma once
 // The noise simulator (processing/noise_simulator.hpp) as what the mock MPU-6050 "feels":
 // one analog sample per internal gyro tick (bias, ARW, bias instability, RRW, ramp and
-// the temperature curve). The mock applies the DLPF, decimation and quantisation itself.
+// the temperature curve, plus the true rate of a motion profile when the board is turned).
+// The mock applies the DLPF, decimation, saturation and quantisation itself, so they act on
+// the motion as on the chip.
 //
 // Not included: the two terms the simulator defines at the *output* rate — angle
 // quantization noise Q and the AR(p) component — because the mock's output rate is set by
@@ -17,12 +19,15 @@ namespace gyrod::driver {
 
 class SimulatorSignalSource final : public SignalSource {
  public:
+  static constexpr double kDefaultHorizonS = 7.0 * 24 * 3600;  // a week of running
+
   // `dlpf_cfg` selects the internal rate the chip will tick at (8 kHz for 0 and 7, else
   // 1 kHz); it must match CONFIG.DLPF_CFG as the driver will set it. `horizon_s` is the
   // longest run the flicker (bias-instability) model is built for. Throws
-  // std::invalid_argument for a model the simulator rejects.
+  // std::invalid_argument for a model the simulator rejects. `motion` turns the board (time
+  // from the first tick); at rest by default, which gives the very samples it always gave.
   SimulatorSignalSource(const processing::SimulationModel& model, int dlpf_cfg, std::uint64_t seed,
-                        double horizon_s = 7.0 * 24 * 3600);
+                        double horizon_s = kDefaultHorizonS, processing::MotionProfile motion = {});
   double expectedTickRateHz() const override { return simulator_->internalRateHz(); }
   AnalogSample nextTick(double t_s) override;
 

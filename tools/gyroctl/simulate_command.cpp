@@ -1,5 +1,7 @@
-// gyroctl simulate: a recording of the simulated gyro at rest (docs/simulator.md), as the
-// CSV that analyze/filter read: t,gx,gy,gz,temp.
+// gyroctl simulate: a recording of the simulated gyro (docs/simulator.md), as the CSV that
+// analyze/filter read: t,gx,gy,gz,temp; with --motion, turned by a motion spec
+// (formats/motion_spec.hpp) and followed by the truth wx,wy,wz that any stream can be scored on.
+#include <cerrno>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -8,8 +10,10 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "formats/model_toml.hpp"
+#include "formats/motion_spec.hpp"
 #include "formats/output_file.hpp"
 #include "processing/noise_simulator.hpp"
 #include "tools/gyroctl/commands.hpp"
@@ -26,6 +30,7 @@ struct SimulateOptions {
   std::optional<double> rate_hz;
   std::uint64_t seed = 1;
   std::optional<int> dlpf, fs_sel;
+  std::string motion;  // empty: at rest, and no truth columns (the output stays as it always was)
   std::string output;
 };
 
@@ -35,6 +40,7 @@ constexpr double kMaxSimulateDurationS = 1e7;  // about 116 days
 // A line is five %.17g numbers: each at most 24 characters ("-1.2345678901234567e-308"),
 // four commas and a newline. The estimate is an upper bound, real lines are a little shorter.
 constexpr std::uint64_t kMaxSimulateLineBytes = 5 * 24 + 5;
+constexpr std::uint64_t kMaxSimulateLineBytesWithTruth = 8 * 24 + 8;  // + wx,wy,wz
 constexpr std::size_t kSamplesBetweenWriteChecks = 1 << 16;
 
 std::string byteCount(double bytes) {
@@ -59,12 +65,12 @@ void requireDurationWithinBound(double duration_s) {
 }
 
 // Refuses before writing when the recording cannot fit on the target's filesystem.
-void requireRoomFor(std::size_t samples, const formats::AtomicOutputFile& out) {
-  const double needed = static_cast<double>(samples) * static_cast<double>(kMaxSimulateLineBytes) + 64.0;
+void requireRoomFor(std::size_t samples, std::uint64_t line_bytes, const formats::AtomicOutputFile& out) {
+  const double needed = static_cast<double>(samples) * static_cast<double>(line_bytes) + 64.0;
   const std::uint64_t available = out.availableBytes();
   if (needed > static_cast<double>(available))
     throw std::invalid_argument(out.target() + ": " + std::to_string(samples) + " samples need up to " +
-                                byteCount(needed) + " (" + std::to_string(kMaxSimulateLineBytes) +
+                                byteCount(needed) + " (" + std::to_string(line_bytes) +
                                 " bytes a line) but its filesystem has " + byteCount(static_cast<double>(available)) +
                                 " free");
 }
@@ -89,19 +95,28 @@ int runSimulate(const SimulateOptions& opt) {
   if (opt.fs_sel) model.fs_sel = *opt.fs_sel;
 
   requireDurationWithinBound(opt.duration_s);
-  NoiseSimulator sim(model, opt.duration_s, opt.seed);  // validates; std::invalid_argument → exit 2
-  formats::AtomicOutputFile out(opt.output, {opt.model_file});
+  // Both validate: std::invalid_argument (bad model or profile text) and RecordingError (bad
+  // motion CSV) → exit 2.
+  const bool with_motion = !opt.motion.empty();
+  NoiseSimulator sim = with_motion
+                           ? NoiseSimulator(model, opt.duration_s, opt.seed, recording::motionFromSpec(opt.motion))
+                           : NoiseSimulator(model, opt.duration_s, opt.seed);
+  std::vector<std::string> inputs{opt.model_file};
+  if (with_motion && !recording::isMotionProfileText(opt.motion)) inputs.push_back(opt.motion);
+  formats::AtomicOutputFile out(opt.output, inputs);
   const std::size_t n = sim.sampleCount();
-  requireRoomFor(n, out);
+  requireRoomFor(n, with_motion ? kMaxSimulateLineBytesWithTruth : kMaxSimulateLineBytes, out);
   std::FILE* f = out.stream();
-  std::fputs("t,gx,gy,gz,temp\n", f);
+  std::fputs(with_motion ? "t,gx,gy,gz,temp,wx,wy,wz\n" : "t,gx,gy,gz,temp\n", f);
   for (std::size_t i = 0; i < n; ++i) {
     // Stop at the first failed write (a full disk) instead of computing the rest.
     if (i % kSamplesBetweenWriteChecks == 0 && out.failed()) break;
     const SimulatedSample s = sim.next();
     // 17 significant digits: every double survives the text round trip exactly.
-    std::fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g\n", s.t_s, s.rate_dps[0], s.rate_dps[1], s.rate_dps[2],
+    std::fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g", s.t_s, s.rate_dps[0], s.rate_dps[1], s.rate_dps[2],
                  s.temperature_c);
+    if (with_motion) std::fprintf(f, ",%.17g,%.17g,%.17g", s.true_rate_dps[0], s.true_rate_dps[1], s.true_rate_dps[2]);
+    std::fputc('\n', f);
   }
   out.commit();
   std::fprintf(stderr, "wrote %zu samples at %g Hz (%s%s, seed %llu) to %s\n", n, model.rate_hz,
@@ -115,8 +130,10 @@ int runSimulate(const SimulateOptions& opt) {
 
 void addSimulateCommand(CLI::App& app, CommandRunner& run) {
   auto opt = std::make_shared<SimulateOptions>();
-  auto* sub = app.add_subcommand("simulate",
-                                 "Write a simulated MPU6050 recording at rest (t,gx,gy,gz,temp) from a noise model");
+  auto* sub =
+      app.add_subcommand("simulate",
+                         "Write a simulated MPU6050 recording (t,gx,gy,gz,temp; with --motion also the truth wx,wy,wz) "
+                         "from a noise model");
   auto* model = sub->add_option("--model", opt->model_file, "model file (TOML, see docs/simulator.md)");
   auto* terms = sub->add_option_group("terms", "noise terms on all three axes (instead of --model)");
   auto* q = terms->add_option("--quantization", opt->quantization, "quantization noise Q [urad]");
@@ -132,6 +149,9 @@ void addSimulateCommand(CLI::App& app, CommandRunner& run) {
   sub->add_option("--seed", opt->seed, "random seed (same seed, same file on every machine)")->default_val(1);
   sub->add_option("--dlpf", opt->dlpf, "DLPF_CFG 0..6 (default: the model file's, else no DLPF)");
   sub->add_option("--fs-sel", opt->fs_sel, "FS_SEL 0..3: quantise and saturate (default: the model file's, else not)");
+  sub->add_option("--motion", opt->motion,
+                  "true rotation: profiles such as step:axis=z,at=5,rate=10 (summed with +), or a CSV t,wx,wy,wz; "
+                  "adds the truth columns wx,wy,wz (docs/simulator.md)");
   sub->add_option("-o,--output", opt->output, "output CSV")->required();
   sub->callback([&run, opt] { run = [opt] { return runSimulate(*opt); }; });
 }
