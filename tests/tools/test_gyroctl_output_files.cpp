@@ -151,6 +151,18 @@ TEST(GyroctlOutputFiles, TheInputIsNeverTheOutputUnderAnyName) {
   EXPECT_EQ(fs::hard_link_count(rec), 2u);
 }
 
+TEST(GyroctlOutputFiles, SimulateNeverWritesOverItsMotionFile) {
+  ScratchDir d;
+  const auto motion = d.write("turns.csv", "t,wz\n0,0\n1,90\n2,0\n");
+  expectRefusal("simulate --arw 0.5 --duration 2 --motion " + motion.string() + " -o " + motion.string(), d, motion,
+                {motion.string() + ": refusing to write the output over the input " + motion.string()});
+  // A profile written as text is no file, so it names no input.
+  const auto out = d.path() / "sim.csv";
+  const auto r =
+      runGyroctl("simulate --arw 0.5 --duration 2 --motion step:axis=z,at=1,rate=10 -o " + out.string(), d.path());
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+}
+
 TEST(GyroctlOutputFiles, ASymbolicLinkToARegularFileIsWrittenThrough) {
   ScratchDir d;
   const auto rec = d.write("rec.csv", noiseCsv(300, 3));
