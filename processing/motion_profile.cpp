@@ -221,8 +221,10 @@ double MotionProfile::settledFrom() const {
     case Kind::Sine:
     case Kind::Constant:
       return std::isinf(d_) ? (kind_ == Kind::Constant ? c_ : kForever) : c_ + d_;
-    case Kind::Turns:
-      return d_ + std::ceil(a_) * (c_ + 360.0 / std::fabs(b_));
+    case Kind::Turns: {
+      const double turn_s = 360.0 / std::fabs(b_), full = std::floor(a_), part = a_ - full;
+      return d_ + full * (c_ + turn_s) + (part > 0.0 ? c_ + part * turn_s : 0.0);
+    }
     case Kind::Sum: {
       double latest = 0.0;
       for (const MotionProfile& part : parts_) latest = std::max(latest, part.settledFrom());

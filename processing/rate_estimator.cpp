@@ -74,7 +74,9 @@ RateEstimator::RateEstimator(const RateEstimatorParameters& params)
     : params_(params), detector_(params.still, levelsOf(params)) {
   const double tau0 = 1.0 / params_.rate_hz;
   for (std::size_t a = 0; a < kMotionAxes; ++a) {
-    axes_[a].q_per_sample = driftProcessNoisePerSecond(params_.axes[a].terms, params_.bias_instability_horizon_s) * tau0;
+    const double q_per_second =
+        driftProcessNoisePerSecond(params_.axes[a].terms, params_.bias_instability_horizon_s);
+    axes_[a].q_per_sample = q_per_second * tau0;
     axes_[a].measurement_var = detector_.windowVariance(a);
   }
   if (params_.temperature_smoothing_s > 0.0) temperature_alpha_ = -std::expm1(-tau0 / params_.temperature_smoothing_s);
@@ -102,7 +104,8 @@ void RateEstimator::reset() {
 
 double RateEstimator::priorVariance(std::size_t a) const {
   const AxisState& s = axes_[a];
-  const double dt_model = params_.axes[a].temperature_coefficient_std_dps_per_c * (temperature_ - temperature_at_update_);
+  const double dt_model =
+      params_.axes[a].temperature_coefficient_std_dps_per_c * (temperature_ - temperature_at_update_);
   return s.posterior_var + s.q_per_sample * static_cast<double>(samples_since_update_) + dt_model * dt_model;
 }
 

@@ -20,8 +20,9 @@
 //       of windows (each window used once), so consecutive measurements do not overlap.
 // A constant rotation ω below the detector's resolution passes as still and is learned as
 // bias: after n updates the fraction 1 − Π(1 − K_i) of ω, with K_i the filter's gains
-// (K ≈ √(q·W·τ0/σm²) in steady state, ≈ 1/1000 per update for the paper's terms and
-// T_B = 100 s: a time constant of about W·τ0/K ≈ 8 min). Faster than that it cannot learn,
+// (K ≈ √(q·W·τ0/σm²) in steady state: 5·10⁻⁴ per 0.5 s window for the paper's Table 2 terms
+// and T_B = 100 s, a time constant W·τ0/K of about 17 min; 5·10⁻³ and 100 s with the terms a
+// 1 h still record's Allan fit gives, docs/motion.md). Faster than that it cannot learn,
 // whatever the data: the process noise is the model's, not a tuning knob. A rotation above
 // the resolution is refused by the gate (the detector's mean test is the innovation test
 // |c̄ − r̂| ≤ z·√(σm² + P)) until P has grown, at the rate q, to let it in.
