@@ -68,7 +68,12 @@ SimulationModel paperSensor(double start_c = 25.0, double final_c = 25.0, double
 // Allan fit (the detector's noise levels and the residual's process noise) and its mean (the
 // bias). The temperature coefficient comes from elsewhere (a warm-up record); here the true one
 // times (1 + error), with its 1σ stated as 10 %.
-RateEstimatorParameters calibrateFrom(std::uint64_t seed) {
+struct Calibration {
+  RateEstimatorParameters rate;
+  FilterChainParameters paper;  // the paper's chain identified from the same record (x axis)
+};
+
+Calibration calibrateFrom(std::uint64_t seed) {
   const SimulationModel still = paperSensor();
   NoiseSimulator sim(still, 3600.0, seed);
   std::array<std::vector<double>, 3> records;
@@ -89,14 +94,20 @@ RateEstimatorParameters calibrateFrom(std::uint64_t seed) {
     m.bias_dps = sum / static_cast<double>(r.size());
     m.bias_std_dps = curve.back().oadev;  // the mean of a record is as good as its longest τ
   }
-  return p;
+  std::vector<double> x_without_bias = records[0];
+  for (double& v : x_without_bias) v -= p.axes[0].bias_dps;
+  return {p, identifyFilterChain(x_without_bias, 20, 0.3)};
+}
+
+const Calibration& calibration() {
+  static const Calibration calibrated = calibrateFrom(100);
+  return calibrated;
 }
 
 // One calibration (a 1 h still record, as the paper's) serves every test: the tests' own
 // records use other seeds.
 RateEstimatorParameters calibrate(std::array<double, 3> coefficient_error = {}) {
-  static const RateEstimatorParameters calibrated = calibrateFrom(100);
-  RateEstimatorParameters p = calibrated;
+  RateEstimatorParameters p = calibration().rate;
   for (std::size_t a = 0; a < 3; ++a) {
     AxisBiasModel& m = p.axes[a];
     m.temperature_coefficient_dps_per_c = kTrueCoefficient[a] * (1.0 + coefficient_error[a]);
@@ -117,6 +128,7 @@ double steadyResidualGain(const RateEstimatorParameters& params, std::size_t axi
 struct Record {
   std::vector<SimulatedSample> sim;
   std::vector<RateSample> est;
+  std::vector<AngularRate> paper_kalman;  // the paper's stream beside it, for the record
   std::array<double, 3> final_residual_variance{};  // the estimator's own P at the end
 };
 
@@ -124,12 +136,18 @@ Record run(const SimulationModel& model, const MotionProfile& motion, double sec
            const RateEstimatorParameters& params) {
   NoiseSimulator sim(model, seconds, seed, motion);
   RateEstimator estimator(params);
+  const FilterChainParameters& paper = calibration().paper;
+  std::array<AxisFilterChain, 3> chains = {AxisFilterChain(paper), AxisFilterChain(paper), AxisFilterChain(paper)};
   Record r;
   r.sim.reserve(sim.sampleCount());
   r.est.reserve(sim.sampleCount());
   for (std::size_t i = 0; i < sim.sampleCount(); ++i) {
     r.sim.push_back(sim.next());
     r.est.push_back(estimator.update(r.sim.back().t_s, r.sim.back().rate_dps, r.sim.back().temperature_c));
+    AngularRate k{};
+    for (std::size_t a = 0; a < 3; ++a)
+      k[a] = chains[a].update(r.sim.back().rate_dps[a] - params.axes[a].bias_dps).kalman_dps;
+    r.paper_kalman.push_back(k);
   }
   for (std::size_t a = 0; a < 3; ++a) r.final_residual_variance[a] = estimator.residualVariance(a);
   return r;
@@ -144,6 +162,10 @@ double anySign(std::mt19937_64& rng) { return std::bernoulli_distribution(0.5)(r
 }  // namespace
 
 TEST(RateEstimator, StepIsWithinTwoPercentAtTheThirdSample) {
+  const ScalarKalmanParameters& k = calibration().paper.kalman;
+  const double gain = steadyStateGain(k.a, k.q, k.r);
+  std::printf("paper's chain identified on the calibration record: A %.4f, K %.4f, DC gain K/(1 - A(1 - K)) %.4f\n",
+              k.a, gain, gain / (1.0 - k.a * (1.0 - gain)));
   for (std::uint64_t seed : {1, 2, 3}) {
     // Hidden: 40 steps of ±10 °/s on a random axis, each after a still period of random
     // length (so the step falls anywhere between two samples), held for 1.5 s.
@@ -165,16 +187,21 @@ TEST(RateEstimator, StepIsWithinTwoPercentAtTheThirdSample) {
       t += rest + 1.5;
     }
     const Record r = run(paperSensor(), MotionProfile::sequence(segments), t + 1.0, seed, calibrate());
-    double sum_ratio = 0.0, sum_raw_ratio = 0.0;
+    double sum_ratio = 0.0, sum_raw_ratio = 0.0, sum_kalman_ratio = 0.0, sum_kalman_end = 0.0;
     for (const Step& s : steps) {
       const auto first = static_cast<std::size_t>(std::ceil(s.t * kRateHz - 1e-9));  // first sample at/after
       const std::size_t third = first + 2;
       sum_ratio += r.est[third].rate_dps[s.axis] / s.size;
       sum_raw_ratio += r.sim[third].rate_dps[s.axis] / s.size;
+      sum_kalman_ratio += r.paper_kalman[third][s.axis] / s.size;
+      sum_kalman_end += r.paper_kalman[first + 74][s.axis] / s.size;
     }
-    const double ratio = sum_ratio / static_cast<double>(steps.size());
-    std::printf("seed %llu: rate at the 3rd sample after a 10 deg/s step: %.4f of the step (raw %.4f)\n",
-                static_cast<unsigned long long>(seed), ratio, sum_raw_ratio / static_cast<double>(steps.size()));
+    const double n = static_cast<double>(steps.size());
+    const double ratio = sum_ratio / n;
+    std::printf("seed %llu: at the 3rd sample after a 10 deg/s step: rate %.4f of the step, raw %.4f, paper's "
+                "kalman %.4f (%.4f after 1.5 s)\n",
+                static_cast<unsigned long long>(seed), ratio, sum_raw_ratio / n, sum_kalman_ratio / n,
+                sum_kalman_end / n);
     EXPECT_NEAR(ratio, 1.0, 0.02);
   }
 }
@@ -207,17 +234,21 @@ TEST(RateEstimator, OneHertzSineKeepsItsAmplitudeAndPhase) {
     const double start = uniform(rng, 5.0, 10.0);
     const MotionProfile motion = MotionProfile::sine(axis, 1.0, 20.0, start, 40.0);
     const Record r = run(paperSensor(), motion, start + 45.0, seed, calibrate());
-    std::vector<double> t, rate, kalman_in, truth;
+    std::vector<double> t, rate, kalman, truth;
     for (std::size_t i = 0; i < r.sim.size(); ++i) {
       if (r.sim[i].t_s < start + 1.0 || r.sim[i].t_s >= start + 39.0) continue;
       t.push_back(r.sim[i].t_s);
       rate.push_back(r.est[i].rate_dps[axis]);
+      kalman.push_back(r.paper_kalman[i][axis]);
       truth.push_back(r.sim[i].true_rate_dps[axis]);
     }
+    const SineFit paper = fitSine(t, kalman, 1.0, start);
     const SineFit want = fitSine(t, truth, 1.0, start), got = fitSine(t, rate, 1.0, start);
     const double gain = got.amplitude / want.amplitude, lag = got.phase_deg - want.phase_deg;
-    std::printf("seed %llu: 1 Hz 20 deg/s on axis %zu: amplitude %.4f, phase %+.2f deg\n",
-                static_cast<unsigned long long>(seed), axis, gain, lag);
+    std::printf("seed %llu: 1 Hz 20 deg/s on axis %zu: rate amplitude %.4f, phase %+.2f deg; paper's kalman "
+                "%.4f, %+.1f deg\n",
+                static_cast<unsigned long long>(seed), axis, gain, lag, paper.amplitude / want.amplitude,
+                paper.phase_deg - want.phase_deg);
     EXPECT_NEAR(gain, 1.0, 0.02);
     EXPECT_LE(std::fabs(lag), 5.0);
   }
@@ -232,16 +263,18 @@ TEST(RateEstimator, TenTurnsIntegrateToTheTrueAngle) {
     const MotionProfile motion = MotionProfile::turns(axis, 10.0, rate, still, 5.0);
     const double seconds = motion.settledFrom() + still + 1.0;
     const Record r = run(paperSensor(), motion, seconds, seed, calibrate());
-    double angle = 0.0, raw_angle = 0.0;
+    double angle = 0.0, raw_angle = 0.0, kalman_angle = 0.0;
     for (std::size_t i = 0; i < r.sim.size(); ++i) {
       angle += r.est[i].rate_dps[axis] * kTau0;
+      kalman_angle += r.paper_kalman[i][axis] * kTau0;
       raw_angle += r.sim[i].rate_dps[axis] * kTau0;
     }
     const double truth = 3600.0 * (rate > 0 ? 1.0 : -1.0);
     const double error = std::fabs(angle - truth) / 3600.0;
-    std::printf("seed %llu: 10 turns at %.1f deg/s on axis %zu: angle error %.4f %% (raw %.3f %%)\n",
+    std::printf("seed %llu: 10 turns at %.1f deg/s on axis %zu: angle error %.4f %% (raw %.3f %%, paper's kalman "
+                "%+.1f %%)\n",
                 static_cast<unsigned long long>(seed), rate, axis, 100.0 * error,
-                100.0 * std::fabs(raw_angle - truth) / 3600.0);
+                100.0 * std::fabs(raw_angle - truth) / 3600.0, 100.0 * (kalman_angle / truth - 1.0));
     EXPECT_LE(error, 0.005);
   }
 }
