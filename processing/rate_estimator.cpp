@@ -77,7 +77,9 @@ RateEstimator::RateEstimator(const RateEstimatorParameters& params)
     const double q_per_second =
         driftProcessNoisePerSecond(params_.axes[a].terms, params_.bias_instability_horizon_s);
     axes_[a].q_per_sample = q_per_second * tau0;
-    axes_[a].measurement_var = detector_.windowVariance(a);
+    // A window mean of variance σm² is worth W samples of variance W·σm² each (at the low
+    // frequencies the residual tracks, the noise is white at the level of the Allan fit).
+    axes_[a].sample_var = detector_.windowVariance(a) * static_cast<double>(params_.still.window_samples);
   }
   if (params_.temperature_smoothing_s > 0.0) temperature_alpha_ = -std::expm1(-tau0 / params_.temperature_smoothing_s);
   if (params_.low_pass_hz) {
@@ -93,60 +95,70 @@ void RateEstimator::reset() {
   detector_.reset();
   for (std::size_t a = 0; a < kMotionAxes; ++a) {
     AxisState& s = axes_[a];
-    s.residual = 0.0;
-    s.posterior_var = params_.axes[a].bias_std_dps * params_.axes[a].bias_std_dps;
+    const double bias_std = params_.axes[a].bias_std_dps, k_std = params_.axes[a].temperature_coefficient_std_dps_per_c;
+    s.offset = s.slope = 0.0;
+    s.p_oo = bias_std * bias_std;
+    s.p_os = 0.0;
+    s.p_ss = k_std * k_std;
   }
   started_ = false;
   low_pass_primed_ = false;
-  samples_since_update_ = 0;
   updates_ = 0;
 }
 
-double RateEstimator::priorVariance(std::size_t a) const {
-  const AxisState& s = axes_[a];
-  const double dt_model =
-      params_.axes[a].temperature_coefficient_std_dps_per_c * (temperature_ - temperature_at_update_);
-  return s.posterior_var + s.q_per_sample * static_cast<double>(samples_since_update_) + dt_model * dt_model;
+double RateEstimator::residual(std::size_t axis) const {
+  const AxisState& s = axes_.at(axis);
+  return s.offset + s.slope * (temperature_ - temperature_start_);
 }
 
-double RateEstimator::residualVariance(std::size_t axis) const { return priorVariance(axis); }
+double RateEstimator::residualVariance(std::size_t axis) const {
+  const AxisState& s = axes_.at(axis);
+  const double h = temperature_ - temperature_start_;
+  return s.p_oo + 2.0 * h * s.p_os + h * h * s.p_ss;
+}
+
+void RateEstimator::measure(std::size_t a, double corrected) {
+  // Kalman update of [offset, slope] by c = offset + slope·h + v, h = T − T_start, var(v) = R.
+  AxisState& s = axes_[a];
+  const double h = temperature_ - temperature_start_;
+  const double ph_o = s.p_oo + h * s.p_os, ph_s = s.p_os + h * s.p_ss;  // P·hᵀ
+  const double innovation_var = ph_o + h * ph_s + s.sample_var;
+  const double gain_o = ph_o / innovation_var, gain_s = ph_s / innovation_var;
+  const double innovation = corrected - (s.offset + s.slope * h);
+  s.offset += gain_o * innovation;
+  s.slope += gain_s * innovation;
+  s.p_oo -= gain_o * ph_o;
+  s.p_os -= gain_o * ph_s;
+  s.p_ss -= gain_s * ph_s;
+}
 
 RateSample RateEstimator::update(double t_s, const AngularRate& raw_dps, double temperature_c) {
   if (!started_) {
     started_ = true;
     t_first_ = t_s;
-    temperature_ = temperature_at_update_ = temperature_c;
+    temperature_ = temperature_start_ = temperature_c;
   } else {
     temperature_ += temperature_alpha_ * (temperature_c - temperature_);
   }
-  ++samples_since_update_;
   const double since_start = t_s - t_first_;
   AngularRate model{}, corrected{}, expected{}, expected_var{};
   for (std::size_t a = 0; a < kMotionAxes; ++a) {
+    axes_[a].p_oo += axes_[a].q_per_sample;  // the offset walks; the slope (k's error) is a constant
     model[a] = params_.axes[a].biasAt(temperature_, since_start);
     corrected[a] = raw_dps[a] - model[a];
-    expected[a] = axes_[a].residual;
-    expected_var[a] = priorVariance(a);
+    expected[a] = residual(a);
+    expected_var[a] = residualVariance(a);
   }
   const bool still = detector_.update(corrected, expected, expected_var);
-  const std::size_t window = detector_.windowSamples();
-  if (still && detector_.stillRun() % window == 0) {
-    // A whole window since the last one, every sample of it still: one measurement.
-    for (std::size_t a = 0; a < kMotionAxes; ++a) {
-      AxisState& s = axes_[a];
-      const double gain = expected_var[a] / (expected_var[a] + s.measurement_var);
-      s.residual += gain * (detector_.windowMean(a) - s.residual);
-      s.posterior_var = (1.0 - gain) * expected_var[a];
-    }
-    samples_since_update_ = 0;
-    temperature_at_update_ = temperature_;
+  if (still) {
+    for (std::size_t a = 0; a < kMotionAxes; ++a) measure(a, corrected[a]);
     ++updates_;
   }
   RateSample out;
   out.still = still;
   for (std::size_t a = 0; a < kMotionAxes; ++a) {
     AxisState& s = axes_[a];
-    out.bias_dps[a] = model[a] + s.residual;
+    out.bias_dps[a] = model[a] + residual(a);
     double rate = raw_dps[a] - out.bias_dps[a];
     if (params_.low_pass_hz) {
       const double x = rate;

@@ -2,30 +2,34 @@
 // The `rate` stream: the rotation rate of a gyro that moves and warms up (issue 11),
 //   rate = raw − b̂(t), then an optional low-pass (off by default, so no delay),
 //   b̂(t) = model bias at the current temperature (+ warm-up shape) + residual r̂,
-// r̂ tracked per axis by a scalar Kalman filter on a random walk, updated only from windows
-// the StillDetector passes. Unlike the paper's AR(1) filter (a 0.3 Hz low-pass of DC gain
-// ≈ 0.44, docs/motion.md), nothing here acts on the motion itself: a rotation goes through
-// with gain 1 and no delay beyond the chip's DLPF.
+// r̂ tracked per axis by a small Kalman filter, updated only by samples whose window the
+// StillDetector passes. Unlike the paper's AR(1) filter (a low-pass of DC gain ≈ 0.45,
+// docs/motion.md), nothing here acts on the motion itself: a rotation goes through with gain 1
+// and no delay beyond the chip's DLPF.
 //
-// The residual filter, per axis (τ0 = 1/rate, W the detector's window):
-//   process noise per second  q = K² + 2·cB/T_B + R²·T_B, from the Allan fit: K² = 3·c_K
-//       (rate random walk), cB = (0.6643·B)² the flicker floor turned into a random walk
-//       that moves by √(2cB) (the Allan deviation's definition) in the horizon T_B, and the
-//       ramp R moving by R·T_B in T_B;
-//   plus the temperature model's error: with k known to ±σk, the model bias is off by a
-//       further σk·|T − T_u| since the last update (T_u its temperature); added at the
-//       update as (σk·(T − T_u))² because that error is one unknown k, not noise;
-//   measurement  the mean of c = raw − model bias over the detector's window, variance
-//       σm² = Allan variance at W·τ0; used when the sensor has been still for a whole number
-//       of windows (each window used once), so consecutive measurements do not overlap.
+// The residual filter, per axis (τ0 = 1/rate, W the detector's window), state [offset, slope]
+// with r̂ = offset + slope·(T − T_start):
+//   offset  a random walk of intensity (per second) q = K² + 2·cB/T_B + R²·T_B, from the Allan
+//       fit: K² = 3·c_K (rate random walk), cB = (0.6643·B)² the flicker floor turned into a
+//       random walk that moves by √(2cB) (the Allan deviation's definition) in the horizon
+//       T_B, and the ramp R moving by R·T_B in T_B; starts at 0 ± the model's bias_std_dps;
+//   slope   the error of the model's temperature coefficient: a constant, 0 ± its 1σ (σk), so
+//       still periods at different temperatures correct k itself, not only the bias;
+//   measurement  each still sample's c = raw − model bias, variance W·σm² (σm² = the Allan
+//       variance at W·τ0: at the low frequencies the residual follows, W such samples are
+//       worth one window mean of variance σm²).
+// Updating with the current sample before subtracting keeps the correction a first-order
+// smoother of the data itself, whose complement |1 − H(f)| ≤ 1 at every f: at rest the rate's
+// Allan variance cannot exceed raw's at any τ (a correction that lags by a window would raise
+// it by about its gain at τ of a few windows).
 // A constant rotation ω below the detector's resolution passes as still and is learned as
-// bias: after n updates the fraction 1 − Π(1 − K_i) of ω, with K_i the filter's gains
-// (K ≈ √(q·W·τ0/σm²) in steady state: 5·10⁻⁴ per 0.5 s window for the paper's Table 2 terms
-// and T_B = 100 s, a time constant W·τ0/K of about 17 min; 5·10⁻³ and 100 s with the terms a
-// 1 h still record's Allan fit gives, docs/motion.md). Faster than that it cannot learn,
-// whatever the data: the process noise is the model's, not a tuning knob. A rotation above
-// the resolution is refused by the gate (the detector's mean test is the innovation test
-// |c̄ − r̂| ≤ z·√(σm² + P)) until P has grown, at the rate q, to let it in.
+// bias: after n samples the fraction 1 − Π(1 − K_i) of ω, with K_i the filter's gains
+// (K ≈ √(q·τ0/(W·σm²)) per sample in steady state: 2·10⁻⁵ for the paper's Table 2 terms and
+// T_B = 100 s, a time constant τ0/K of about 17 min; 2·10⁻⁴ and 90 s with the terms a 1 h
+// still record's Allan fit gives, docs/motion.md). Faster than that it cannot learn, whatever
+// the data: the process noise is the model's, not a tuning knob. A rotation above the
+// resolution is refused by the gate (the detector's mean test is the innovation test
+// |c̄ − r̂| ≤ z·√(σm² + var r̂)) until var r̂ has grown, at the rate q, to let it in.
 //
 // update() allocates nothing; storage (the detector's ring) is sized at construction.
 #include <array>
@@ -81,21 +85,22 @@ class RateEstimator {
   void reset();
 
   const StillDetector& detector() const { return detector_; }
-  double residual(std::size_t axis) const { return axes_.at(axis).residual; }
-  double residualVariance(std::size_t axis) const;  // P now (prior when between updates)
+  // r̂ at the current temperature and its variance h·P·hᵀ (h = [1, T − T_start]).
+  double residual(std::size_t axis) const;
+  double residualVariance(std::size_t axis) const;
   double processNoisePerSecond(std::size_t axis) const { return axes_.at(axis).q_per_sample * params_.rate_hz; }
-  std::size_t updates() const { return updates_; }  // residual updates so far
+  std::size_t updates() const { return updates_; }  // samples that updated the residual
   const RateEstimatorParameters& parameters() const { return params_; }
 
  private:
   struct AxisState {
-    double residual = 0.0;
-    double posterior_var = 0.0;  // P after the last update
+    double offset = 0.0, slope = 0.0;          // r̂ = offset + slope·(T − T_start)
+    double p_oo = 0.0, p_os = 0.0, p_ss = 0.0;  // their covariance
     double q_per_sample = 0.0;
-    double measurement_var = 0.0;  // σm²
+    double sample_var = 0.0;  // R = W·σm²
     double lp_in = 0.0, lp_out = 0.0;
   };
-  double priorVariance(std::size_t axis) const;
+  void measure(std::size_t axis, double corrected);
 
   RateEstimatorParameters params_;
   StillDetector detector_;
@@ -104,9 +109,8 @@ class RateEstimator {
   bool low_pass_primed_ = false;
   double t_first_ = 0.0;
   double temperature_ = 0.0;           // smoothed
-  double temperature_at_update_ = 0.0;
+  double temperature_start_ = 0.0;     // of the first sample: the slope's origin
   double temperature_alpha_ = 1.0;     // EMA weight of a new sample
-  std::size_t samples_since_update_ = 0;
   std::size_t updates_ = 0;
   double lp_b0_ = 1.0, lp_a1_ = 0.0;   // y = b0·(x + x1) − a1·y1
 };
