@@ -19,9 +19,9 @@
 //       variance at W·τ0: at the low frequencies the residual follows, W such samples are
 //       worth one window mean of variance σm²).
 // Updating with the current sample before subtracting keeps the correction a first-order
-// smoother of the data itself, whose complement |1 − H(f)| ≤ 1 at every f: at rest the rate's
-// Allan variance cannot exceed raw's at any τ (a correction that lags by a window would raise
-// it by about its gain at τ of a few windows).
+// smoother of the data itself, whose complement |1 − H(f)| ≤ 1 at every f: while the sensor stays
+// at rest, the rate's expected Allan variance cannot exceed raw's at any τ (a correction that
+// lags by a window would raise it by about its gain at τ of a few windows).
 // A constant rotation ω below the detector's resolution passes as still and is learned as
 // bias: after n samples the fraction 1 − Π(1 − K_i) of ω, with K_i the filter's gains
 // (K ≈ √(q·τ0/(W·σm²)) per sample in steady state: 2·10⁻⁵ for the paper's Table 2 terms and
