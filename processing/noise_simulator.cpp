@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "processing/motion_profile.hpp"
 #include "processing/portable_math.hpp"
 
 namespace gyrod::processing {
@@ -181,6 +182,12 @@ double aliasedWhiteNoiseFactor(int dlpf_cfg, double rate_hz) {
 NoiseSimulator::AxisState::AxisState(SplitMix64& seeder)
     : arw_noise(seeder), rrw_noise(seeder), flicker_noise(seeder), q_noise(seeder), ar_noise(seeder) {}
 
+NoiseSimulator::NoiseSimulator(const SimulationModel& model, double duration_s, std::uint64_t seed,
+                               MotionProfile motion)
+    : NoiseSimulator(model, duration_s, seed) {
+  if (!motion.atRest()) motion_ = std::move(motion);
+}
+
 NoiseSimulator::NoiseSimulator(const SimulationModel& model, double duration_s, std::uint64_t seed)
     : model_(model), seeder_(seed), temperature_noise_(seeder_) {
   validateSimulationModel(model_);
@@ -279,22 +286,7 @@ void NoiseSimulator::initExtras(std::uint64_t seed, double duration_s) {
   }
 }
 
-namespace {
-
-// sin x from portable::tan, so that the sinusoid effect is the same bits everywhere:
-// x is reduced to [−π/2, π/2] with sin(π − x) = sin x, then sin x = 2u/(1 + u²), u = tan(x/2)
-// with |x/2| ≤ π/4 inside tan's domain. `cycles` is the phase in turns.
-double portableSinOfCycles(double cycles) {
-  double frac = cycles - std::floor(cycles);  // [0, 1)
-  if (frac >= 0.5) frac -= 1.0;               // [−0.5, 0.5)
-  double x = 2.0 * std::numbers::pi * frac;   // [−π, π)
-  if (x > 0.5 * std::numbers::pi) x = std::numbers::pi - x;
-  if (x < -0.5 * std::numbers::pi) x = -std::numbers::pi - x;
-  const double u = portable::tan(0.5 * x);
-  return 2.0 * u / (1.0 + u * u);
-}
-
-}  // namespace
+// The extra effects' sinusoids use portableSinOfCycles (processing/motion_profile.hpp).
 
 double NoiseSimulator::extraEffectAt(std::size_t a, std::uint64_t index) {
   const AxisExtraEffects& e = model_.axes[a].extra;
@@ -361,6 +353,12 @@ SimulatedSample NoiseSimulator::nextAnalog() {
     }
     out.rate_dps[a] = v;
   }
+  if (motion_) {
+    // The true rotation enters with the noise, before the DLPF, as it does on the chip; no
+    // motion adds nothing at all (not even + 0.0, which would turn a −0.0 into +0.0).
+    out.true_rate_dps = motion_->rateAt(t);
+    for (std::size_t a = 0; a < kSimulatedAxes; ++a) out.rate_dps[a] += out.true_rate_dps[a];
+  }
   const TemperatureModel& temp = model_.temperature;
   // Without a warm-up the curve is final + (+0)·e^{…} = final + 0.0 bit for bit: skip the
   // exponential (it was 8 % of a model check's time, which simulates that case).
@@ -422,6 +420,7 @@ SimulatedSample NoiseSimulator::next() {
   SimulatedSample out;
   out.t_s = static_cast<double>(output_index_) / model_.rate_hz;
   out.temperature_c = analog.temperature_c;
+  if (motion_) out.true_rate_dps = motion_->rateAt(out.t_s);
   for (std::size_t a = 0; a < kSimulatedAxes; ++a) out.rate_dps[a] = rate[a] + output_noise[a];
   if (lsb_per_dps_) {
     for (double& r : out.rate_dps) r = quantizeToInt16(r, *lsb_per_dps_) / *lsb_per_dps_;

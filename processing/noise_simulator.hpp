@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "processing/motion_profile.hpp"
 #include "processing/noise_terms.hpp"
 #include "processing/portable_random.hpp"
 #include "processing/sensor_model.hpp"
@@ -132,6 +133,9 @@ struct SimulatedSample {
   double t_s = 0.0;                               // from 0
   std::array<double, kSimulatedAxes> rate_dps{};  // °/s
   double temperature_c = 0.0;
+  // The true rotation rate at t_s (the motion profile, before the DLPF and everything the
+  // sensor adds); zero without motion. For scoring a stream against the truth.
+  std::array<double, kSimulatedAxes> true_rate_dps{};
 };
 
 class NoiseSimulator {
@@ -140,16 +144,23 @@ class NoiseSimulator {
   // sampleCount(); the stream itself may be read further. Throws std::invalid_argument
   // (see validateSimulationModel; duration must be finite and ≥ one sample).
   NoiseSimulator(const SimulationModel& model, double duration_s, std::uint64_t seed);
+  // The same sensor turned by `motion`: its true rate is added to the analog rate at the
+  // internal rate (nextAnalog()), so the DLPF, the decimation, the saturation at full scale
+  // and the quantisation act on it as on the chip; the noise realisation is the one without
+  // motion (same seed, same bits before the rotation is added). A motion at rest gives
+  // exactly the stream of the constructor above.
+  NoiseSimulator(const SimulationModel& model, double duration_s, std::uint64_t seed, MotionProfile motion);
 
-  // The next output sample at rate_hz: analog rate at the internal rate → DLPF (if on;
+  // The next output sample at rate_hz: analog rate (+ the motion's true rate) at the internal rate → DLPF (if on;
   // started in steady state at the first value) → every D-th sample (t = n/rate_hz,
   // n = 0, 1, …) → + output-rate terms (Q, AR, extra effects) → quantised to 1/sensitivity °/s and
   // saturated (if FS_SEL is set; temperature then also to 1/340 °C).
   SimulatedSample next();
 
   // For the mock device, which applies the DLPF, decimation and quantisation itself:
-  // the analog rate at the internal rate (bias + ARW + bias instability + RRW + ramp)
-  // and temperature, one internal sample per call (t = i/internal rate), and the terms
+  // the analog rate at the internal rate (bias + ARW + bias instability + RRW + ramp, + the
+  // motion; the truth in true_rate_dps) and temperature, one internal sample per call
+  // (t = i/internal rate), and the terms
   // defined at the output rate (quantisation noise Q, AR, the extra effects), one output
   // sample per call.
   // next() is exactly these two composed as described above; use either next() or
@@ -214,7 +225,8 @@ class NoiseSimulator {
   std::uint64_t output_index_ = 0;
   std::vector<ExtraState> extras_;  // empty when no axis has extra effects
   std::optional<ZigguratNormalGenerator> extra_noise_;
-  std::uint64_t extra_index_ = 0;  // output samples produced by nextOutputRateNoise()
+  std::uint64_t extra_index_ = 0;    // output samples produced by nextOutputRateNoise()
+  std::optional<MotionProfile> motion_;  // none: at rest
 };
 
 }  // namespace gyrod::processing
