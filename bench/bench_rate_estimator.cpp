@@ -78,8 +78,8 @@ void BM_PaperChain(benchmark::State& state) {
   gyrod::processing::FilterChainParameters p;
   p.kalman = {0.95, 3e-5, 5e-3};
   std::array<gyrod::processing::AxisFilterChain, 3> chains = {gyrod::processing::AxisFilterChain(p),
-                                                               gyrod::processing::AxisFilterChain(p),
-                                                               gyrod::processing::AxisFilterChain(p)};
+                                                              gyrod::processing::AxisFilterChain(p),
+                                                              gyrod::processing::AxisFilterChain(p)};
   std::size_t i = 0;
   for (auto _ : state) {
     const Input& s = data[i];

@@ -225,7 +225,7 @@ class NoiseSimulator {
   std::uint64_t output_index_ = 0;
   std::vector<ExtraState> extras_;  // empty when no axis has extra effects
   std::optional<ZigguratNormalGenerator> extra_noise_;
-  std::uint64_t extra_index_ = 0;    // output samples produced by nextOutputRateNoise()
+  std::uint64_t extra_index_ = 0;        // output samples produced by nextOutputRateNoise()
   std::optional<MotionProfile> motion_;  // none: at rest
 };
 

@@ -65,8 +65,9 @@ void validateRateEstimatorParameters(const RateEstimatorParameters& p) {
     requireNonNegative(m.temperature_coefficient_std_dps_per_c, w + "temperature_coefficient_std_dps_per_c");
     for (NoiseTerm t : kAllNoiseTerms) requireNonNegative(m.terms.get(t), w + std::string(noiseTermKey(t)));
     if (m.terms.arw_deg_per_sqrt_h == 0.0 && m.terms.quantization_urad == 0.0)
-      throw std::invalid_argument(w + "the still detector needs a white-noise level: arw_deg_per_sqrt_h or "
-                                      "quantization_urad must be > 0");
+      throw std::invalid_argument(w +
+                                  "the still detector needs a white-noise level: arw_deg_per_sqrt_h or "
+                                  "quantization_urad must be > 0");
   }
 }
 
@@ -74,8 +75,7 @@ RateEstimator::RateEstimator(const RateEstimatorParameters& params)
     : params_(params), detector_(params.still, levelsOf(params)) {
   const double tau0 = 1.0 / params_.rate_hz;
   for (std::size_t a = 0; a < kMotionAxes; ++a) {
-    const double q_per_second =
-        driftProcessNoisePerSecond(params_.axes[a].terms, params_.bias_instability_horizon_s);
+    const double q_per_second = driftProcessNoisePerSecond(params_.axes[a].terms, params_.bias_instability_horizon_s);
     axes_[a].q_per_sample = q_per_second * tau0;
     // A window mean of variance σm² is worth W samples of variance W·σm² each (at the low
     // frequencies the residual tracks, the noise is white at the level of the Allan fit).

@@ -51,9 +51,9 @@ struct AxisBiasModel {
   // (0 amplitude = none).
   double warm_up_amplitude_dps = 0.0;
   double warm_up_time_constant_s = 0.0;
-  double bias_std_dps = 0.0;  // 1σ of bias_dps: the residual's starting uncertainty
+  double bias_std_dps = 0.0;                           // 1σ of bias_dps: the residual's starting uncertainty
   double temperature_coefficient_std_dps_per_c = 0.0;  // 1σ of the coefficient
-  NoiseTerms terms;  // the Allan fit (paper units)
+  NoiseTerms terms;                                    // the Allan fit (paper units)
 
   double biasAt(double temperature_c, double since_start_s) const;
 };
@@ -94,7 +94,7 @@ class RateEstimator {
 
  private:
   struct AxisState {
-    double offset = 0.0, slope = 0.0;          // r̂ = offset + slope·(T − T_start)
+    double offset = 0.0, slope = 0.0;           // r̂ = offset + slope·(T − T_start)
     double p_oo = 0.0, p_os = 0.0, p_ss = 0.0;  // their covariance
     double q_per_sample = 0.0;
     double sample_var = 0.0;  // R = W·σm²
@@ -108,11 +108,11 @@ class RateEstimator {
   bool started_ = false;
   bool low_pass_primed_ = false;
   double t_first_ = 0.0;
-  double temperature_ = 0.0;           // smoothed
-  double temperature_start_ = 0.0;     // of the first sample: the slope's origin
-  double temperature_alpha_ = 1.0;     // EMA weight of a new sample
+  double temperature_ = 0.0;        // smoothed
+  double temperature_start_ = 0.0;  // of the first sample: the slope's origin
+  double temperature_alpha_ = 1.0;  // EMA weight of a new sample
   std::size_t updates_ = 0;
-  double lp_b0_ = 1.0, lp_a1_ = 0.0;   // y = b0·(x + x1) − a1·y1
+  double lp_b0_ = 1.0, lp_a1_ = 0.0;  // y = b0·(x + x1) − a1·y1
 };
 
 }  // namespace gyrod::processing

@@ -43,8 +43,8 @@ StillDetector::StillDetector(const StillDetectorParameters& params,
     requirePositiveLevel(levels_[a].window_allan_variance, axis + "window_allan_variance");
     requirePositiveLevel(levels_[a].sample_allan_variance, axis + "sample_allan_variance");
   }
-  difference_threshold_ = kDifferenceScale * chiSquareQuantile(1.0 - params_.difference_false_alarm,
-                                                               differenceDof(params_.window_samples));
+  difference_threshold_ =
+      kDifferenceScale * chiSquareQuantile(1.0 - params_.difference_false_alarm, differenceDof(params_.window_samples));
   ring_.assign(kMotionAxes * params_.window_samples, 0.0);
 }
 
@@ -100,8 +100,8 @@ bool StillDetector::update(const AngularRate& corrected, const AngularRate& expe
     const double mean = sum_[a] / static_cast<double>(w);
     const double spread = std::sqrt(levels_[a].window_allan_variance + expected_variance[a]);
     const double d_statistic = diff_sq_sum_[a] / (2.0 * levels_[a].sample_allan_variance);
-    still = std::fabs(mean - expected[a]) <= params_.mean_threshold_sigmas * spread &&
-            d_statistic <= difference_threshold_;
+    still =
+        std::fabs(mean - expected[a]) <= params_.mean_threshold_sigmas * spread && d_statistic <= difference_threshold_;
   }
   still_ = still;
   still_run_ = still ? still_run_ + 1 : 0;

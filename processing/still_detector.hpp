@@ -39,9 +39,9 @@
 namespace gyrod::processing {
 
 struct StillDetectorParameters {
-  std::size_t window_samples = 25;      // W (0.5 s at 50 Hz); ≥ 3
-  double mean_threshold_sigmas = 3.0;   // z
-  double difference_false_alarm = 1e-3; // αd, per axis and window at rest
+  std::size_t window_samples = 25;       // W (0.5 s at 50 Hz); ≥ 3
+  double mean_threshold_sigmas = 3.0;    // z
+  double difference_false_alarm = 1e-3;  // αd, per axis and window at rest
 };
 
 // The noise level of one axis at rest.

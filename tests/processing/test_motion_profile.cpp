@@ -6,8 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
-#include <numbers>
 #include <cstring>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
@@ -86,9 +86,8 @@ TEST(MotionProfile, TurnsTurnTheStatedAngleWithStillPeriods) {
 }
 
 TEST(MotionProfile, SumAddsAndSequenceRunsEachOnItsOwnClock) {
-  const MotionProfile sum =
-      MotionProfile::sum({MotionProfile::constant(0, 1.0), MotionProfile::step(0, 1.0, 2.0),
-                          MotionProfile::step(1, 0.0, 4.0)});
+  const MotionProfile sum = MotionProfile::sum(
+      {MotionProfile::constant(0, 1.0), MotionProfile::step(0, 1.0, 2.0), MotionProfile::step(1, 0.0, 4.0)});
   EXPECT_EQ(sum.rateAt(0.5), (AngularRate{1.0, 4.0, 0.0}));
   EXPECT_EQ(sum.rateAt(1.5), (AngularRate{3.0, 4.0, 0.0}));
   const MotionProfile seq = MotionProfile::sequence(

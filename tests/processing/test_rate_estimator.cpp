@@ -117,11 +117,10 @@ RateEstimatorParameters calibrate(std::array<double, 3> coefficient_error = {}) 
   return p;
 }
 
-
 struct Record {
   std::vector<SimulatedSample> sim;
   std::vector<RateSample> est;
-  std::vector<AngularRate> paper_kalman;  // the paper's stream beside it, for the record
+  std::vector<AngularRate> paper_kalman;            // the paper's stream beside it, for the record
   std::array<double, 3> final_residual_variance{};  // the estimator's own P at the end
 };
 
@@ -191,10 +190,10 @@ TEST(RateEstimator, StepIsWithinTwoPercentAtTheThirdSample) {
     }
     const double n = static_cast<double>(steps.size());
     const double ratio = sum_ratio / n;
-    std::printf("seed %llu: at the 3rd sample after a 10 deg/s step: rate %.4f of the step, raw %.4f, paper's "
-                "kalman %.4f (%.4f after 1.5 s)\n",
-                static_cast<unsigned long long>(seed), ratio, sum_raw_ratio / n, sum_kalman_ratio / n,
-                sum_kalman_end / n);
+    std::printf(
+        "seed %llu: at the 3rd sample after a 10 deg/s step: rate %.4f of the step, raw %.4f, paper's "
+        "kalman %.4f (%.4f after 1.5 s)\n",
+        static_cast<unsigned long long>(seed), ratio, sum_raw_ratio / n, sum_kalman_ratio / n, sum_kalman_end / n);
     EXPECT_NEAR(ratio, 1.0, 0.02);
   }
 }
@@ -238,10 +237,11 @@ TEST(RateEstimator, OneHertzSineKeepsItsAmplitudeAndPhase) {
     const SineFit paper = fitSine(t, kalman, 1.0, start);
     const SineFit want = fitSine(t, truth, 1.0, start), got = fitSine(t, rate, 1.0, start);
     const double gain = got.amplitude / want.amplitude, lag = got.phase_deg - want.phase_deg;
-    std::printf("seed %llu: 1 Hz 20 deg/s on axis %zu: rate amplitude %.4f, phase %+.2f deg; paper's kalman "
-                "%.4f, %+.1f deg\n",
-                static_cast<unsigned long long>(seed), axis, gain, lag, paper.amplitude / want.amplitude,
-                paper.phase_deg - want.phase_deg);
+    std::printf(
+        "seed %llu: 1 Hz 20 deg/s on axis %zu: rate amplitude %.4f, phase %+.2f deg; paper's kalman "
+        "%.4f, %+.1f deg\n",
+        static_cast<unsigned long long>(seed), axis, gain, lag, paper.amplitude / want.amplitude,
+        paper.phase_deg - want.phase_deg);
     EXPECT_NEAR(gain, 1.0, 0.02);
     EXPECT_LE(std::fabs(lag), 5.0);
   }
@@ -264,10 +264,11 @@ TEST(RateEstimator, TenTurnsIntegrateToTheTrueAngle) {
     }
     const double truth = 3600.0 * (rate > 0 ? 1.0 : -1.0);
     const double error = std::fabs(angle - truth) / 3600.0;
-    std::printf("seed %llu: 10 turns at %.1f deg/s on axis %zu: angle error %.4f %% (raw %.3f %%, paper's kalman "
-                "%+.1f %%)\n",
-                static_cast<unsigned long long>(seed), rate, axis, 100.0 * error,
-                100.0 * std::fabs(raw_angle - truth) / 3600.0, 100.0 * (kalman_angle / truth - 1.0));
+    std::printf(
+        "seed %llu: 10 turns at %.1f deg/s on axis %zu: angle error %.4f %% (raw %.3f %%, paper's kalman "
+        "%+.1f %%)\n",
+        static_cast<unsigned long long>(seed), rate, axis, 100.0 * error, 100.0 * std::fabs(raw_angle - truth) / 3600.0,
+        100.0 * (kalman_angle / truth - 1.0));
     EXPECT_LE(error, 0.005);
   }
 }
@@ -280,10 +281,10 @@ MotionProfile warmUpMotion(std::mt19937_64& rng, int minutes) {
   std::vector<MotionSegment> segments;
   for (int i = 0; i < minutes; ++i) {
     const std::size_t sine_axis = anyAxis(rng), turn_axis = (sine_axis + 1) % 3;
-    const MotionProfile moving = MotionProfile::sum(
-        {MotionProfile::sine(sine_axis, uniform(rng, 0.2, 2.0), uniform(rng, 5.0, 30.0)),
-         MotionProfile::constant(turn_axis, anySign(rng) * uniform(rng, 5.0, 40.0), uniform(rng, 5.0, 20.0),
-                                 uniform(rng, 10.0, 30.0))});
+    const MotionProfile moving =
+        MotionProfile::sum({MotionProfile::sine(sine_axis, uniform(rng, 0.2, 2.0), uniform(rng, 5.0, 30.0)),
+                            MotionProfile::constant(turn_axis, anySign(rng) * uniform(rng, 5.0, 40.0),
+                                                    uniform(rng, 5.0, 20.0), uniform(rng, 10.0, 30.0))});
     segments.push_back({moving, 58.0});
     segments.push_back({MotionProfile{}, 2.0});
   }
@@ -303,8 +304,7 @@ TEST(RateEstimator, BiasAfterAFifteenDegreeWarmUpInMotion) {
     const MotionProfile motion =
         MotionProfile::sequence({{MotionProfile{}, 2.0}, {warmUpMotion(rng, kMinutes), 60.0 * kMinutes}});
     const double end_of_motion = 2.0 + 60.0 * kMinutes;
-    const Record r = run(paperSensor(25.0, 40.0, 300.0), motion, end_of_motion + 20.0, seed,
-                         calibrate(k_error));
+    const Record r = run(paperSensor(25.0, 40.0, 300.0), motion, end_of_motion + 20.0, seed, calibrate(k_error));
     const auto last_moving = static_cast<std::size_t>(end_of_motion * kRateHz) - 1;
     std::array<double, 3> true_bias{}, startup_error{};
     const std::size_t n_end = r.sim.size() - last_moving - 1;
@@ -386,10 +386,11 @@ TEST(RateEstimator, ASlowRotationIsLearnedNoFasterThanTheBiasModelAllows) {
     const double allowed = omega * (1.0 - kept);
     std::size_t still = 0;
     for (std::size_t i = before + 1; i < r.est.size(); ++i) still += r.est[i].still ? 1 : 0;
-    std::printf("rotation %.4f deg/s (%.1f x resolution) for 10 min: learned %.5f deg/s, the model allows %.5f "
-                "(+ 3 x noise %.5f), still %.1f %% of the time\n",
-                omega, fraction, learned, allowed, 3.0 * noise,
-                100.0 * static_cast<double>(still) / static_cast<double>(r.est.size() - before - 1));
+    std::printf(
+        "rotation %.4f deg/s (%.1f x resolution) for 10 min: learned %.5f deg/s, the model allows %.5f "
+        "(+ 3 x noise %.5f), still %.1f %% of the time\n",
+        omega, fraction, learned, allowed, 3.0 * noise,
+        100.0 * static_cast<double>(still) / static_cast<double>(r.est.size() - before - 1));
     EXPECT_LE(learned, allowed + 3.0 * noise);
     if (fraction > 1.0) {
       EXPECT_LE(std::fabs(learned), 3.0 * noise);  // refused by the gate: nothing learned
