@@ -111,6 +111,8 @@ int runFilter(const FilterOptions& opt) {
     if (!std::isfinite(b)) throw std::invalid_argument("--bias values must be finite numbers");
   const std::size_t n = rec.size();
   const double dt = 1.0 / in.rate_hz;
+  std::optional<RateColumns> rate_columns;  // first, so that a bad --model fails before any work
+  if (!opt.model.empty()) rate_columns.emplace(opt, rec, in.rate_hz);
 
   std::vector<std::vector<double>> chain_input;
   std::vector<FilterChainParameters> params;
@@ -135,11 +137,7 @@ int runFilter(const FilterOptions& opt) {
   out.reserve(n * (1 + 3 * rec.axes.size()) * 24 + 64);
   out += "t";
   for (const auto& name : rec.axis_names) out += "," + name + "," + name + "_mean," + name + "_kalman";
-  std::optional<RateColumns> rate_columns;
-  if (!opt.model.empty()) {
-    rate_columns.emplace(opt, rec, in.rate_hz);
-    RateColumns::appendHeader(out, rec);
-  }
+  if (rate_columns) RateColumns::appendHeader(out, rec);
   out += '\n';
   std::vector<AxisFilterChain> chains;
   for (const auto& p : params) chains.emplace_back(p);
