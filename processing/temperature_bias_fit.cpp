@@ -137,17 +137,17 @@ TemperatureBiasFit fitTemperatureBias(std::span<const double> secs, std::span<co
     return w.dot(e.cwiseProduct(e));
   };
   const double duration = b.t.back() - b.t.front();
-  const double lo = std::log(duration / 100.0), hi = std::log(2.0 * duration);
+  const double lo = std::log(duration / 100.0), hi = std::log(duration / 3.0);
   constexpr int kScan = 25;
   const double step = (hi - lo) / (kScan - 1);
   int best = 0;
   double best_sse = std::numeric_limits<double>::infinity();
-  for (int j = 0; j < kScan; ++j) {
+  for (int j = 0; with_temperature && j < kScan; ++j) {
     const double v = sse(lo + step * j);
     if (v < best_sse) best_sse = v, best = j;
   }
   WeightedFit chosen = linear;
-  if (std::isfinite(best_sse)) {
+  if (with_temperature && std::isfinite(best_sse)) {
     const double log_tau = goldenSectionMinimum(lo + step * std::max(best - 1, 0),
                                                 lo + step * std::min(best + 1, kScan - 1), {30, 0.0}, sse)
                                .midpoint();

@@ -8,8 +8,10 @@
 // errors are the ordinary ones scaled by (1 + ρ)/(1 − ρ), ρ the lag-1 correlation of the
 // residuals (clamped to [0, 0.95]): an effective number of independent blocks.
 // The warm-up shape A·e^{−t/τ} (a bias transient beyond what the temperature explains): τ
-// minimises the joint fit's residual (log-spaced scan from duration/100 to 2·duration, then
-// golden section, as fitExponentialWarmUp finds the temperature's τ); kept only when |A| > 5 standard errors (τ was searched, hence more than 3). When
+// minimises the joint fit's residual (log-spaced scan from duration/100 to duration/3, so the
+// transient settles within the record and cannot stand in for a slow drift, then golden section,
+// as fitExponentialWarmUp finds the temperature's τ); searched only on a record whose temperature
+// moves (a warm-up), and kept only when |A| > 5 standard errors (τ was searched, hence more than 3). When
 // τ is close to the temperature's own time constant, e^{−t/τ} and T are nearly collinear, A's
 // standard error is large, and the shape is rightly dropped: the record cannot tell them apart.
 // A temperature spread (std of the block means) below 0.1 °C fits no coefficient (k = 0 and
