@@ -297,3 +297,33 @@ TEST(Calibration, FilterWithoutATempColumnTakesTheReferenceAndSaysSo) {
   EXPECT_EQ(e.exit_status, 2) << e.err;
   EXPECT_NE(e.err.find("'gz' is missing"), std::string::npos) << e.err;
 }
+
+TEST(Calibration, ModelCheckWritesTheSameCalibrationBesideItsEffects) {
+  ScratchDir d;
+  const auto hidden = d.write("hidden.toml",
+                              "rate_hz = 50\n[temperature]\nstart_c = 24\nfinal_c = 34\ntime_constant_s = 120\n"
+                              "noise_std_c = 0.02\n[x]\narw_deg_per_sqrt_h = 0.5\nbias_dps = 0.3\n"
+                              "[x.extra]\ntemperature_coefficient_dps_per_c = 0.02\ntemperature_reference_c = 25\n"
+                              "[y]\narw_deg_per_sqrt_h = 0.5\n[z]\narw_deg_per_sqrt_h = 0.5\n");
+  const auto rec = d.path() / "rec.csv";
+  auto r = runGyroctl("simulate --model " + hidden.string() + " --duration 300 --seed 9 -o " + rec.string(), d.path());
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const auto checked = d.path() / "checked.toml", analysed = d.path() / "analysed.toml";
+  r = runGyroctl("model-check " + rec.string() + " --replicas 8 --threads 2 --write-model " + checked.string(),
+                 d.path());
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  r = runGyroctl("analyze " + rec.string() + " --write-model " + analysed.string(), d.path());
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const SensorModel c = readSensorModelToml(checked.string()), a = readSensorModelToml(analysed.string());
+  for (std::size_t axis = 0; axis < 3; ++axis) {
+    ASSERT_TRUE(c.calibration[axis]) << readWholeFile(checked);
+    // The same fit of the same record: the same calibration table.
+    EXPECT_EQ(c.calibration[axis]->temperature_coefficient_dps_per_c,
+              a.calibration[axis]->temperature_coefficient_dps_per_c);
+    EXPECT_EQ(c.calibration[axis]->bias_std_dps, a.calibration[axis]->bias_std_dps);
+  }
+  const AxisCalibration& x = *c.calibration[0];
+  EXPECT_NEAR(x.temperature_coefficient_dps_per_c, 0.02, 3.0 * x.temperature_coefficient_std_dps_per_c);
+  EXPECT_NE(c.simulation.axes[0].extra.temperature_coefficient_dps_per_c, 0.0) << readWholeFile(checked);
+  EXPECT_NO_THROW(rateEstimatorParameters(c));
+}
