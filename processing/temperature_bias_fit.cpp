@@ -144,7 +144,10 @@ TemperatureBiasFit fitTemperatureBias(std::span<const double> secs, std::span<co
   double best_sse = std::numeric_limits<double>::infinity();
   for (int j = 0; with_temperature && j < kScan; ++j) {
     const double v = sse(lo + step * j);
-    if (v < best_sse) best_sse = v, best = j;
+    if (v < best_sse) {
+      best_sse = v;
+      best = j;
+    }
   }
   WeightedFit chosen = linear;
   if (with_temperature && std::isfinite(best_sse)) {
