@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <stdexcept>
 #include <vector>
@@ -55,11 +56,18 @@ TEST(TemperatureBiasFit, RecoversBiasAndCoefficientWithinThreeStandardErrors) {
 
 TEST(TemperatureBiasFit, FindsAWarmUpShapeBeyondTheTemperature) {
   // A 0.05 °/s transient of τ = 60 s (faster than the temperature's 300 s).
-  const Synthetic s = warmUpRecord(3, -0.4, -0.02, 0.05, 60.0, 0.05);
-  const TemperatureBiasFit f = fitTemperatureBias(s.secs, s.rate, s.temp);
-  EXPECT_NEAR(f.warm_up_amplitude_dps, 0.05, 3.0 * f.warm_up_amplitude_std_dps + 0.1 * 0.05);
-  EXPECT_NEAR(f.warm_up_time_constant_s, 60.0, 15.0);
-  EXPECT_NEAR(f.coefficient_dps_per_c, -0.02, 3.0 * f.coefficient_std_dps_per_c + 1e-4);
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    const Synthetic s = warmUpRecord(seed, -0.4, -0.02, 0.05, 60.0, 0.05);
+    const TemperatureBiasFit f = fitTemperatureBias(s.secs, s.rate, s.temp);
+    std::printf("seed %llu: shape %.5g +- %.2g, tau %.4g s; k %.6g +- %.2g; bias %.6g +- %.2g\n",
+                static_cast<unsigned long long>(seed), f.warm_up_amplitude_dps, f.warm_up_amplitude_std_dps,
+                f.warm_up_time_constant_s, f.coefficient_dps_per_c, f.coefficient_std_dps_per_c, f.bias_dps,
+                f.bias_std_dps);
+    EXPECT_NEAR(f.warm_up_amplitude_dps, 0.05, 3.0 * f.warm_up_amplitude_std_dps) << "seed " << seed;
+    EXPECT_NEAR(f.warm_up_time_constant_s, 60.0, 15.0) << "seed " << seed;
+    EXPECT_NEAR(f.coefficient_dps_per_c, -0.02, 3.0 * f.coefficient_std_dps_per_c) << "seed " << seed;
+    EXPECT_NEAR(f.bias_dps, -0.4 - 0.02 * (f.reference_c - 25.0), 3.0 * f.bias_std_dps) << "seed " << seed;
+  }
 }
 
 TEST(TemperatureBiasFit, AFlatTemperatureFitsNoCoefficient) {

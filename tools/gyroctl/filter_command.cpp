@@ -86,6 +86,7 @@ class RateColumns {
     }
     out += s.still ? ",1" : ",0";
   }
+  std::size_t stillSamples() const { return estimator_->updates(); }
 
  private:
   const recording::Recording& rec_;
@@ -165,6 +166,9 @@ int runFilter(const FilterOptions& opt) {
                  opt.ar_phi || opt.kalman_q || opt.kalman_r ? " (some given on the command line)"
                                                             : " (identified from the file)");
   }
+  if (rate_columns)
+    std::fprintf(stderr, "rate stream from %s: %zu of %zu samples still (they updated the residual bias)\n",
+                 opt.model.c_str(), rate_columns->stillSamples(), n);
   std::fprintf(stderr, "wrote %zu samples to %s\n", n, opt.output.c_str());
   return kExitOk;
 }
