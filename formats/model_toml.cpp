@@ -64,8 +64,9 @@ class ModelReader {
     return *node.as_table();
   }
 
-  SimulationModel read(const toml::table& root) const {
-    SimulationModel model;
+  SensorModel read(const toml::table& root) const {
+    SensorModel sensor;
+    SimulationModel& model = sensor.simulation;
     const toml::key* rate_key = nullptr;
     for (auto&& [key, node] : root) {
       const std::string k(key.str());
@@ -79,9 +80,12 @@ class ModelReader {
       } else if (k == "temperature") {
         readTemperature(table(node, key), model.temperature);
       } else if (k == "x" || k == "y" || k == "z") {
-        readAxis(table(node, key), k, model.axes[static_cast<std::size_t>(k[0] - 'x')]);
+        readAxis(table(node, key), k, sensor, static_cast<std::size_t>(k[0] - 'x'));
+      } else if (k == "filter") {
+        sensor.filter = readFilter(table(node, key));
       } else {
-        fail(key.source(), "unknown key '" + k + "' (expected rate_hz, dlpf, fs_sel, [temperature], [x], [y], [z])");
+        fail(key.source(),
+             "unknown key '" + k + "' (expected rate_hz, dlpf, fs_sel, [temperature], [x], [y], [z], [filter])");
       }
     }
     if (model.dlpf_cfg) {
@@ -92,7 +96,7 @@ class ModelReader {
         doc_.failFile(e.what() + std::string(" (rate_hz not given: default 50)"));
       }
     }
-    return model;
+    return sensor;
   }
 
   void readTemperature(const toml::table& t, processing::TemperatureModel& temp) const {
@@ -112,7 +116,8 @@ class ModelReader {
     }
   }
 
-  void readAxis(const toml::table& t, const std::string& axis, processing::AxisNoiseModel& out) const {
+  void readAxis(const toml::table& t, const std::string& axis, SensorModel& sensor, std::size_t slot) const {
+    processing::AxisNoiseModel& out = sensor.simulation.axes[slot];
     const std::string where = axis + ".";
     for (auto&& [key, node] : t) {
       const std::string k(key.str());
@@ -130,10 +135,14 @@ class ModelReader {
         readAr(table(node, key), axis, out.ar);
       } else if (k == "extra") {
         readExtra(table(node, key), axis, out.extra);
+      } else if (k == "calibration") {
+        sensor.calibration[slot] = readCalibration(table(node, key), axis);
+      } else if (k == "kalman") {
+        sensor.kalman[slot] = readKalman(table(node, key), axis);
       } else {
         fail(key.source(), "unknown key '" + k + "' in [" + axis +
                                "] (expected the five noise-term keys of noise_terms.hpp, bias_dps, [" + axis +
-                               ".ar], [" + axis + ".extra])");
+                               ".ar], [" + axis + ".extra], [" + axis + ".calibration], [" + axis + ".kalman])");
       }
     }
   }
@@ -208,6 +217,96 @@ class ModelReader {
     }
   }
 
+  // [x.calibration]: every key optional (AxisCalibration's defaults).
+  AxisCalibration readCalibration(const toml::table& t, const std::string& axis) const {
+    const std::string where = axis + ".calibration.";
+    AxisCalibration c;
+    const toml::key* amplitude_key = nullptr;
+    bool time_constant_given = false;
+    for (auto&& [key, node] : t) {
+      const std::string k(key.str());
+      if (k == "bias_std_dps") {
+        c.bias_std_dps = nonNegative(node, key, where);
+      } else if (k == "temperature_coefficient_dps_per_c") {
+        c.temperature_coefficient_dps_per_c = number(node, key, where);
+      } else if (k == "temperature_coefficient_std_dps_per_c") {
+        c.temperature_coefficient_std_dps_per_c = nonNegative(node, key, where);
+      } else if (k == "temperature_reference_c") {
+        c.temperature_reference_c = number(node, key, where);
+      } else if (k == "warm_up_amplitude_dps") {
+        c.warm_up_amplitude_dps = number(node, key, where);
+        amplitude_key = &key;
+      } else if (k == "warm_up_amplitude_std_dps") {
+        c.warm_up_amplitude_std_dps = nonNegative(node, key, where);
+      } else if (k == "warm_up_time_constant_s") {
+        c.warm_up_time_constant_s = positive(node, key, where);
+        time_constant_given = true;
+      } else {
+        fail(key.source(), "unknown key '" + k + "' in [" + axis +
+                               ".calibration] (expected bias_std_dps, temperature_coefficient_dps_per_c, "
+                               "temperature_coefficient_std_dps_per_c, temperature_reference_c, "
+                               "warm_up_amplitude_dps, warm_up_amplitude_std_dps, warm_up_time_constant_s)");
+      }
+    }
+    if (amplitude_key && c.warm_up_amplitude_dps != 0.0 && !time_constant_given)
+      fail(amplitude_key->source(), where + "warm_up_amplitude_dps needs warm_up_time_constant_s");
+    return c;
+  }
+
+  // [x.kalman]: a, q, r as gyrod's [filter.kalman] takes them.
+  processing::ScalarKalmanParameters readKalman(const toml::table& t, const std::string& axis) const {
+    const std::string where = axis + ".kalman.";
+    processing::ScalarKalmanParameters k;
+    for (auto&& [key, node] : t) {
+      const std::string name(key.str());
+      if (name == "a") {
+        k.a = number(node, key, where);
+        if (!(std::fabs(k.a) <= 1.0)) fail(key.source(), where + "a must be in [-1, 1], got " + formatNumber(k.a));
+      } else if (name == "q") {
+        k.q = nonNegative(node, key, where);
+      } else if (name == "r") {
+        k.r = positive(node, key, where);
+      } else {
+        fail(key.source(), "unknown key '" + name + "' in [" + axis + ".kalman] (expected a, q, r)");
+      }
+    }
+    return k;
+  }
+
+  // [filter]: every key optional (FilterModel's defaults).
+  FilterModel readFilter(const toml::table& t) const {
+    const std::string where = "filter.";
+    FilterModel f;
+    for (auto&& [key, node] : t) {
+      const std::string k(key.str());
+      if (k == "mean_window") {
+        f.mean_window = static_cast<std::size_t>(integerIn(node, key, 1, 100000));
+      } else if (k == "mean_threshold_dps") {
+        f.mean_threshold_dps = positive(node, key, where);
+      } else if (k == "still_window_samples") {
+        f.still.window_samples = static_cast<std::size_t>(integerIn(node, key, 3, 100000));
+      } else if (k == "still_mean_threshold_sigmas") {
+        f.still.mean_threshold_sigmas = positive(node, key, where);
+      } else if (k == "still_difference_false_alarm") {
+        f.still.difference_false_alarm = positive(node, key, where);
+        if (!(f.still.difference_false_alarm < 1.0))
+          fail(key.source(), where + k + " must be < 1, got " + formatNumber(f.still.difference_false_alarm));
+      } else if (k == "bias_instability_horizon_s") {
+        f.bias_instability_horizon_s = positive(node, key, where);
+      } else if (k == "temperature_smoothing_s") {
+        f.temperature_smoothing_s = nonNegative(node, key, where);
+      } else if (k == "low_pass_hz") {
+        f.low_pass_hz = positive(node, key, where);
+      } else {
+        fail(key.source(), "unknown key '" + k +
+                               "' in [filter] (expected mean_window, mean_threshold_dps, still_window_samples, "
+                               "still_mean_threshold_sigmas, still_difference_false_alarm, "
+                               "bias_instability_horizon_s, temperature_smoothing_s, low_pass_hz)");
+      }
+    }
+    return f;
+  }
+
   void readAr(const toml::table& t, const std::string& axis, processing::ArComponent& ar) const {
     const std::string where = axis + ".ar.";
     const toml::key* phi_key = nullptr;
@@ -250,12 +349,12 @@ void appendKeyValue(std::string& out, const std::string& key, double v) {
 
 }  // namespace
 
-processing::SimulationModel parseModelToml(std::string_view text, const std::string& source_name) {
+SensorModel parseSensorModelToml(std::string_view text, const std::string& source_name) {
   try {
     const formats::TomlDocument doc(text, source_name);
-    SimulationModel model = ModelReader(doc).read(doc.root());
+    SensorModel model = ModelReader(doc).read(doc.root());
     try {
-      processing::validateSimulationModel(model);  // anything not already tied to a line
+      processing::validateSimulationModel(model.simulation);  // anything not already tied to a line
     } catch (const std::invalid_argument& e) {
       doc.failFile(e.what());
     }
@@ -265,7 +364,13 @@ processing::SimulationModel parseModelToml(std::string_view text, const std::str
   }
 }
 
-processing::SimulationModel readModelToml(const std::string& path) {
+processing::SimulationModel parseModelToml(std::string_view text, const std::string& source_name) {
+  return parseSensorModelToml(text, source_name).simulation;
+}
+
+processing::SimulationModel readModelToml(const std::string& path) { return readSensorModelToml(path).simulation; }
+
+SensorModel readSensorModelToml(const std::string& path) {
   std::FILE* f = std::fopen(path.c_str(), "rb");
   if (!f) throw RecordingError(path + ": cannot open: " + std::strerror(errno));
   std::string text;
@@ -275,11 +380,54 @@ processing::SimulationModel readModelToml(const std::string& path) {
   const bool failed = std::ferror(f);
   std::fclose(f);
   if (failed) throw RecordingError(path + ": cannot read");
-  return parseModelToml(text, path);
+  return parseSensorModelToml(text, path);
 }
 
-std::string modelToToml(const processing::SimulationModel& model) {
-  std::string out = "# gyrod simulation model (docs/simulator.md)\n";
+namespace {
+
+void appendCalibration(std::string& out, const std::string& axis, const SensorModel& sensor, std::size_t slot) {
+  if (const auto& c = sensor.calibration[slot]) {
+    out += "\n[" + axis + ".calibration]\n";
+    appendKeyValue(out, "bias_std_dps", c->bias_std_dps);
+    appendKeyValue(out, "temperature_coefficient_dps_per_c", c->temperature_coefficient_dps_per_c);
+    appendKeyValue(out, "temperature_coefficient_std_dps_per_c", c->temperature_coefficient_std_dps_per_c);
+    appendKeyValue(out, "temperature_reference_c", c->temperature_reference_c);
+    if (c->warm_up_amplitude_dps != 0.0 || c->warm_up_time_constant_s > 0.0) {
+      appendKeyValue(out, "warm_up_amplitude_dps", c->warm_up_amplitude_dps);
+      appendKeyValue(out, "warm_up_amplitude_std_dps", c->warm_up_amplitude_std_dps);
+      appendKeyValue(out, "warm_up_time_constant_s", c->warm_up_time_constant_s);
+    }
+  }
+  if (const auto& k = sensor.kalman[slot]) {
+    out += "\n[" + axis + ".kalman]\n";
+    appendKeyValue(out, "a", k->a);
+    appendKeyValue(out, "q", k->q);
+    appendKeyValue(out, "r", k->r);
+  }
+}
+
+void appendFilter(std::string& out, const FilterModel& f) {
+  out += "\n[filter]\nmean_window = " + std::to_string(f.mean_window) + "\n";
+  appendKeyValue(out, "mean_threshold_dps", f.mean_threshold_dps);
+  out += "still_window_samples = " + std::to_string(f.still.window_samples) + "\n";
+  appendKeyValue(out, "still_mean_threshold_sigmas", f.still.mean_threshold_sigmas);
+  appendKeyValue(out, "still_difference_false_alarm", f.still.difference_false_alarm);
+  appendKeyValue(out, "bias_instability_horizon_s", f.bias_instability_horizon_s);
+  appendKeyValue(out, "temperature_smoothing_s", f.temperature_smoothing_s);
+  if (f.low_pass_hz) appendKeyValue(out, "low_pass_hz", *f.low_pass_hz);
+}
+
+bool hasCalibration(const SensorModel& m) {
+  for (std::size_t a = 0; a < processing::kSimulatedAxes; ++a)
+    if (m.calibration[a] || m.kalman[a]) return true;
+  return m.filter.has_value();
+}
+
+// The simulator's model, with the calibration tables of `sensor` when given.
+std::string modelText(const processing::SimulationModel& model, const SensorModel* sensor) {
+  std::string out = sensor
+                        ? "# gyrod sensor model: simulation (docs/simulator.md) and calibration (docs/calibration.md)\n"
+                        : "# gyrod simulation model (docs/simulator.md)\n";
   appendKeyValue(out, "rate_hz", model.rate_hz);
   if (model.dlpf_cfg) out += "dlpf = " + std::to_string(*model.dlpf_cfg) + "\n";
   if (model.fs_sel) out += "fs_sel = " + std::to_string(*model.fs_sel) + "\n";
@@ -329,8 +477,18 @@ std::string modelToToml(const processing::SimulationModel& model) {
       }
       out += "]\n";
     }
+    if (sensor) appendCalibration(out, names[a], *sensor, a);
   }
+  if (sensor && sensor->filter) appendFilter(out, *sensor->filter);
   return out;
+}
+
+}  // namespace
+
+std::string modelToToml(const processing::SimulationModel& model) { return modelText(model, nullptr); }
+
+std::string sensorModelToToml(const SensorModel& model) {
+  return modelText(model.simulation, hasCalibration(model) ? &model : nullptr);
 }
 
 }  // namespace gyrod::recording

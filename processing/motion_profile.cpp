@@ -169,13 +169,12 @@ double MotionProfile::turnsRateAt(double t) const {
 AngularRate MotionProfile::rateAt(double t) const {
   AngularRate w{};
   switch (kind_) {
-    case Kind::Rest:
-      break;
+    case Kind::Rest: break;
     case Kind::Table: {
       if (t <= points_.front().t_s) return points_.front().rate_dps;
       if (t >= points_.back().t_s) return points_.back().rate_dps;
-      const auto after = std::upper_bound(points_.begin(), points_.end(), t,
-                                          [](double v, const MotionPoint& p) { return v < p.t_s; });
+      const auto after =
+          std::upper_bound(points_.begin(), points_.end(), t, [](double v, const MotionPoint& p) { return v < p.t_s; });
       const MotionPoint& hi = *after;
       const MotionPoint& lo = *(after - 1);
       const double f = (t - lo.t_s) / (hi.t_s - lo.t_s);
@@ -191,9 +190,7 @@ AngularRate MotionProfile::rateAt(double t) const {
     case Kind::Constant:
       if (within(t, c_, d_)) w[axis_] = a_;
       break;
-    case Kind::Turns:
-      w[axis_] = turnsRateAt(t);
-      break;
+    case Kind::Turns: w[axis_] = turnsRateAt(t); break;
     case Kind::Sum:
       for (const MotionProfile& part : parts_) {
         const AngularRate v = part.rateAt(t);
@@ -212,24 +209,21 @@ AngularRate MotionProfile::rateAt(double t) const {
 
 double MotionProfile::settledFrom() const {
   switch (kind_) {
-    case Kind::Rest:
-      return 0.0;
-    case Kind::Table:
-      return points_.back().t_s;
-    case Kind::Step:
-      return a_;
+    case Kind::Rest: return 0.0;
+    case Kind::Table: return points_.back().t_s;
+    case Kind::Step: return a_;
     case Kind::Sine:
-    case Kind::Constant:
-      return std::isinf(d_) ? (kind_ == Kind::Constant ? c_ : kForever) : c_ + d_;
-    case Kind::Turns:
-      return d_ + std::ceil(a_) * (c_ + 360.0 / std::fabs(b_));
+    case Kind::Constant: return std::isinf(d_) ? (kind_ == Kind::Constant ? c_ : kForever) : c_ + d_;
+    case Kind::Turns: {
+      const double turn_s = 360.0 / std::fabs(b_), full = std::floor(a_), part = a_ - full;
+      return d_ + full * (c_ + turn_s) + (part > 0.0 ? c_ + part * turn_s : 0.0);
+    }
     case Kind::Sum: {
       double latest = 0.0;
       for (const MotionProfile& part : parts_) latest = std::max(latest, part.settledFrom());
       return latest;
     }
-    case Kind::Sequence:
-      return starts_.empty() ? 0.0 : starts_.back();
+    case Kind::Sequence: return starts_.empty() ? 0.0 : starts_.back();
   }
   return kForever;
 }

@@ -42,13 +42,11 @@ class MotionProfile {
   static MotionProfile sine(std::size_t axis, double frequency_hz, double amplitude_dps, double start_s = 0.0,
                             double duration_s = kForever);
   // rate_dps on `axis` for start ≤ t < start + duration, 0 elsewhere.
-  static MotionProfile constant(std::size_t axis, double rate_dps, double start_s = 0.0,
-                                double duration_s = kForever);
+  static MotionProfile constant(std::size_t axis, double rate_dps, double start_s = 0.0, double duration_s = kForever);
   // `count` full turns (360° each, a fraction allowed for the last) about `axis` at rate_dps
   // (its sign is the direction), each preceded and the last also followed by still_s at rest,
   // from start_s: still, turn, still, turn, ..., still. The angle turned is 360·count exactly.
-  static MotionProfile turns(std::size_t axis, double count, double rate_dps, double still_s,
-                             double start_s = 0.0);
+  static MotionProfile turns(std::size_t axis, double count, double rate_dps, double still_s, double start_s = 0.0);
   // The sum of the parts at every t.
   static MotionProfile sum(std::vector<MotionProfile> parts);
   // Each segment's profile in turn, on its own clock starting at 0, for its duration_s; after

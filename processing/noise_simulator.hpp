@@ -159,7 +159,8 @@ class NoiseSimulator {
 
   // For the mock device, which applies the DLPF, decimation and quantisation itself:
   // the analog rate at the internal rate (bias + ARW + bias instability + RRW + ramp, + the
-  // motion; the truth in true_rate_dps) and temperature, one internal sample per call (t = i/internal rate), and the terms
+  // motion; the truth in true_rate_dps) and temperature, one internal sample per call
+  // (t = i/internal rate), and the terms
   // defined at the output rate (quantisation noise Q, AR, the extra effects), one output
   // sample per call.
   // next() is exactly these two composed as described above; use either next() or
@@ -224,7 +225,7 @@ class NoiseSimulator {
   std::uint64_t output_index_ = 0;
   std::vector<ExtraState> extras_;  // empty when no axis has extra effects
   std::optional<ZigguratNormalGenerator> extra_noise_;
-  std::uint64_t extra_index_ = 0;    // output samples produced by nextOutputRateNoise()
+  std::uint64_t extra_index_ = 0;        // output samples produced by nextOutputRateNoise()
   std::optional<MotionProfile> motion_;  // none: at rest
 };
 

@@ -6,8 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
-#include <numbers>
 #include <cstring>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
@@ -79,13 +79,15 @@ TEST(MotionProfile, TurnsTurnTheStatedAngleWithStillPeriods) {
   EXPECT_EQ(turns.rateAt(1.6)[2], -90.0);  // first turn: 1.5 .. 5.5
   EXPECT_EQ(turns.rateAt(5.9)[2], 0.0);    // still: 5.5 .. 6.5
   const double end = turns.settledFrom();
+  EXPECT_DOUBLE_EQ(end, 0.5 + 2 * (1.0 + 4.0) + 1.0 + 0.5 * 4.0);  // the half turn ends it
+  EXPECT_EQ(turns.rateAt(end - 0.01)[2], -90.0);
   EXPECT_NEAR(integrateAngle(turns, 2, end + 2.0), -900.0, 0.02);
   EXPECT_EQ(turns.rateAt(end + 1.0)[2], 0.0);
 }
 
 TEST(MotionProfile, SumAddsAndSequenceRunsEachOnItsOwnClock) {
-  const MotionProfile sum =
-      MotionProfile::sum({MotionProfile::constant(0, 1.0), MotionProfile::step(0, 1.0, 2.0), MotionProfile::step(1, 0.0, 4.0)});
+  const MotionProfile sum = MotionProfile::sum(
+      {MotionProfile::constant(0, 1.0), MotionProfile::step(0, 1.0, 2.0), MotionProfile::step(1, 0.0, 4.0)});
   EXPECT_EQ(sum.rateAt(0.5), (AngularRate{1.0, 4.0, 0.0}));
   EXPECT_EQ(sum.rateAt(1.5), (AngularRate{3.0, 4.0, 0.0}));
   const MotionProfile seq = MotionProfile::sequence(
@@ -158,7 +160,8 @@ TEST(NoiseSimulatorMotion, AtRestTheStreamIsBitForBitTheOneWithoutMotion) {
 TEST(NoiseSimulatorMotion, MotionGoesThroughTheDlpfOntoTheSameNoise) {
   SimulationModel m = chipModel();
   m.fs_sel.reset();  // no rounding, so the difference is the filtered motion alone
-  const MotionProfile motion = MotionProfile::sum({MotionProfile::step(1, 1.01, 10.0), MotionProfile::sine(2, 1.0, 20.0)});
+  const MotionProfile motion =
+      MotionProfile::sum({MotionProfile::step(1, 1.01, 10.0), MotionProfile::sine(2, 1.0, 20.0)});
   NoiseSimulator plain(m, 20.0, 7);
   NoiseSimulator moving(m, 20.0, 7, motion);
   const DigitalLowPassFilter dlpf(4);

@@ -8,10 +8,15 @@
 #include <stdexcept>
 #include <string>
 
+#include "formats/calibration.hpp"
 #include "formats/model_toml.hpp"
 #include "formats/output_file.hpp"
+#include "processing/allan.hpp"
 #include "processing/axis_analysis.hpp"
+#include "processing/detrend.hpp"
+#include "processing/noise_fit.hpp"
 #include "processing/noise_terms.hpp"
+#include "processing/warm_up_fit.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
 
@@ -218,6 +223,49 @@ void printAxisText(std::ostream& o, const std::string& name, const AxisAnalysis&
   }
 }
 
+// The calibration of one axis into the model: bias against temperature (and a warm-up shape),
+// and, when either was fitted, the five terms refitted on the record without them (the
+// temperature curve would otherwise show as rate random walk and ramp).
+void calibrateAxisInto(recording::SensorModel& sensor, std::size_t slot, const std::string& name,
+                       const std::vector<double>& secs, const recording::Recording& rec, std::size_t idx,
+                       const AnalysisOptions& options, std::vector<std::string>& notes) {
+  recording::AxisCalibrationFit c;
+  try {
+    c = recording::calibrateAxis(secs, rec.axes[idx], rec.temp);
+  } catch (const std::invalid_argument& e) {
+    notes.push_back(name + ": no calibration (" + e.what() + ")");
+    return;
+  }
+  sensor.calibration[slot] = c.calibration;
+  sensor.simulation.axes[slot].bias_dps = c.bias_dps;
+  char line[256];
+  std::snprintf(line, sizeof line, "%s: bias %.6g +- %.2g deg/s at %.3f C", name.c_str(), c.bias_dps,
+                c.calibration.bias_std_dps, c.calibration.temperature_reference_c);
+  std::string note = line;
+  if (c.fit.coefficientFitted()) {
+    std::snprintf(line, sizeof line, ", %.6g +- %.2g deg/s per C over a spread of %.3g C",
+                  c.calibration.temperature_coefficient_dps_per_c, c.calibration.temperature_coefficient_std_dps_per_c,
+                  c.fit.temperature_spread_c);
+    note += line;
+  } else {
+    note += rec.temp.empty() ? ", no temperature column" : ", temperature too flat for a coefficient";
+  }
+  if (c.calibration.warm_up_amplitude_dps != 0.0) {
+    std::snprintf(line, sizeof line, ", warm-up shape %.4g +- %.2g deg/s, tau %.4g s",
+                  c.calibration.warm_up_amplitude_dps, c.calibration.warm_up_amplitude_std_dps,
+                  c.calibration.warm_up_time_constant_s);
+    note += line;
+  }
+  if (c.changed()) {
+    std::vector<double> x = c.corrected;
+    const double tau0 = 1.0 / options.rate_hz;
+    if (options.detrend) removeLinearTrend(x, tau0);
+    sensor.simulation.axes[slot].terms = fitNoiseTerms(allanDeviationTable(x, tau0, options.cluster_sizes)).value;
+    note += "; terms refitted without them";
+  }
+  notes.push_back(note);
+}
+
 int runAnalyze(const AnalyzeOptions& opt) {
   // A target that cannot be written fails now, not after the analysis.
   if (!opt.write_model.empty()) formats::checkOutputTarget(opt.write_model, {opt.file});
@@ -247,22 +295,22 @@ int runAnalyze(const AnalyzeOptions& opt) {
                 in.rate_source.c_str(), rec.size() / in.rate_hz,
                 options.detrend ? ", constant and linear trend removed" : ", no detrending");
   }
-  SimulationModel model;
+  recording::SensorModel sensor;
+  SimulationModel& model = sensor.simulation;
   model.rate_hz = in.rate_hz;
-  if (!rec.temp.empty()) {
-    const double temp_mean = [&] {
-      long double s = 0.0L;
-      for (double v : rec.temp) s += v;
-      return static_cast<double>(s / static_cast<long double>(rec.temp.size()));
-    }();
-    model.temperature.start_c = model.temperature.final_c = temp_mean;
-    model.temperature.noise_std_c = std::sqrt(varianceAboutMean(rec.temp));
-  }
+  const std::vector<double> secs = recording::secondsFromStart(rec, in.rate_hz);
+  if (!rec.temp.empty()) model.temperature = fitExponentialWarmUp(secs, rec.temp);
+  sensor.filter = recording::FilterModel{};
+  sensor.filter->mean_window = opt.mean_window;
+  sensor.filter->mean_threshold_dps = opt.mean_threshold_dps;
+  std::vector<std::string> notes;
   for (std::size_t idx : in.axis_indices) {
     const AxisAnalysis a = analyzeAxis(rec.axes[idx], options);
-    if (const auto slot = recording::axisOfColumn(rec.axis_names[idx])) {
+    if (const auto slot = recording::axisOfColumn(rec.axis_names[idx]); slot && !opt.write_model.empty()) {
       model.axes[*slot].terms = a.noise.value;
       model.axes[*slot].bias_dps = a.zero_mean.mean;
+      sensor.kalman[*slot] = a.filter.kalman;
+      calibrateAxisInto(sensor, *slot, rec.axis_names[idx], secs, rec, idx, options, notes);
     }
     if (opt.json)
       doc["axes"][rec.axis_names[idx]] = axisJson(a);
@@ -270,7 +318,9 @@ int runAnalyze(const AnalyzeOptions& opt) {
       printAxisText(std::cout, rec.axis_names[idx], a);
   }
   if (!opt.write_model.empty()) {
-    formats::writeFileAtomically(opt.write_model, recording::modelToToml(model), {opt.file});
+    std::string head = "# Sensor model of " + opt.file + " from gyroctl analyze (docs/calibration.md).\n";
+    for (const std::string& note : notes) head += "# " + note + "\n";
+    formats::writeFileAtomically(opt.write_model, head + recording::sensorModelToToml(sensor), {opt.file});
     if (!opt.json) std::printf("\nModel written to %s\n", opt.write_model.c_str());
   }
   if (opt.json) std::cout << doc.dump(1) << '\n';
@@ -302,7 +352,8 @@ void addAnalyzeCommand(CLI::App& app, CommandRunner& run) {
       ->default_val(3)
       ->check(CLI::Range(std::size_t{1}, std::size_t{8}));
   sub->add_option("--write-model", opt->write_model,
-                  "write the fitted model (noise terms and bias per axis) as TOML for gyroctl simulate --model");
+                  "write the sensor model (noise terms, bias against temperature, filter parameters per axis) as TOML "
+                  "for gyroctl simulate --model, gyroctl filter --model and gyrod's filter.model");
   sub->callback([&run, opt] { run = [opt] { return runAnalyze(*opt); }; });
 }
 

@@ -1,14 +1,20 @@
-// gyroctl filter: the daemon's per-sample chain, offline: (detrend) → mean filter → Kalman.
+// gyroctl filter: the daemon's per-sample chain, offline: (detrend) → mean filter → Kalman;
+// with --model also the rate stream (raw − b̂(t), processing::RateEstimator).
+#include <array>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 
+#include "formats/calibration.hpp"
 #include "formats/output_file.hpp"
 #include "processing/detrend.hpp"
 #include "processing/filter_chain.hpp"
+#include "processing/rate_estimator.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
 
@@ -16,6 +22,13 @@ namespace gyrod::gyroctl {
 namespace {
 
 using namespace gyrod::processing;
+
+// 17 significant digits: every double survives the text round trip exactly.
+void appendNumber(std::string& out, double v) {
+  char buf[32];
+  const int n = std::snprintf(buf, sizeof buf, "%.17g", v);
+  out.append(buf, static_cast<std::size_t>(n));
+}
 
 struct FilterOptions {
   std::string file;
@@ -26,6 +39,7 @@ struct FilterOptions {
   std::optional<double> ar_phi, kalman_q, kalman_r;
   bool no_detrend = false;
   std::vector<double> bias_dps;  // --bias: subtract these constants instead of detrending
+  std::string model;             // --model: add the rate stream's columns
 };
 
 // Identifying the Kalman filter from the file (the AR(1) fit of the mean-filtered series and
@@ -34,12 +48,60 @@ struct FilterOptions {
 // chain runs sample by sample as gyrod does, on any number of samples.
 constexpr std::size_t kMinSamplesToIdentify = 100;
 
-// 17 significant digits: every double survives the text round trip exactly.
-void appendNumber(std::string& out, double v) {
-  char buf[32];
-  const int n = std::snprintf(buf, sizeof buf, "%.17g", v);
-  out.append(buf, static_cast<std::size_t>(n));
-}
+// The rate stream of a recording (--model): processing::RateEstimator fed with the raw
+// columns, the t column and the temp column, as gyrod feeds it.
+class RateColumns {
+ public:
+  RateColumns(const FilterOptions& opt, const recording::Recording& rec, double rate_hz)
+      : rec_(rec), dt_(1.0 / rate_hz) {
+    processing::RateEstimatorParameters p =
+        recording::rateEstimatorParameters(recording::readSensorModelToml(opt.model));
+    if (std::fabs(p.rate_hz - rate_hz) > 1e-9 * rate_hz)
+      std::fprintf(stderr, "%s: model rate %g Hz, recording %g Hz: the rate stream runs at the recording's\n",
+                   opt.model.c_str(), p.rate_hz, rate_hz);
+    p.rate_hz = rate_hz;
+    for (std::size_t slot = 0; slot < kMotionAxes; ++slot) {
+      const std::string name(recording::kGyroColumns[slot]);
+      const std::vector<double>* column = rec.axis(name);
+      if (!column)
+        throw recording::RecordingError(opt.file + ": --model needs the columns gx, gy and gz (the still detector " +
+                                        "tests all three); '" + name + "' is missing");
+      columns_[slot] = column;
+    }
+    if (rec.temp.empty()) {
+      fixed_temperature_c_ = p.axes[0].temperature_reference_c;
+      std::fprintf(stderr, "%s has no temp column: the rate stream takes the model's reference temperature, %g C\n",
+                   opt.file.c_str(), fixed_temperature_c_);
+    }
+    estimator_.emplace(p);
+  }
+  static void appendHeader(std::string& out, const recording::Recording& rec) {
+    for (const auto& name : rec.axis_names) out += "," + name + "_rate," + name + "_bias";
+    out += ",still";
+  }
+  void appendRow(std::string& out, std::size_t i) {
+    AngularRate raw{};
+    for (std::size_t slot = 0; slot < kMotionAxes; ++slot) raw[slot] = (*columns_[slot])[i];
+    const double t = rec_.t.empty() ? static_cast<double>(i) * dt_ : rec_.t[i];
+    const RateSample s = estimator_->update(t, raw, rec_.temp.empty() ? fixed_temperature_c_ : rec_.temp[i]);
+    for (const auto& name : rec_.axis_names) {
+      const std::size_t slot = *recording::axisOfColumn(name);
+      out += ',';
+      appendNumber(out, s.rate_dps[slot]);
+      out += ',';
+      appendNumber(out, s.bias_dps[slot]);
+    }
+    out += s.still ? ",1" : ",0";
+  }
+  std::size_t stillSamples() const { return estimator_->updates(); }
+
+ private:
+  const recording::Recording& rec_;
+  double dt_;
+  std::array<const std::vector<double>*, kMotionAxes> columns_{};
+  double fixed_temperature_c_ = 0.0;
+  std::optional<RateEstimator> estimator_;
+};
 
 int runFilter(const FilterOptions& opt) {
   if (opt.kalman_q && !(*opt.kalman_q >= 0.0)) throw std::invalid_argument("--kalman-q must be >= 0");
@@ -65,6 +127,8 @@ int runFilter(const FilterOptions& opt) {
       << ", or give --ar-phi, --kalman-q and --kalman-r)";
     throw recording::RecordingError(s.str());
   }
+  std::optional<RateColumns> rate_columns;  // first, so that a bad --model fails before any work
+  if (!opt.model.empty()) rate_columns.emplace(opt, rec, in.rate_hz);
 
   std::vector<std::vector<double>> chain_input;
   std::vector<FilterChainParameters> params;
@@ -89,6 +153,7 @@ int runFilter(const FilterOptions& opt) {
   out.reserve(n * (1 + 3 * rec.axes.size()) * 24 + 64);
   out += "t";
   for (const auto& name : rec.axis_names) out += "," + name + "," + name + "_mean," + name + "_kalman";
+  if (rate_columns) RateColumns::appendHeader(out, rec);
   out += '\n';
   std::vector<AxisFilterChain> chains;
   chains.reserve(params.size());
@@ -105,9 +170,10 @@ int runFilter(const FilterOptions& opt) {
       out += ',';
       appendNumber(out, f.kalman_dps);
     }
+    if (rate_columns) rate_columns->appendRow(out, i);
     out += '\n';
   }
-  formats::writeFileAtomically(opt.output, out, {opt.file});
+  formats::writeFileAtomically(opt.output, out, {opt.file, opt.model});
 
   for (std::size_t axis = 0; axis < params.size(); ++axis) {
     const auto& k = params[axis].kalman;
@@ -116,6 +182,9 @@ int runFilter(const FilterOptions& opt) {
                  opt.ar_phi || opt.kalman_q || opt.kalman_r ? " (some given on the command line)"
                                                             : " (identified from the file)");
   }
+  if (rate_columns)
+    std::fprintf(stderr, "rate stream from %s: %zu of %zu samples still (they updated the residual bias)\n",
+                 opt.model.c_str(), rate_columns->stillSamples(), n);
   std::fprintf(stderr, "wrote %zu samples to %s\n", n, opt.output.c_str());
   return kExitOk;
 }
@@ -143,6 +212,9 @@ void addFilterCommand(CLI::App& app, CommandRunner& run) {
                   "subtract these constants [deg/s], one per gyro column, instead of detrending (as gyrod does)")
       ->delimiter(',')
       ->excludes(no_detrend);
+  sub->add_option("--model", opt->model,
+                  "sensor model file (gyroctl analyze --write-model): add gx_rate,gx_bias per axis and still, "
+                  "the rate stream of processing::RateEstimator (docs/calibration.md)");
   sub->callback([&run, opt] { run = [opt] { return runFilter(*opt); }; });
 }
 

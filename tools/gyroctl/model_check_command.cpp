@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "formats/calibration.hpp"
 #include "formats/model_toml.hpp"
 #include "formats/output_file.hpp"
 #include "processing/model_check.hpp"
@@ -364,14 +365,6 @@ std::optional<std::size_t> simulatorAxisFor(const std::string& column) {
   return recording::axisOfColumn(column);
 }
 
-// Seconds from the first sample for each sample: from t when present, else i/rate.
-std::vector<double> secondsFromStart(const recording::Recording& rec, double rate_hz) {
-  std::vector<double> s(rec.size());
-  for (std::size_t i = 0; i < s.size(); ++i)
-    s[i] = rec.t.empty() ? static_cast<double>(i) / rate_hz : rec.t[i] - rec.t[0];
-  return s;
-}
-
 // Mean of the noise-free curve over the recording's times: the temperature term's
 // reference, so that k·(T − reference) averages to zero and bias_dps stays the mean rate.
 double meanOfCurve(const TemperatureModel& m, std::span<const double> secs) {
@@ -437,9 +430,10 @@ AxisNoiseModel extendedAxisModel(const AxisModelCheck& r, std::span<const double
 std::string extendedModelToml(const ModelCheckCliOptions& opt, const LoadedInput& in,
                               const std::vector<std::pair<std::string, AxisModelCheck>>& results) {
   const recording::Recording& rec = in.recording;
-  SimulationModel model;
+  recording::SensorModel sensor;
+  SimulationModel& model = sensor.simulation;
   model.rate_hz = in.rate_hz;
-  const std::vector<double> secs = secondsFromStart(rec, in.rate_hz);
+  const std::vector<double> secs = recording::secondsFromStart(rec, in.rate_hz);
   double reference_c = model.temperature.start_c;
   if (!rec.temp.empty()) {
     model.temperature = processing::fitExponentialWarmUp(secs, rec.temp);
@@ -452,6 +446,13 @@ std::string extendedModelToml(const ModelCheckCliOptions& opt, const LoadedInput
     if (!slot) continue;
     model.axes[*slot] = extendedAxisModel(r, rec.axes[in.axis_indices[k]], rec, in.rate_hz, reference_c, name, notes);
     axes_written.push_back(name);
+    // The rate stream's calibration, fitted as gyroctl analyze fits it (bias_dps stays the
+    // check's: the mean with its steps removed).
+    try {
+      sensor.calibration[*slot] = recording::calibrateAxis(secs, rec.axes[in.axis_indices[k]], rec.temp).calibration;
+    } catch (const std::invalid_argument& e) {
+      notes.push_back(name + ": no calibration (" + e.what() + ")");
+    }
   }
   validateSimulationModel(model);
   std::string head = "# Extended model of " + opt.file + " from gyroctl model-check (seed " + std::to_string(opt.seed) +
@@ -466,7 +467,7 @@ std::string extendedModelToml(const ModelCheckCliOptions& opt, const LoadedInput
         "# [temperature] is a warm-up curve fitted to the recording's temperature; the recording's own\n"
         "# temperature (room cycles, steps) is not reproduced, only the temperature coefficient.\n";
   for (const std::string& note : notes) head += "# " + note + "\n";
-  return head + recording::modelToToml(model);
+  return head + recording::sensorModelToToml(sensor);
 }
 
 int runModelCheck(const ModelCheckCliOptions& opt) {

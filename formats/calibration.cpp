@@ -1,0 +1,67 @@
+#include "formats/calibration.hpp"
+
+#include <cmath>
+
+namespace gyrod::recording {
+
+processing::RateEstimatorParameters rateEstimatorParameters(const SensorModel& model) {
+  processing::RateEstimatorParameters p;
+  p.rate_hz = model.simulation.rate_hz;
+  const FilterModel filter = model.filter.value_or(FilterModel{});
+  p.still = filter.still;
+  p.bias_instability_horizon_s = filter.bias_instability_horizon_s;
+  p.temperature_smoothing_s = filter.temperature_smoothing_s;
+  p.low_pass_hz = filter.low_pass_hz;
+  for (std::size_t a = 0; a < processing::kMotionAxes; ++a) {
+    processing::AxisBiasModel& m = p.axes[a];
+    m.terms = model.simulation.axes[a].terms;
+    m.bias_dps = model.simulation.axes[a].bias_dps;
+    if (const auto& c = model.calibration[a]) {
+      m.bias_std_dps = c->bias_std_dps;
+      m.temperature_coefficient_dps_per_c = c->temperature_coefficient_dps_per_c;
+      m.temperature_coefficient_std_dps_per_c = c->temperature_coefficient_std_dps_per_c;
+      m.temperature_reference_c = c->temperature_reference_c;
+      m.warm_up_amplitude_dps = c->warm_up_amplitude_dps;
+      m.warm_up_time_constant_s = c->warm_up_time_constant_s;
+    }
+  }
+  processing::validateRateEstimatorParameters(p);
+  return p;
+}
+
+std::vector<double> secondsFromStart(const Recording& rec, double rate_hz) {
+  std::vector<double> s(rec.size());
+  for (std::size_t i = 0; i < s.size(); ++i)
+    s[i] = rec.t.empty() ? static_cast<double>(i) / rate_hz : rec.t[i] - rec.t[0];
+  return s;
+}
+
+AxisCalibrationFit calibrateAxis(std::span<const double> secs, std::span<const double> rate_dps,
+                                 std::span<const double> temp_c) {
+  constexpr double kReferenceWithoutTemperatureC = 25.0;
+  const std::vector<double> constant_temperature(temp_c.empty() ? rate_dps.size() : 0, kReferenceWithoutTemperatureC);
+  const std::span<const double> temp = temp_c.empty() ? std::span<const double>(constant_temperature) : temp_c;
+  AxisCalibrationFit out;
+  out.fit = processing::fitTemperatureBias(secs, rate_dps, temp);
+  const processing::TemperatureBiasFit& f = out.fit;
+  out.bias_dps = f.bias_dps;
+  AxisCalibration& c = out.calibration;
+  c.bias_std_dps = f.bias_std_dps;
+  c.temperature_coefficient_dps_per_c = f.coefficient_dps_per_c;
+  c.temperature_coefficient_std_dps_per_c = f.coefficient_std_dps_per_c;
+  c.temperature_reference_c = f.reference_c;
+  c.warm_up_amplitude_dps = f.warm_up_amplitude_dps;
+  c.warm_up_amplitude_std_dps = f.warm_up_amplitude_std_dps;
+  c.warm_up_time_constant_s = f.warm_up_time_constant_s;
+  out.corrected.assign(rate_dps.begin(), rate_dps.end());
+  const double t0 = secs.empty() ? 0.0 : secs.front();
+  for (std::size_t i = 0; i < out.corrected.size(); ++i) {
+    double model = f.coefficient_dps_per_c * (temp[i] - f.reference_c);
+    if (f.warm_up_amplitude_dps != 0.0)
+      model += f.warm_up_amplitude_dps * std::exp(-(secs[i] - t0) / f.warm_up_time_constant_s);
+    out.corrected[i] -= model;
+  }
+  return out;
+}
+
+}  // namespace gyrod::recording
