@@ -58,7 +58,7 @@ void NoiseRefitWorker::onAxisDone() {
   {
     const std::lock_guard lock(mutex_);
     if (work_) return;  // not done yet (a stale wake-up)
-    result = std::move(result_);
+    result = result_;   // trivially copyable: a plain copy
   }
   pipeline_.applyNoiseRefit(*axis_, result);
   if (*axis_ + 1 < kAxes) {
@@ -87,7 +87,7 @@ void NoiseRefitWorker::threadMain() {
       spdlog::error("noise refit failed: {}", e.what());
     }
     lock.lock();
-    result_ = std::move(result);
+    result_ = result;
     work_ = false;
     const std::uint64_t one = 1;
     [[maybe_unused]] const ssize_t n = ::write(done_fd_.get(), &one, sizeof one);
