@@ -46,9 +46,9 @@ struct WatchOptions {
   std::optional<std::uint64_t> count;
 };
 
-// The columns follow the first RATE line: with `rate` (gyrod with the rate stream) the stream
-// to read comes first, then raw and the paper's kalman, then the still detector; a line
-// without it (an older gyrod) shows raw and kalman only.
+// Two layouts. Once a RATE line carries `rate` the stream to read comes first, then raw and
+// the paper's kalman, then the still detector, with a new header where the switch happens;
+// until then (an older gyrod, or gyrod still estimating its start-up bias) raw and kalman.
 void printRateHeader(bool with_rate) {
   if (with_rate) {
     std::printf("%10s %12s  %10s %10s %10s  %10s %10s %10s  %10s %10s %10s %6s  [deg/s]\n", "seq", "t [s]", "rate x",
@@ -97,7 +97,7 @@ int runWatch(const WatchOptions& opt) {
   if (opt.common.json) std::printf("%s\n", conn.versionLine().c_str());
   conn.sendLine(protocol::requestLine(protocol::WatchRequest{true, opt.decimate}));
   std::uint64_t rates = 0;
-  std::optional<bool> with_rate;  // the layout, from the first RATE line
+  std::optional<bool> with_rate;  // the layout; none before the first RATE line
   while (!opt.count || rates < *opt.count) {
     const std::string line = conn.readLine(std::nullopt);
     const protocol::ServerMessage message = parseServerLine(line);
@@ -107,8 +107,9 @@ int runWatch(const WatchOptions& opt) {
     if (opt.common.json) {
       std::printf("%s\n", line.c_str());
     } else if (rate) {
-      if (!with_rate) {
-        with_rate = std::isfinite(rate->rate_dps[0]) || rate->still.has_value();
+      const bool carries_rate = std::isfinite(rate->rate_dps[0]) || rate->still.has_value();
+      if (!with_rate || (carries_rate && !*with_rate)) {
+        with_rate = carries_rate;
         printRateHeader(*with_rate);
       }
       printRate(*rate, *with_rate);
