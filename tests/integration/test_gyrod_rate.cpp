@@ -56,6 +56,28 @@ std::string rateConfig(const std::filesystem::path& dir, const std::filesystem::
   return c.str();
 }
 
+// Reads RATE lines until `count` arrived (GAP lines would be a failure here: none are injected).
+std::vector<json> readRates(LineClient& c, std::size_t count) {
+  std::vector<json> rates;
+  while (rates.size() < count) {
+    const auto line = c.readLine(20s);
+    if (!line) break;
+    json j = json::parse(*line);
+    EXPECT_NE(j["class"], "GAP") << *line;
+    if (j["class"] == "RATE") rates.push_back(std::move(j));
+  }
+  return rates;
+}
+
+std::string statusRateModel(const std::filesystem::path& socket) {
+  LineClient asker(socket.string());
+  if (!asker.readLine()) return "(no VERSION)";
+  asker.send("{\"cmd\":\"status\"}\n");
+  while (const auto line = asker.readLine(10s))
+    if (line->find("\"STATUS\"") != std::string::npos) return json::parse(*line).value("rate_model", "(none)");
+  return "(no STATUS)";
+}
+
 double meanOf(const std::vector<double>& v) {
   double m = 0.0;
   for (double x : v) m += x / static_cast<double>(v.size());
@@ -187,4 +209,61 @@ TEST(GyrodRate, BadRateLowPassExitsWithExConfigNamingFileLineAndKey) {
   const std::string log = readWholeFile(d.path() / "log.txt");
   EXPECT_NE(log.find(cfg.string() + ":5"), std::string::npos) << log;
   EXPECT_NE(log.find("filter.rate_low_pass_hz"), std::string::npos) << log;
+}
+
+TEST(GyrodRate, SighupAppliesANewModelWithoutLosingTheStreamAndABadOneChangesNothing) {
+  ScratchDir d;
+  const auto model = d.write("sensor.toml", sensorModel());
+  std::string config = rateConfig(d.path(), model);
+  const std::string model_line = "model = \"" + model.string() + "\"\n";
+  config.erase(config.find(model_line), model_line.size());  // start without a model
+  const auto cfg = d.write("gyrod.toml", config);
+  GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt");
+  LineClient w((d.path() / "gyrod.sock").string());
+  ASSERT_TRUE(w.connected()) << readWholeFile(d.path() / "log.txt");
+  ASSERT_TRUE(w.readLine());  // VERSION
+  ASSERT_TRUE(w.send("{\"cmd\":\"watch\"}\n"));
+  const auto before = readRates(w, 100);
+  ASSERT_EQ(before.size(), 100u);
+  EXPECT_EQ(statusRateModel(d.path() / "gyrod.sock"), "bias");
+  for (const json& r : before) {
+    ASSERT_TRUE(r.contains("rate")) << r.dump();  // raw − the configured bias, from the first sample
+    EXPECT_FALSE(r.contains("still")) << r.dump();
+    for (int a = 0; a < 3; ++a) EXPECT_EQ(r["rate"][a].get<double>(), r["raw"][a].get<double>() - kBias[a]) << r.dump();
+  }
+
+  // A model file that does not parse: the running stream is kept.
+  const auto broken = d.write("broken.toml", "[x]\narw_deg_per_sqrt_h = \"fast\"\n");
+  std::string with_broken = config;
+  with_broken.insert(with_broken.find("[filter]\n") + 9, "model = \"" + broken.string() + "\"\n");
+  d.write("gyrod.toml", with_broken);
+  gyrod.signal(SIGHUP);
+  (void)readRates(w, 50);
+  EXPECT_EQ(statusRateModel(d.path() / "gyrod.sock"), "bias");
+  EXPECT_NE(readWholeFile(d.path() / "log.txt").find("keeping the running filter"), std::string::npos);
+
+  d.write("gyrod.toml", rateConfig(d.path(), model));
+  gyrod.signal(SIGHUP);
+  std::vector<json> after;
+  for (int tries = 0; tries < 20 && (after.empty() || !after.back().contains("still")); ++tries) {
+    auto more = readRates(w, 50);
+    after.insert(after.end(), more.begin(), more.end());
+  }
+  ASSERT_FALSE(after.empty());
+  EXPECT_TRUE(after.back().contains("still")) << after.back().dump();
+  EXPECT_EQ(statusRateModel(d.path() / "gyrod.sock"), "model " + model.string());
+  EXPECT_EQ(after.back()["seq"].get<std::uint64_t>() - before.back()["seq"].get<std::uint64_t>(), 50 + after.size())
+      << "no sample lost across the reloads";
+  gyrod.signal(SIGTERM);
+  EXPECT_EQ(gyrod.waitExit(2000ms), std::optional<int>(0)) << readWholeFile(d.path() / "log.txt");
+}
+
+TEST(GyrodRate, RateLowPassWithoutAModelIsAConfigError) {
+  ScratchDir d;
+  const auto cfg = d.write("gyrod.toml", "[device]\nbackend = \"mock\"\n[filter]\nrate_low_pass_hz = 5\n");
+  GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt");
+  EXPECT_EQ(gyrod.waitExit(5000ms), std::optional<int>(78));
+  const std::string log = readWholeFile(d.path() / "log.txt");
+  EXPECT_NE(log.find(cfg.string() + ":4"), std::string::npos) << log;
+  EXPECT_NE(log.find("needs filter.model"), std::string::npos) << log;
 }
