@@ -17,6 +17,7 @@
 #include "driver/counter_names.hpp"
 #include "formats/calibration.hpp"
 #include "formats/model_toml.hpp"
+#include "formats/toml_document.hpp"
 
 namespace gyrod::daemon {
 namespace {
@@ -142,6 +143,9 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
     options.header_comments.push_back("gyrod " + std::string(GYROD_RELEASE) + " recording of " + device_.description);
     options.header_comments.push_back(
         "raw rates as read from the chip (bias not removed); GAP lines mark lost samples");
+    if (rate_model_.params)  // the recording holds what the rate stream was fed, at full precision
+      options.header_comments.push_back("the RATE stream's rate, bias and still: gyroctl filter FILE --model " +
+                                        config_.filter.model + " --rate " + formats::shortest(config_.device.rate_hz));
     recorder_ = std::make_unique<Recorder>(options);
   }
 
@@ -192,6 +196,9 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
                server_->socketPath().empty() ? std::string("(socket activation)") : server_->socketPath(),
                recorder_ ? ", recording to " + recorder_->currentFile() : std::string());
   if (!device_.virtual_clock) spdlog::info("event loop scheduling: {}", loopSchedulingNote());
+  spdlog::info("rate stream: {}", pipeline_.rateModel() == RateModel::SensorModel
+                                      ? "raw - the bias of the sensor model " + config_.filter.model
+                                      : std::string("raw - the bias of [bias] (no filter.model: no temperature term)"));
   if (pipeline_.phase() == PipelinePhase::Estimating)
     spdlog::info("keep the sensor still: estimating {} over the first {:.1f} s",
                  config_.bias.source == BiasSource::Estimate ? "the bias and the filter" : "the filter",
