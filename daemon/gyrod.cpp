@@ -75,7 +75,12 @@ LoadedRateModel Gyrod::loadRateModel(const GyrodConfig& c) {
   LoadedRateModel loaded;
   const FilterConfig& f = c.filter;
   if (f.model.empty()) return loaded;
-  const recording::SensorModel model = recording::readSensorModelToml(f.model);
+  recording::SensorModel model;
+  try {
+    model = recording::readSensorModelToml(f.model);  // its messages name FILE:LINE
+  } catch (const std::exception& e) {                 // unreadable, or not a model file: a misconfiguration
+    throw ConfigError(std::string(e.what()) + " (filter.model)");
+  }
   try {
     processing::RateEstimatorParameters p = recording::rateEstimatorParameters(model);
     if (std::fabs(p.rate_hz - c.device.rate_hz) > 1e-9 * c.device.rate_hz)
@@ -86,7 +91,7 @@ LoadedRateModel Gyrod::loadRateModel(const GyrodConfig& c) {
     processing::validateRateEstimatorParameters(p);
     loaded.params = p;
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(f.model + " (filter.model): cannot run the rate stream on it: " + e.what());
+    throw ConfigError(f.model + " (filter.model): cannot run the rate stream on it: " + std::string(e.what()));
   }
   std::ostringstream identity;
   identity << f.model << '\n' << f.rate_low_pass_hz.value_or(-1.0) << '\n' << recording::sensorModelToToml(model);
@@ -122,8 +127,8 @@ PipelineSettings Gyrod::pipelineSettings(const GyrodConfig& c, const LoadedRateM
 Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
     : config_(config),
       config_file_(std::move(config_file)),
-      device_(makeDeviceParts(config)),
       rate_model_(loadRateModel(config)),
+      device_(makeDeviceParts(config)),
       pipeline_(pipelineSettings(config, rate_model_)),
       noise_refit_(loop_, pipeline_, config.device.rate_hz, [this] { allan_reply_.invalidate(); }),
       allan_reply_([this] { return allanReport(); }) {

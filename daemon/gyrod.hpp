@@ -64,9 +64,9 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   GyrodConfig config_;
   std::string config_file_;
   EventLoop loop_;
+  LoadedRateModel rate_model_;  // first: a bad model file is a configuration error (exit 78)
   DeviceParts device_;
   std::unique_ptr<driver::Mpu6050Driver> driver_;
-  LoadedRateModel rate_model_;
   SamplePipeline pipeline_;
   NoiseRefitWorker noise_refit_;
   AllanReplyCache allan_reply_;

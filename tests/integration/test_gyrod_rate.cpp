@@ -31,6 +31,8 @@ constexpr double kModelBiasStdDps = 0.02;
 
 // The default mock model's terms and biases (daemon/device_backend.cpp), as a sensor model
 // with a calibration: what `gyroctl analyze --write-model` would find on a long still record.
+// The mock simulates the file filter.model names, so this is the simulated chip's own model
+// (at a constant 25 °C: the file has no [temperature]).
 std::string sensorModel() {
   std::ostringstream m;
   m << "rate_hz = 50\n";
@@ -276,33 +278,53 @@ TEST(GyrodRate, RateLowPassWithoutAModelIsAConfigError) {
 TEST(GyrodRate, TheOfflineRateStreamMatchesAcrossGaps) {
   ScratchDir d;
   const auto model = d.write("sensor.toml", sensorModel());
-  const auto cfg = d.write("gyrod.toml", rateConfig(d.path(), model, "[mock.faults]\nfifo_overflow_at_s = [3, 7]\n"));
+  const auto cfg = d.write("gyrod.toml", rateConfig(d.path(), model, "[mock.faults]\nfifo_overflow_at_s = [6, 9]\n"));
   GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt");
   LineClient watcher((d.path() / "gyrod.sock").string());
   ASSERT_TRUE(watcher.connected()) << readWholeFile(d.path() / "log.txt");
   ASSERT_TRUE(watcher.readLine());  // VERSION
   ASSERT_TRUE(watcher.send("{\"cmd\":\"watch\"}\n"));
   std::vector<json> rates;
-  std::size_t gaps = 0;
-  while (rates.size() < 500) {
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> gaps;  // first missing seq, count
+  while (rates.size() < 700) {
     const auto line = watcher.readLine(20s);
     ASSERT_TRUE(line.has_value()) << readWholeFile(d.path() / "log.txt");
     json j = json::parse(*line);
     if (j["class"] == "RATE") rates.push_back(std::move(j));
-    if (j["class"] == "GAP") ++gaps;
+    if (j["class"] == "GAP") gaps.emplace_back(j["seq"].get<std::uint64_t>(), j["count"].get<std::uint64_t>());
   }
   gyrod.signal(SIGTERM);
   ASSERT_EQ(gyrod.waitExit(2000ms), std::optional<int>(0)) << readWholeFile(d.path() / "log.txt");
-  ASSERT_GE(gaps, 1u);
-  ASSERT_EQ(rates.front()["seq"], 0u);  // the watch saw every sample, so line i is recording row i
+  ASSERT_GE(gaps.size(), 1u);
+  // The watcher connected before the first gap (at 6 s), so it saw every GAP: a sample's row in
+  // the recording is its seq less the samples lost before it.
+  ASSERT_LT(rates.front()["seq"].get<std::uint64_t>(), gaps.front().first);
+  const auto rowOf = [&gaps](std::uint64_t seq) {
+    std::uint64_t lost = 0;
+    for (const auto& [first, count] : gaps) lost += first < seq ? count : 0;
+    return static_cast<std::size_t>(seq - lost);
+  };
   std::string rec_path;
   for (const auto& e : std::filesystem::directory_iterator(d.path()))
     if (e.path().filename().string().rfind("rec-", 0) == 0) rec_path = e.path().string();
   ASSERT_FALSE(rec_path.empty());
   const auto offline = offlineRate(rec_path, model, d);
-  ASSERT_GE(offline.size(), rates.size());
-  for (std::size_t i = 0; i < rates.size(); ++i) {
-    for (int a = 0; a < 3; ++a) ASSERT_EQ(rates[i]["rate"][a].get<double>(), offline[i].rate[a]) << "row " << i;
-    ASSERT_EQ(rates[i]["still"].get<bool>(), offline[i].still) << "row " << i;
+  for (const json& r : rates) {
+    const std::size_t i = rowOf(r["seq"].get<std::uint64_t>());
+    ASSERT_LT(i, offline.size());
+    for (int a = 0; a < 3; ++a) ASSERT_EQ(r["rate"][a].get<double>(), offline[i].rate[a]) << "row " << i;
+    ASSERT_EQ(r["still"].get<bool>(), offline[i].still) << "row " << i;
   }
+}
+
+TEST(GyrodRate, AModelFileThatIsNotOneExitsWithExConfigNamingItsLine) {
+  ScratchDir d;
+  const auto model = d.write("sensor.toml", "rate_hz = 50\n[x]\narw_deg_per_sqrt_h = \"fast\"\n");
+  const auto cfg =
+      d.write("gyrod.toml", "[device]\nbackend = \"mock\"\n[filter]\nmodel = \"" + model.string() + "\"\n");
+  GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt");
+  EXPECT_EQ(gyrod.waitExit(5000ms), std::optional<int>(78));
+  const std::string log = readWholeFile(d.path() / "log.txt");
+  EXPECT_NE(log.find(model.string() + ":3"), std::string::npos) << log;
+  EXPECT_NE(log.find("filter.model"), std::string::npos) << log;
 }
