@@ -72,6 +72,26 @@ TEST(GyroctlErrors, NaNAndInfAreRejectedWithTheirLine) {
                      ":2: column 'gx': non-finite value '1e999'");
 }
 
+// A finite value the statistics cannot carry, or a series they reject, is named by file
+// (and line) before anything reaches stdout, never by an internal function's name.
+TEST(GyroctlErrors, ValuesTheAnalysisCannotCarryAreRefusedBeforeAnyOutput) {
+  ScratchDir d;
+  std::string huge_text = "t,gx\n", constant_text = "t,gx\n";
+  for (int i = 0; i < 200; ++i) {
+    const std::string t = std::to_string(i * 0.02);
+    huge_text += t + (i == 5 ? ",1e308\n" : i % 2 ? ",0.1\n" : ",-0.1\n");
+    constant_text += t + ",0.5\n";
+  }
+  const auto huge = d.write("huge.csv", huge_text);
+  const auto r = runGyroctl("analyze " + huge.string(), d.path());
+  expectOneLineError(r, huge.string() + ":7: column 'gx': 1e+308 deg/s is beyond 1e+12 deg/s");
+  const auto constant = d.write("constant.csv", constant_text);
+  const auto c = runGyroctl("analyze " + constant.string() + " --json", d.path());
+  expectOneLineError(c, constant.string() + ": column 'gx': ");
+  EXPECT_EQ(c.err.find("yuleWalker"), std::string::npos) << c.err;
+  EXPECT_EQ(c.err.find("Test:"), std::string::npos) << c.err;
+}
+
 TEST(GyroctlErrors, MissingColumn) {
   ScratchDir d;
   const auto f = d.write("w.csv", whiteNoiseCsv(500, 50.0, 1));
