@@ -175,3 +175,20 @@ TEST(GyroctlErrors, ImportOfAForeignFileThatIsNotImucal) {
   expectOneLineError(runGyroctl("import " + g.string() + " -o " + (d.path() / "o.csv").string(), d.path()),
                      g.string() + ":5: column 'gy': 'x' is not an integer count");
 }
+
+// The importer bounds its lines as the recording reader does and escapes what it echoes.
+TEST(GyroctlErrors, ImportBoundsLinesAndEscapesEchoedValues) {
+  ScratchDir d;
+  const auto out = (d.path() / "o.csv").string();
+  const auto long_line = d.write("long.csv", "Fs,100\nax,ay,az,gx,gy,gz\n1,2,3," + std::string(70'000, '4') + ",5,6\n");
+  expectOneLineError(runGyroctl("import " + long_line.string() + " -o " + out, d.path()),
+                     long_line.string() + ":3: line longer than 65536 bytes (the limit for one line)");
+  const auto escape = d.write("esc.csv", "Fs,100\nax,ay,az,gx,gy,gz\n1,2,3,4,\x1b[2J\xe2\x80\xae,6\n");
+  expectOneLineError(runGyroctl("import " + escape.string() + " -o " + out, d.path()),
+                     escape.string() + ":3: column 'gy': '\\x1B[2J\\u{202E}' is not an integer count");
+  const auto wide = d.write("wide.csv", "Fs," + std::string(5000, '7') + "x\n");
+  const auto r = runGyroctl("import " + wide.string() + " -o " + out, d.path());
+  expectOneLineError(r, wide.string() + ":1: sample rate '" + std::string(80, '7') + "…' (5001 bytes) is not");
+  EXPECT_LT(r.err.size(), 400u) << r.err.size();
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
