@@ -359,10 +359,22 @@ void checkReferences(const Section& filter, const Section& socket, const Section
   if (!config.socket.group.empty() && !groupExists(config.socket.group))
     socket.failValue("group", "no such group on this system");
   if (config.device.backend == DeviceBackend::Mock && config.mock.source == MockSource::Replay) {
+    double rate = 50.0;  // as the replay source assumes for a file without t
     try {
-      (void)recording::readRecordingCsv(config.mock.replay_file);
+      const recording::Recording rec = recording::readRecordingCsv(config.mock.replay_file);
+      if (rec.t.size() >= 2) rate = recording::sampleRateFromTimes(rec);
     } catch (const std::exception& e) {
       mock.failValue("replay_file", e.what());
+    }
+    // The mock holds each recorded sample for a whole number of the chip's internal periods.
+    const double internal = driver::mpu6050::gyroOutputRateHz(config.device.dlpf);
+    const double ratio = internal / rate;
+    const double hold = std::round(ratio);
+    if (hold < 1.0 || std::abs(ratio - hold) > 1e-6 * ratio) {
+      std::ostringstream cause;  // 6 digits: a rate inferred from t is not exact anyway
+      cause << "a recording at " << rate << " Hz cannot be replayed at the chip's internal rate of " << internal
+            << " Hz (it must divide it)";
+      mock.failValue("replay_file", cause.str());
     }
   }
 }

@@ -523,6 +523,22 @@ TEST(ConfigErrors, ReferencedFilesAndGroupAreCheckedWhenLoadingAFile) {
     const std::string m = e.what();
     EXPECT_EQ(m.rfind(replay + ":5: key 'mock.replay_file': " + bad_csv + ":2: ", 0), 0u) << m;
   }
+  // 30 Hz does not divide the chip's 1 kHz internal rate (dlpf 4): the mock could not replay it.
+  const auto odd_rate = d.write("odd.csv", "t,gx\n0,1\n0.0333333333333,2\n0.0666666666667,3\n");
+  const auto odd = d.write(
+      "odd.toml", "[device]\nbackend = \"mock\"\n[mock]\nsource = \"replay\"\nreplay_file = \"" + odd_rate + "\"\n");
+  try {
+    loadConfigFile(odd);
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind(odd + ":5: key 'mock.replay_file': a recording at 30", 0), 0u) << m;
+    EXPECT_NE(m.find("cannot be replayed at the chip's internal rate of 1000 Hz"), std::string::npos) << m;
+  }
+  const auto good_rate = d.write("good.csv", "t,gx\n0,1\n0.02,2\n0.04,3\n");
+  const auto good = d.write(
+      "good.toml", "[device]\nbackend = \"mock\"\n[mock]\nsource = \"replay\"\nreplay_file = \"" + good_rate + "\"\n");
+  EXPECT_NO_THROW(loadConfigFile(good));
   EXPECT_NO_THROW(parseConfig(readText(model), "x.toml"));
   EXPECT_NO_THROW(parseConfig(readText(group), "x.toml"));
 }
