@@ -55,22 +55,21 @@ std::string quotedValue(std::string_view raw) {
   while (i < raw.size() && shown < kQuotedValueMaxChars) {
     const auto byte = static_cast<unsigned char>(raw[i]);
     ++shown;
-    if (byte < 0x20 || byte == 0x7F) {
-      appendHex(out, "\\x%02X", byte);
-      ++i;
-    } else if (byte == '\\') {
+    char32_t c = 0;
+    std::size_t length = 0;
+    if (byte == '\\') {
       out += "\\\\";
       ++i;
-    } else if (byte < 0x80) {
+    } else if (byte >= 0x20 && byte < 0x7F) {
       out += static_cast<char>(byte);
       ++i;
-    } else if (char32_t c = 0; const std::size_t length = utf8Sequence(raw.substr(i), c)) {
+    } else if (byte >= 0x80 && (length = utf8Sequence(raw.substr(i), c)) != 0) {
       if (isEscapedCodePoint(c))
         appendHex(out, "\\u{%04X}", static_cast<unsigned>(c));
       else
         out.append(raw.substr(i, length));
       i += length;
-    } else {
+    } else {  // a control byte, DEL, or a byte that starts no UTF-8 sequence
       appendHex(out, "\\x%02X", byte);
       ++i;
     }
