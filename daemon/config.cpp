@@ -9,7 +9,11 @@
 #include <fstream>
 #include <sstream>
 
+#include <grp.h>
+#include <unistd.h>
+
 #include "driver/mpu6050_config.hpp"
+#include "formats/model_toml.hpp"
 #include "formats/motion_spec.hpp"
 #include "formats/recording_csv.hpp"
 #include "formats/toml_document.hpp"
@@ -338,7 +342,51 @@ std::string i2cDevicePath(std::string_view bus) {
 
 namespace {
 
-GyrodConfig readConfig(const formats::TomlDocument& doc) {
+bool groupExists(const std::string& name) {
+  long size = ::sysconf(_SC_GETGR_R_SIZE_MAX);
+  std::vector<char> buffer(size > 0 ? static_cast<std::size_t>(size) : 16384);
+  group entry{};
+  group* found = nullptr;
+  while (::getgrnam_r(name.c_str(), &entry, buffer.data(), buffer.size(), &found) == ERANGE)
+    buffer.resize(buffer.size() * 2);
+  return found != nullptr;
+}
+
+// The files and names the configuration refers to, read as start-up will use them, so that
+// a bad one stops gyrod with exit 78 and the file:line of its key, and a SIGHUP that names
+// one keeps the running settings (both go through loadConfigFile).
+void checkReferences(const Section& filter, const Section& socket, const Section& mock, const GyrodConfig& config) {
+  if (!config.filter.model.empty()) {
+    try {
+      (void)recording::readModelToml(config.filter.model);
+    } catch (const std::exception& e) {
+      filter.failValue("model", e.what());
+    }
+  }
+  if (!config.socket.group.empty() && !groupExists(config.socket.group))
+    socket.failValue("group", "no such group on this system");
+  if (config.device.backend == DeviceBackend::Mock && config.mock.source == MockSource::Replay) {
+    double rate = 50.0;  // as the replay source assumes for a file without t
+    try {
+      const recording::Recording rec = recording::readRecordingCsv(config.mock.replay_file);
+      if (rec.t.size() >= 2) rate = recording::sampleRateFromTimes(rec);
+    } catch (const std::exception& e) {
+      mock.failValue("replay_file", e.what());
+    }
+    // The mock holds each recorded sample for a whole number of the chip's internal periods.
+    const double internal = driver::mpu6050::gyroOutputRateHz(config.device.dlpf);
+    const double ratio = internal / rate;
+    const double hold = std::round(ratio);
+    if (hold < 1.0 || std::abs(ratio - hold) > 1e-6 * ratio) {
+      std::ostringstream cause;  // 6 digits: a rate inferred from t is not exact anyway
+      cause << "a recording at " << rate << " Hz cannot be replayed at the chip's internal rate of " << internal
+            << " Hz (it must divide it)";
+      mock.failValue("replay_file", cause.str());
+    }
+  }
+}
+
+GyrodConfig readConfig(const formats::TomlDocument& doc, ReferenceChecks checks) {
   const auto& root = doc.root();
   GyrodConfig config;
   // Unknown top-level names first, so that a misspelt section is reported as such.
@@ -374,19 +422,22 @@ GyrodConfig readConfig(const formats::TomlDocument& doc) {
   if (config.bias.source == BiasSource::Model && config.filter.model.empty())
     bias.failValue("source", "\"model\" needs filter.model (a model file from `gyroctl analyze --write-model`)");
   readAllan(section("allan", {"window_s", "refit_interval_s", "taus"}), config.allan, config.device.rate_hz);
-  readSocket(section("socket", {"path", "mode", "group", "client_buffer_kib"}), config.socket);
+  const auto socket = section("socket", {"path", "mode", "group", "client_buffer_kib"});
+  readSocket(socket, config.socket);
   readRecord(section("record", {"path", "rotate_mb", "rotate_minutes", "flush_interval_s", "fsync_each_flush", "keep"}),
              config.record);
   readLog(section("log", {"level"}), config.log);
-  readMock(section("mock", {"source", "replay_file", "seed", "speed", "motion", "faults"}), config.mock);
+  const auto mock = section("mock", {"source", "replay_file", "seed", "speed", "motion", "faults"});
+  readMock(mock, config.mock);
+  if (checks == ReferenceChecks::On) checkReferences(filter, socket, mock, config);
   return config;
 }
 
 }  // namespace
 
-GyrodConfig parseConfig(std::string_view toml_text, const std::string& source_name) {
+GyrodConfig parseConfig(std::string_view toml_text, const std::string& source_name, ReferenceChecks checks) {
   try {
-    return readConfig(formats::TomlDocument(toml_text, source_name, formats::SyntaxErrorColumn::Shown));
+    return readConfig(formats::TomlDocument(toml_text, source_name, formats::SyntaxErrorColumn::Shown), checks);
   } catch (const formats::TomlError& e) {
     throw ConfigError(e.what());
   }
@@ -398,7 +449,7 @@ GyrodConfig loadConfigFile(const std::string& path) {
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw ConfigError(path + ": read error: " + std::strerror(errno));
-  return parseConfig(text.str(), path);
+  return parseConfig(text.str(), path, ReferenceChecks::On);
 }
 
 }  // namespace gyrod::daemon

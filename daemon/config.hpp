@@ -152,10 +152,17 @@ struct GyrodConfig {
   bool operator==(const GyrodConfig&) const = default;
 };
 
+// Whether the files and names a configuration refers to (filter.model, socket.group,
+// mock.replay_file when replaying) are checked as well: reading them needs the system
+// the daemon runs on, so text parsed on its own does not by default.
+enum class ReferenceChecks { Off, On };
+
 // Parses and validates TOML text; `source_name` is the file name used in messages.
 // Keys absent from the text keep their defaults. Throws ConfigError.
-GyrodConfig parseConfig(std::string_view toml_text, const std::string& source_name);
-// Reads the file and parses it. Throws ConfigError ("FILE: cannot open: ...") if unreadable.
+GyrodConfig parseConfig(std::string_view toml_text, const std::string& source_name,
+                        ReferenceChecks checks = ReferenceChecks::Off);
+// Reads the file and parses it with the reference checks on (start-up and SIGHUP).
+// Throws ConfigError ("FILE: cannot open: ..." if unreadable, else FILE:LINE and the key).
 GyrodConfig loadConfigFile(const std::string& path);
 
 // Names as written in the file.

@@ -36,4 +36,24 @@ std::optional<double> parseNumber(std::string_view field) {
   return value;
 }
 
+BoundedLineReader::BoundedLineReader(std::istream& in, std::size_t max_bytes)
+    : in_(in), max_bytes_(max_bytes), buffer_(max_bytes + 2, '\0') {}
+
+BoundedLineReader::Result BoundedLineReader::next() {
+  length_ = 0;
+  if (!in_.good()) return Result::End;
+  // Room for one byte past the limit: filling it (failbit without eofbit) means too long.
+  in_.getline(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
+  const auto extracted = static_cast<std::size_t>(in_.gcount());
+  if (in_.bad()) return Result::End;
+  if (in_.fail() && !in_.eof()) return Result::TooLong;
+  if (extracted == 0 && in_.eof()) return Result::End;
+  length_ = in_.eof() ? extracted : extracted - 1;  // the '\n' is extracted, not stored
+  return length_ > max_bytes_ ? Result::TooLong : Result::Line;
+}
+
+std::string lineTooLongCause(std::size_t max_bytes) {
+  return "line longer than " + std::to_string(max_bytes) + " bytes (the limit for one line)";
+}
+
 }  // namespace gyrod::recording

@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "formats/csv_fields.hpp"
+#include "formats/quoted_value.hpp"
 
 namespace gyrod::recording {
 namespace {
@@ -47,8 +48,16 @@ Recording readRecordingCsv(const std::string& path) {
 
   Recording rec;
   rec.path = path;
-  std::string raw;
+  BoundedLineReader reader(in);
   std::size_t line_no = 0;
+  // The next line, trimmed; nullopt at the end. A line past the limit stops the reading.
+  const auto nextLine = [&]() -> std::optional<std::string_view> {
+    const auto result = reader.next();
+    if (result == BoundedLineReader::Result::End) return std::nullopt;
+    ++line_no;
+    if (result == BoundedLineReader::Result::TooLong) fail(path, line_no, lineTooLongCause(reader.maxBytes()));
+    return trimField(reader.line());
+  };
 
   // First meaningful line: a header, or the first of a column of bare numbers.
   // Empty lines and comments are skipped; GAP and DROPPED lines are kept as records.
@@ -62,9 +71,8 @@ Recording readRecordingCsv(const std::string& path) {
     return true;
   };
   std::string_view first;
-  while (std::getline(in, raw)) {
-    ++line_no;
-    first = trimField(raw);
+  while (const auto line = nextLine()) {
+    first = *line;
     if (!skippable(first)) break;
   }
   if (isSkippable(first)) fail(path, 0, "empty file: no header and no samples");
@@ -83,11 +91,12 @@ Recording readRecordingCsv(const std::string& path) {
     if (names.size() == 1 && first.find(',') == std::string_view::npos &&
         std::find(kKnownColumns.begin(), kKnownColumns.end(), names[0]) == kKnownColumns.end())
       fail(path, line_no,
-           "'" + std::string(names[0]) + "' is neither a number nor a header of columns t,gx,gy,gz,temp");
+           formats::quotedValue(names[0]) + " is neither a number nor a header of columns t,gx,gy,gz,temp");
     bool have_t = false, have_temp = false;
     for (auto name : names) {
       if (std::find(kKnownColumns.begin(), kKnownColumns.end(), name) == kKnownColumns.end())
-        fail(path, line_no, "unknown column '" + std::string(name) + "' (expected any of t,gx,gy,gz,temp,wx,wy,wz)");
+        fail(path, line_no,
+             "unknown column " + formats::quotedValue(name) + " (expected any of t,gx,gy,gz,temp,wx,wy,wz)");
       for (std::size_t j = 0; j < roles.size(); ++j)
         if (names[j] == name) fail(path, line_no, "column '" + std::string(name) + "' appears twice");
       if (name == "t") {
@@ -125,9 +134,10 @@ Recording readRecordingCsv(const std::string& path) {
                                  : roles[c].first == Role::Truth ? std::string(kTruthColumns[roles[c].second])
                                                                  : rec.axis_names[roles[c].second];
       const auto value = parseNumber(fields[c]);
-      if (!value) fail(path, line_no, "column '" + column + "': '" + std::string(fields[c]) + "' is not a number");
+      if (!value)
+        fail(path, line_no, "column '" + column + "': " + formats::quotedValue(fields[c]) + " is not a number");
       if (!std::isfinite(*value))
-        fail(path, line_no, "column '" + column + "': non-finite value '" + std::string(fields[c]) + "'");
+        fail(path, line_no, "column '" + column + "': non-finite value " + formats::quotedValue(fields[c]));
       switch (roles[c].first) {
         case Role::T: rec.t.push_back(*value); break;
         case Role::Temp: rec.temp.push_back(*value); break;
@@ -138,9 +148,8 @@ Recording readRecordingCsv(const std::string& path) {
   };
 
   if (bare_numbers) consume(first);
-  while (std::getline(in, raw)) {
-    ++line_no;
-    const auto line = trimField(raw);
+  while (const auto next = nextLine()) {
+    const auto line = *next;
     if (skippable(line)) continue;
     if (bare_numbers && line.find(',') != std::string_view::npos)
       fail(path, line_no, "more than one column in a file of bare numbers (add a header t,gx,gy,gz,temp)");

@@ -72,11 +72,11 @@ WeightedFit weightedLeastSquares(const Eigen::MatrixXd& x, const Eigen::VectorXd
     if (i > 0) num += e(i) * e(i - 1);
   }
   f.rho = den > 0.0 ? std::clamp(num / den, 0.0, 0.95) : 0.0;
-  const Eigen::VectorXd s = svd.singularValues();
+  const Eigen::VectorXd& s = svd.singularValues();
   Eigen::VectorXd inv_s2(p);
   for (Eigen::Index j = 0; j < p; ++j)
     inv_s2(j) = s(j) > 1e-12 * s(0) ? 1.0 / (s(j) * s(j)) : std::numeric_limits<double>::infinity();
-  const Eigen::MatrixXd v = svd.matrixV();
+  const Eigen::MatrixXd& v = svd.matrixV();
   f.covariance = Eigen::MatrixXd::Zero(p, p);
   for (Eigen::Index j = 0; j < p; ++j) {
     if (!std::isfinite(inv_s2(j))) {

@@ -489,3 +489,56 @@ TEST(CommandLine, ABadConfigFileIsAConfigError) {
   // A broken default file is an error too, not silently skipped.
   EXPECT_THROW(parseArgs({}, f), ConfigError);
 }
+
+// A file read at start-up (and at SIGHUP) checks what the configuration refers to, with the
+// key's file:line; text parsed on its own does not (it may come from another machine).
+TEST(ConfigErrors, ReferencedFilesAndGroupAreCheckedWhenLoadingAFile) {
+  TempDir d;
+  const auto missing_model = d.path("no-model.toml");
+  const auto model = d.write("model.toml", "[filter]\nmean_window = 5\nmodel = \"" + missing_model + "\"\n");
+  try {
+    loadConfigFile(model);
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind(model + ":3: key 'filter.model': " + missing_model + ": ", 0), 0u) << m;
+    EXPECT_NE(m.find("No such file or directory"), std::string::npos) << m;
+  }
+  const auto group = d.write("group.toml", "[socket]\ngroup = \"no-such-group-gyrod-test\"\n");
+  try {
+    loadConfigFile(group);
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), group +
+                                         ":2: key 'socket.group': no such group on this system (got "
+                                         "\"no-such-group-gyrod-test\")");
+  }
+  const auto bad_csv = d.write("bad.csv", "t,gx,gy,gz,temp\n0,1,2,x,25\n");
+  const auto replay = d.write(
+      "replay.toml", "[device]\nbackend = \"mock\"\n[mock]\nsource = \"replay\"\nreplay_file = \"" + bad_csv + "\"\n");
+  try {
+    loadConfigFile(replay);
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind(replay + ":5: key 'mock.replay_file': " + bad_csv + ":2: ", 0), 0u) << m;
+  }
+  // 30 Hz does not divide the chip's 1 kHz internal rate (dlpf 4): the mock could not replay it.
+  const auto odd_rate = d.write("odd.csv", "t,gx\n0,1\n0.0333333333333,2\n0.0666666666667,3\n");
+  const auto odd = d.write(
+      "odd.toml", "[device]\nbackend = \"mock\"\n[mock]\nsource = \"replay\"\nreplay_file = \"" + odd_rate + "\"\n");
+  try {
+    loadConfigFile(odd);
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind(odd + ":5: key 'mock.replay_file': a recording at 30", 0), 0u) << m;
+    EXPECT_NE(m.find("cannot be replayed at the chip's internal rate of 1000 Hz"), std::string::npos) << m;
+  }
+  const auto good_rate = d.write("good.csv", "t,gx\n0,1\n0.02,2\n0.04,3\n");
+  const auto good = d.write(
+      "good.toml", "[device]\nbackend = \"mock\"\n[mock]\nsource = \"replay\"\nreplay_file = \"" + good_rate + "\"\n");
+  EXPECT_NO_THROW(loadConfigFile(good));
+  EXPECT_NO_THROW(parseConfig(readText(model), "x.toml"));
+  EXPECT_NO_THROW(parseConfig(readText(group), "x.toml"));
+}

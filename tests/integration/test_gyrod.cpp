@@ -299,6 +299,61 @@ TEST(Gyrod, SighupReloadsTheFilterWithoutLosingTheStream) {
   EXPECT_EQ(gyrod.waitExit(1000ms), std::optional<int>(0));
 }
 
+// A SIGHUP whose file would not start gyrod changes nothing: one error line naming file:line
+// and key, the stream goes on. The same file at start-up exits 78.
+TEST(Gyrod, SighupWithAMissingModelKeepsTheRunningSettings) {
+  ScratchDir d;
+  const auto cfg = d.write("gyrod.toml", mockConfig(d.path(), 20.0));
+  GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt");
+  LineClient w((d.path() / "gyrod.sock").string());
+  startWatching(w);
+  if (HasFatalFailure()) return;
+  Stream before = readRates(w, 100);
+  ASSERT_EQ(before.rates.size(), 100u);
+  std::string text = readWholeFile(cfg);
+  const auto missing = (d.path() / "gone-model.toml").string();
+  text.replace(text.find("mean_window = 20"), 16, "model = \"" + missing + "\"\nmean_window = 5");
+  d.write("gyrod.toml", text);
+  gyrod.signal(SIGHUP);
+  Stream after = readRates(w, 300);
+  ASSERT_EQ(after.rates.size(), 300u);
+  EXPECT_TRUE(after.gaps.empty());
+  expectContiguous(after.rates);
+  const std::string log = readWholeFile(d.path() / "log.txt");
+  EXPECT_EQ(log.find("filter reloaded"), std::string::npos) << log;
+  const auto error = log.find("SIGHUP: keeping the running filter: " + cfg.string() + ":8: key 'filter.model': ");
+  ASSERT_NE(error, std::string::npos) << log;
+  EXPECT_NE(log.find("No such file or directory", error), std::string::npos) << log;
+  gyrod.signal(SIGTERM);
+  EXPECT_EQ(gyrod.waitExit(1000ms), std::optional<int>(0));
+
+  GyrodProcess again({"--config", cfg.string()}, d.path() / "again.txt");
+  EXPECT_EQ(again.waitExit(5000ms), std::optional<int>(78));
+  EXPECT_NE(readWholeFile(d.path() / "again.txt").find(cfg.string() + ":8: key 'filter.model'"), std::string::npos);
+}
+
+TEST(Gyrod, UnknownSocketGroupAndBadReplayFileExitWithExConfig) {
+  ScratchDir d;
+  std::string text = mockConfig(d.path(), 20.0);
+  text.replace(text.find("[record]"), 8, "group = \"no-such-group-gyrod\"\n[record]");
+  const auto group = d.write("group.toml", text);
+  GyrodProcess a({"--config", group.string()}, d.path() / "a.txt");
+  EXPECT_EQ(a.waitExit(5000ms), std::optional<int>(78));
+  const std::string a_log = readWholeFile(d.path() / "a.txt");
+  EXPECT_NE(a_log.find("key 'socket.group': no such group on this system (got \"no-such-group-gyrod\")"),
+            std::string::npos)
+      << a_log;
+  EXPECT_EQ(std::count(a_log.begin(), a_log.end(), '\n'), 1) << a_log;
+
+  const auto csv = d.write("bad.csv", "t,gx,gy,gz,temp\n0,1,2,3,25\n0.02,1,2,oops,25\n");
+  const auto replay = d.write(
+      "replay.toml", mockConfig(d.path(), 20.0, "source = \"replay\"\nreplay_file = \"" + csv.string() + "\"\n"));
+  GyrodProcess b({"--config", replay.string()}, d.path() / "b.txt");
+  EXPECT_EQ(b.waitExit(5000ms), std::optional<int>(78));
+  const std::string b_log = readWholeFile(d.path() / "b.txt");
+  EXPECT_NE(b_log.find("key 'mock.replay_file': " + csv.string() + ":3: "), std::string::npos) << b_log;
+}
+
 TEST(Gyrod, RecordingReadsCleanlyAfterKillDashNine) {
   ScratchDir d;
   const auto cfg = d.write("gyrod.toml", mockConfig(d.path(), 20.0));

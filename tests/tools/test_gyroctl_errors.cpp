@@ -72,6 +72,26 @@ TEST(GyroctlErrors, NaNAndInfAreRejectedWithTheirLine) {
                      ":2: column 'gx': non-finite value '1e999'");
 }
 
+// A finite value the statistics cannot carry, or a series they reject, is named by file
+// (and line) before anything reaches stdout, never by an internal function's name.
+TEST(GyroctlErrors, ValuesTheAnalysisCannotCarryAreRefusedBeforeAnyOutput) {
+  ScratchDir d;
+  std::string huge_text = "t,gx\n", constant_text = "t,gx\n";
+  for (int i = 0; i < 200; ++i) {
+    const std::string t = std::to_string(i * 0.02);
+    huge_text += t + (i == 5 ? ",1e308\n" : i % 2 ? ",0.1\n" : ",-0.1\n");
+    constant_text += t + ",0.5\n";
+  }
+  const auto huge = d.write("huge.csv", huge_text);
+  const auto r = runGyroctl("analyze " + huge.string(), d.path());
+  expectOneLineError(r, huge.string() + ":7: column 'gx': 1e+308 deg/s is beyond 1e+12 deg/s");
+  const auto constant = d.write("constant.csv", constant_text);
+  const auto c = runGyroctl("analyze " + constant.string() + " --json", d.path());
+  expectOneLineError(c, constant.string() + ": column 'gx': ");
+  EXPECT_EQ(c.err.find("yuleWalker"), std::string::npos) << c.err;
+  EXPECT_EQ(c.err.find("Test:"), std::string::npos) << c.err;
+}
+
 TEST(GyroctlErrors, MissingColumn) {
   ScratchDir d;
   const auto f = d.write("w.csv", whiteNoiseCsv(500, 50.0, 1));
@@ -154,4 +174,21 @@ TEST(GyroctlErrors, ImportOfAForeignFileThatIsNotImucal) {
   const auto g = d.write("y.csv", "Fs,100\nLogging Type,1\nax,ay,az,gx,gy,gz\n1,2,3,4,5,6\n1,2,3,4,x,6\n");
   expectOneLineError(runGyroctl("import " + g.string() + " -o " + (d.path() / "o.csv").string(), d.path()),
                      g.string() + ":5: column 'gy': 'x' is not an integer count");
+}
+
+// The importer bounds its lines as the recording reader does and escapes what it echoes.
+TEST(GyroctlErrors, ImportBoundsLinesAndEscapesEchoedValues) {
+  ScratchDir d;
+  const auto out = (d.path() / "o.csv").string();
+  const auto long_line = d.write("long.csv", "Fs,100\nax,ay,az,gx,gy,gz\n1,2,3," + std::string(70'000, '4') + ",5,6\n");
+  expectOneLineError(runGyroctl("import " + long_line.string() + " -o " + out, d.path()),
+                     long_line.string() + ":3: line longer than 65536 bytes (the limit for one line)");
+  const auto escape = d.write("esc.csv", "Fs,100\nax,ay,az,gx,gy,gz\n1,2,3,4,\x1b[2J\xe2\x80\xae,6\n");
+  expectOneLineError(runGyroctl("import " + escape.string() + " -o " + out, d.path()),
+                     escape.string() + ":3: column 'gy': '\\x1B[2J\\u{202E}' is not an integer count");
+  const auto wide = d.write("wide.csv", "Fs," + std::string(5000, '7') + "x\n");
+  const auto r = runGyroctl("import " + wide.string() + " -o " + out, d.path());
+  expectOneLineError(r, wide.string() + ":1: sample rate '" + std::string(80, '7') + "…' (5001 bytes) is not");
+  EXPECT_LT(r.err.size(), 400u) << r.err.size();
+  EXPECT_FALSE(std::filesystem::exists(out));
 }

@@ -1,4 +1,5 @@
 // gyroctl analyze: every table of the paper for each axis of a static recording.
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -29,6 +30,45 @@ using nlohmann::json;
 // Fewer samples than this cannot carry the tests (100 reverse-arrangement segments
 // need ≥ 10 samples each to mean anything) nor a useful Allan curve.
 constexpr std::size_t kMinimumSamples = 100;
+// Far beyond any gyro's range (the MPU-6050 tops out at 2000 °/s), and far enough below
+// the largest double that sums of squares over any recording stay finite: a larger
+// value is a broken file, and would otherwise surface as an overflow deep in the statistics.
+constexpr double kLargestAnalysableRateDps = 1e12;
+
+// Every input check before any output: a rejected file leaves stdout empty and names
+// FILE:LINE, never the internal function that happened to meet the value first.
+void requireAnalysableValues(const recording::Recording& rec, std::size_t axis_index) {
+  const auto& values = rec.axes[axis_index];
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (std::abs(values[i]) <= kLargestAnalysableRateDps) continue;
+    std::ostringstream s;
+    s << rec.path << ':' << (i < rec.line_numbers.size() ? rec.line_numbers[i] : i + 1) << ": column '"
+      << rec.axis_names[axis_index] << "': " << values[i] << " deg/s is beyond " << kLargestAnalysableRateDps
+      << " deg/s, more than any gyro measures (the statistics would overflow)";
+    throw recording::RecordingError(s.str());
+  }
+}
+
+// A processing function's std::invalid_argument begins with its own name ("fitLinearTrend:
+// ..."), which means nothing to a user: the tool names the file and the column instead.
+std::string withoutFunctionName(const std::string& message) {
+  const auto colon = message.find(": ");
+  if (colon == std::string::npos || colon == 0) return message;
+  for (std::size_t i = 0; i < colon; ++i) {
+    const char c = message[i];
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == ':')) return message;
+  }
+  return message.substr(colon + 2);
+}
+
+AxisAnalysis analyzeColumn(const recording::Recording& rec, std::size_t axis_index, const AnalysisOptions& options) {
+  try {
+    return analyzeAxis(rec.axes[axis_index], options);
+  } catch (const std::invalid_argument& e) {
+    throw recording::RecordingError(rec.path + ": column '" + rec.axis_names[axis_index] +
+                                    "': " + withoutFunctionName(e.what()));
+  }
+}
 
 struct AnalyzeOptions {
   std::string file;
@@ -283,6 +323,10 @@ int runAnalyze(const AnalyzeOptions& opt) {
   options.mean_window = opt.mean_window;
   options.mean_threshold_dps = opt.mean_threshold_dps;
   options.max_ar_order = opt.max_ar_order;
+  for (std::size_t idx : in.axis_indices) requireAnalysableValues(rec, idx);
+  std::vector<AxisAnalysis> analyses;
+  analyses.reserve(in.axis_indices.size());
+  for (std::size_t idx : in.axis_indices) analyses.push_back(analyzeColumn(rec, idx, options));
 
   json doc;
   doc["file"] = opt.file;
@@ -304,8 +348,9 @@ int runAnalyze(const AnalyzeOptions& opt) {
   sensor.filter->mean_window = opt.mean_window;
   sensor.filter->mean_threshold_dps = opt.mean_threshold_dps;
   std::vector<std::string> notes;
-  for (std::size_t idx : in.axis_indices) {
-    const AxisAnalysis a = analyzeAxis(rec.axes[idx], options);
+  for (std::size_t k = 0; k < in.axis_indices.size(); ++k) {
+    const std::size_t idx = in.axis_indices[k];
+    const AxisAnalysis& a = analyses[k];
     if (const auto slot = recording::axisOfColumn(rec.axis_names[idx]); slot && !opt.write_model.empty()) {
       model.axes[*slot].terms = a.noise.value;
       model.axes[*slot].bias_dps = a.zero_mean.mean;

@@ -120,6 +120,8 @@ int runFilter(const FilterOptions& opt) {
     if (!std::isfinite(b)) throw std::invalid_argument("--bias values must be finite numbers");
   const std::size_t n = rec.size();
   const double dt = 1.0 / in.rate_hz;
+  std::optional<RateColumns> rate_columns;  // first, so that a bad --model fails before any work
+  if (!opt.model.empty()) rate_columns.emplace(opt, rec, in.rate_hz);
   const bool identifies = !(opt.ar_phi && opt.kalman_q && opt.kalman_r);
   if (identifies && n < kMinSamplesToIdentify) {
     std::ostringstream s;
@@ -127,8 +129,6 @@ int runFilter(const FilterOptions& opt) {
       << ", or give --ar-phi, --kalman-q and --kalman-r)";
     throw recording::RecordingError(s.str());
   }
-  std::optional<RateColumns> rate_columns;  // first, so that a bad --model fails before any work
-  if (!opt.model.empty()) rate_columns.emplace(opt, rec, in.rate_hz);
 
   std::vector<std::vector<double>> chain_input;
   std::vector<FilterChainParameters> params;

@@ -14,7 +14,9 @@
 #include <string>
 #include <vector>
 
+#include "formats/csv_fields.hpp"
 #include "formats/output_file.hpp"
+#include "formats/quoted_value.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
 
@@ -66,11 +68,16 @@ int runImport(const ImportOptions& opt) {
   requireNotADirectory(opt.file);
   std::ifstream in(opt.file);
   if (!in) throw recording::RecordingError(opt.file + ": cannot open: " + std::strerror(errno));
+  recording::BoundedLineReader reader(in);
   std::string line;
   std::size_t line_no = 0;
   auto next = [&]() -> bool {
-    if (!std::getline(in, line)) return false;
+    const auto result = reader.next();
+    if (result == recording::BoundedLineReader::Result::End) return false;
     ++line_no;
+    if (result == recording::BoundedLineReader::Result::TooLong)
+      fail(opt.file, line_no, recording::lineTooLongCause(reader.maxBytes()));
+    line.assign(reader.line());
     if (!line.empty() && line.back() == '\r') line.pop_back();
     return true;
   };
@@ -79,11 +86,12 @@ int runImport(const ImportOptions& opt) {
   if (opt.format != "auto" && opt.format != "imucal")
     throw std::invalid_argument("--format '" + opt.format + "': known formats are imucal (or auto)");
   if (first.size() != 2 || first[0] != "Fs")
-    fail(opt.file, line_no, "not an imucal recording: the first line should be 'Fs,<rate>' (found '" + line + "')");
+    fail(opt.file, line_no,
+         "not an imucal recording: the first line should be 'Fs,<rate>' (found " + formats::quotedValue(line) + ")");
   char* end = nullptr;
   const double fs = std::strtod(first[1].c_str(), &end);
   if (end == first[1].c_str() || *end != '\0' || !(fs > 0.0) || !std::isfinite(fs))
-    fail(opt.file, line_no, "sample rate '" + first[1] + "' is not a positive number");
+    fail(opt.file, line_no, "sample rate " + formats::quotedValue(first[1]) + " is not a positive number");
 
   // Skip the remaining key,value header lines up to the column names.
   std::vector<std::string> columns;
@@ -104,7 +112,7 @@ int runImport(const ImportOptions& opt) {
   std::vector<int> present;
   for (int a = 0; a < 3; ++a)
     if (gcol[a] >= 0) present.push_back(a);
-  if (present.empty()) fail(opt.file, line_no, "no gyro column (gx, gy or gz) in '" + line + "'");
+  if (present.empty()) fail(opt.file, line_no, "no gyro column (gx, gy or gz) in " + formats::quotedValue(line));
 
   const double lsb = kGyroLsbPerDps[opt.fs_sel];
   std::string out = "t";
@@ -127,7 +135,8 @@ int runImport(const ImportOptions& opt) {
       const auto& field = f[static_cast<std::size_t>(gcol[a])];
       const std::string_view column = names[a];
       if (!parseLong(field, counts))
-        fail(opt.file, line_no, "column '" + std::string(column) + "': '" + field + "' is not an integer count");
+        fail(opt.file, line_no,
+             "column '" + std::string(column) + "': " + formats::quotedValue(field) + " is not an integer count");
       if (counts < -32768 || counts > 32767)
         fail(opt.file, line_no, "column '" + std::string(column) + "': " + field + " is outside the 16-bit range");
       std::snprintf(buf, sizeof buf, ",%.17g", static_cast<double>(counts) / lsb);
