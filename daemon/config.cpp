@@ -111,7 +111,7 @@ void readBias(const Section& s, BiasConfig& b) {
   }
 }
 
-void readFilter(const Section& s, FilterConfig& f) {
+void readFilter(const Section& s, FilterConfig& f, double rate_hz) {
   if (auto v = s.integer("mean_window")) {
     if (*v < 1 || *v > 100000) s.failValue("mean_window", "must be a window length 1..100000 samples");
     f.mean_window = static_cast<std::size_t>(*v);
@@ -121,6 +121,13 @@ void readFilter(const Section& s, FilterConfig& f) {
     f.mean_threshold_dps = *v;
   }
   if (auto v = s.string("model")) f.model = *v;
+  if (auto v = s.number("rate_low_pass_hz")) {
+    // A first-order low-pass at or past Nyquist is no low-pass (its bilinear form breaks down).
+    if (!(*v >= 0.0 && *v < rate_hz / 2.0))
+      s.failValue("rate_low_pass_hz",
+                  "must be 0 (off) or a cut-off > 0 Hz below half device.rate_hz (" + shortest(rate_hz / 2.0) + " Hz)");
+    f.rate_low_pass_hz = *v;
+  }
   for (const auto& k : s.tables("kalman", {"a", "q", "r"})) {
     if (!s.node("kalman")->is_table()) s.failType(*s.node("kalman"), "kalman", "must be a table");
     if (auto v = k.number("a")) {
@@ -408,8 +415,10 @@ GyrodConfig readConfig(const formats::TomlDocument& doc, ReferenceChecks checks)
   readGpio(section("gpio", {"chip", "line"}), config.gpio);
   const auto bias = section("bias", {"source", "still_seconds", "values"});
   readBias(bias, config.bias);
-  const auto filter = section("filter", {"mean_window", "mean_threshold_dps", "model", "kalman"});
-  readFilter(filter, config.filter);
+  const auto filter = section("filter", {"mean_window", "mean_threshold_dps", "model", "rate_low_pass_hz", "kalman"});
+  readFilter(filter, config.filter, config.device.rate_hz);
+  if (config.filter.rate_low_pass_hz.value_or(0.0) > 0.0 && config.filter.model.empty())
+    filter.failValue("rate_low_pass_hz", "needs filter.model (without a model, rate is raw − the constant bias)");
   if (config.bias.source == BiasSource::Model && config.filter.model.empty())
     bias.failValue("source", "\"model\" needs filter.model (a model file from `gyroctl analyze --write-model`)");
   readAllan(section("allan", {"window_s", "refit_interval_s", "taus"}), config.allan, config.device.rate_hz);

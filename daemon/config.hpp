@@ -64,6 +64,9 @@ struct FilterConfig {
   std::size_t mean_window = 20;     // L (paper: 20)
   double mean_threshold_dps = 0.3;  // r (paper: 0.3 °/s)
   std::string model;                // model file from `gyroctl analyze --write-model`; empty = none
+  // The rate stream's first-order low-pass, −3 dB in Hz, over the model file's [filter]
+  // low_pass_hz; 0 = off; unset = the model's (none there: off).
+  std::optional<double> rate_low_pass_hz;
   KalmanOverrideConfig kalman;
   bool operator==(const FilterConfig&) const = default;
 };

@@ -15,7 +15,9 @@
 #include <system_error>
 
 #include "driver/counter_names.hpp"
+#include "formats/calibration.hpp"
 #include "formats/model_toml.hpp"
+#include "formats/toml_document.hpp"
 
 namespace gyrod::daemon {
 namespace {
@@ -66,7 +68,38 @@ Vec3 modelBias(const std::string& path) {
 
 }  // namespace
 
-PipelineSettings Gyrod::pipelineSettings(const GyrodConfig& c) {
+// The rate stream's parameters from filter.model, exactly as `gyroctl filter --model` builds
+// them (rateEstimatorParameters of readSensorModelToml), at the device's rate, with
+// filter.rate_low_pass_hz over the model's low-pass when set.
+LoadedRateModel Gyrod::loadRateModel(const GyrodConfig& c) {
+  LoadedRateModel loaded;
+  const FilterConfig& f = c.filter;
+  if (f.model.empty()) return loaded;
+  recording::SensorModel model;
+  try {
+    model = recording::readSensorModelToml(f.model);  // its messages name FILE:LINE
+  } catch (const std::exception& e) {                 // unreadable, or not a model file: a misconfiguration
+    throw ConfigError(std::string(e.what()) + " (filter.model)");
+  }
+  try {
+    processing::RateEstimatorParameters p = recording::rateEstimatorParameters(model);
+    if (std::fabs(p.rate_hz - c.device.rate_hz) > 1e-9 * c.device.rate_hz)
+      spdlog::warn("{}: model rate {} Hz, device {} Hz: the rate stream runs at the device's", f.model, p.rate_hz,
+                   c.device.rate_hz);
+    p.rate_hz = c.device.rate_hz;
+    if (f.rate_low_pass_hz) p.low_pass_hz = *f.rate_low_pass_hz > 0.0 ? f.rate_low_pass_hz : std::nullopt;
+    processing::validateRateEstimatorParameters(p);
+    loaded.params = p;
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(f.model + " (filter.model): cannot run the rate stream on it: " + std::string(e.what()));
+  }
+  std::ostringstream identity;
+  identity << f.model << '\n' << f.rate_low_pass_hz.value_or(-1.0) << '\n' << recording::sensorModelToToml(model);
+  loaded.identity = identity.str();
+  return loaded;
+}
+
+PipelineSettings Gyrod::pipelineSettings(const GyrodConfig& c, const LoadedRateModel& rate_model) {
   PipelineSettings s;
   s.rate_hz = c.device.rate_hz;
   switch (c.bias.source) {
@@ -87,14 +120,16 @@ PipelineSettings Gyrod::pipelineSettings(const GyrodConfig& c) {
   s.allan_window_samples = static_cast<std::size_t>(std::llround(c.allan.window_s * c.device.rate_hz));
   for (double tau : c.allan.taus_s)
     s.allan_cluster_sizes.push_back(static_cast<std::size_t>(std::llround(tau * c.device.rate_hz)));
+  s.rate_model = rate_model.params;
   return s;
 }
 
 Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
     : config_(config),
       config_file_(std::move(config_file)),
+      rate_model_(loadRateModel(config)),
       device_(makeDeviceParts(config)),
-      pipeline_(pipelineSettings(config)),
+      pipeline_(pipelineSettings(config, rate_model_)),
       noise_refit_(loop_, pipeline_, config.device.rate_hz, [this] { allan_reply_.invalidate(); }),
       allan_reply_([this] { return allanReport(); }) {
   start_real_ns_ = monotonicNowNs();
@@ -113,6 +148,9 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
     options.header_comments.push_back("gyrod " + std::string(GYROD_RELEASE) + " recording of " + device_.description);
     options.header_comments.push_back(
         "raw rates as read from the chip (bias not removed); GAP lines mark lost samples");
+    if (rate_model_.params)  // the recording holds what the rate stream was fed, at full precision
+      options.header_comments.push_back("the RATE stream's rate, bias and still: gyroctl filter FILE --model " +
+                                        config_.filter.model + " --rate " + formats::shortest(config_.device.rate_hz));
     recorder_ = std::make_unique<Recorder>(options);
   }
 
@@ -163,6 +201,9 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
                server_->socketPath().empty() ? std::string("(socket activation)") : server_->socketPath(),
                recorder_ ? ", recording to " + recorder_->currentFile() : std::string());
   if (!device_.virtual_clock) spdlog::info("event loop scheduling: {}", loopSchedulingNote());
+  spdlog::info("rate stream: {}", pipeline_.rateModel() == RateModel::SensorModel
+                                      ? "raw - the bias of the sensor model " + config_.filter.model
+                                      : std::string("raw - the bias of [bias] (no filter.model: no temperature term)"));
   if (pipeline_.phase() == PipelinePhase::Estimating)
     spdlog::info("keep the sensor still: estimating {} over the first {:.1f} s",
                  config_.bias.source == BiasSource::Estimate ? "the bias and the filter" : "the filter",
@@ -245,6 +286,14 @@ void Gyrod::onSample(const driver::GyroSample& s) {
     r.mean_dps = {kNaN, kNaN, kNaN};
     r.kalman_dps = {kNaN, kNaN, kNaN};
   }
+  if (out.has_rate) {
+    r.rate_dps = out.rate;
+    r.bias_dps = out.rate_bias;
+  } else {  // a start-up bias still being estimated
+    r.rate_dps = {kNaN, kNaN, kNaN};
+    r.bias_dps = {kNaN, kNaN, kNaN};
+  }
+  r.still = out.still;
   server_->publishRate(r);
   if (recorder_) recorder_->pushSample(r.t_s, r.raw_dps[0], r.raw_dps[1], r.raw_dps[2], r.temp_c);
   ++samples_published_;
@@ -292,16 +341,31 @@ void Gyrod::reload() {
     return;
   }
   try {
-    const GyrodConfig fresh = loadConfigFile(config_file_);
+    GyrodConfig fresh = loadConfigFile(config_file_);
+    fresh.device.rate_hz = config_.device.rate_hz;  // [device] applies at restart
     const auto& f = fresh.filter;
+    LoadedRateModel rate_model = loadRateModel(fresh);  // before anything changes
     pipeline_.reloadFilter(f.mean_window, f.mean_threshold_dps, {f.kalman.a, f.kalman.q, f.kalman.r});
+    const bool new_rate_model = rate_model.identity != rate_model_.identity;
+    if (new_rate_model) {
+      pipeline_.reloadRateModel(rate_model.params);
+      rate_model_ = std::move(rate_model);
+    }
     config_.filter = f;
     ++reloads_;
-    spdlog::info("SIGHUP: filter reloaded from {} (L = {}, r = {} deg/s); other sections apply at restart",
-                 config_file_, f.mean_window, f.mean_threshold_dps);
+    spdlog::info(
+        "SIGHUP: filter reloaded from {} (L = {}, r = {} deg/s; rate stream: {}); other sections apply at "
+        "restart",
+        config_file_, f.mean_window, f.mean_threshold_dps,
+        new_rate_model ? "restarted on " + rateModelDescription() : "unchanged");
   } catch (const std::exception& e) {
     spdlog::error("SIGHUP: keeping the running filter: {}", e.what());
   }
+}
+
+std::string Gyrod::rateModelDescription() const {
+  if (pipeline_.rateModel() == RateModel::SensorModel) return "model " + config_.filter.model;
+  return "bias";
 }
 
 AllanReport Gyrod::allanReport() {
@@ -347,6 +411,7 @@ StatusReport Gyrod::statusReport() {
     bias << " [" << pipeline_.bias()[0] << ", " << pipeline_.bias()[1] << ", " << pipeline_.bias()[2] << "] deg/s";
   }
   r.bias_source = bias.str();
+  r.rate_model = rateModelDescription();
   if (recorder_) r.recording = recorder_->currentFile();
   return r;
 }

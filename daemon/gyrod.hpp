@@ -22,6 +22,13 @@
 
 namespace gyrod::daemon {
 
+// The rate stream's model as read from filter.model; `identity` tells a SIGHUP whether it
+// changed (the path, the low-pass and the file's contents).
+struct LoadedRateModel {
+  std::optional<processing::RateEstimatorParameters> params;
+  std::string identity;
+};
+
 class Gyrod final : public driver::SampleSink, public ServerContent {
  public:
   // Builds everything from the configuration; throws with a one-line message when the
@@ -44,7 +51,9 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   StatusReport statusReport() override;
 
  private:
-  static PipelineSettings pipelineSettings(const GyrodConfig& config);
+  static LoadedRateModel loadRateModel(const GyrodConfig& config);
+  static PipelineSettings pipelineSettings(const GyrodConfig& config, const LoadedRateModel& rate_model);
+  std::string rateModelDescription() const;
   void serviceDriver();
   void rearmDriverTimer();
   void pumpVirtualClock();
@@ -55,6 +64,7 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   GyrodConfig config_;
   std::string config_file_;
   EventLoop loop_;
+  LoadedRateModel rate_model_;  // first: a bad model file is a configuration error (exit 78)
   DeviceParts device_;
   std::unique_ptr<driver::Mpu6050Driver> driver_;
   SamplePipeline pipeline_;

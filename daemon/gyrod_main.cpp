@@ -56,6 +56,9 @@ int main(int argc, char** argv) {
   try {
     Gyrod gyrod(command_line.config, command_line.config_file);
     return gyrod.run();
+  } catch (const ConfigError& e) {  // e.g. a model file named by filter.model that is not one
+    spdlog::critical("{}", e.what());
+    return kExitConfigError;
   } catch (const std::exception& e) {
     spdlog::critical("{}", e.what());
     return 1;

@@ -42,12 +42,15 @@ std::string_view toString(BiasOrigin origin) {
   return "?";
 }
 
+std::string_view toString(RateModel model) { return model == RateModel::SensorModel ? "model" : "bias"; }
+
 SamplePipeline::SamplePipeline(const PipelineSettings& settings)
     : settings_(validated(settings)),
       allan_raw_(makeAllanArray(settings)),
       allan_mean_(makeAllanArray(settings)),
       allan_kalman_(makeAllanArray(settings)) {
   if (settings_.bias_origin != BiasOrigin::Estimate) bias_ = settings_.bias_dps;
+  if (settings_.rate_model) rate_.emplace(*settings_.rate_model);  // validates them
   for (auto& p : params_) {
     p.mean_window = settings_.mean_window;
     p.mean_threshold_dps = settings_.mean_threshold_dps;
@@ -121,7 +124,20 @@ ProcessedSample SamplePipeline::process(std::uint64_t seq, double t_s, const Vec
   out.temp_c = temp_c;
   out.raw = raw_dps;
   ++processed_;
+  if (!first_t_s_) first_t_s_ = t_s;
+  last_t_s_ = t_s;
   for (std::size_t axis = 0; axis < kAxes; ++axis) allan_raw_[axis].push(raw_dps[axis]);
+  if (rate_) {
+    const processing::RateSample r = rate_->update(t_s, raw_dps, temp_c);
+    out.rate = r.rate_dps;
+    out.rate_bias = r.bias_dps;
+    out.still = r.still;
+    out.has_rate = true;
+  } else if (phase_ == PipelinePhase::Running) {
+    for (std::size_t axis = 0; axis < kAxes; ++axis) out.rate[axis] = raw_dps[axis] - bias_[axis];
+    out.rate_bias = bias_;
+    out.has_rate = true;
+  }
   if (phase_ == PipelinePhase::Estimating) {
     for (std::size_t axis = 0; axis < kAxes; ++axis) still_[axis].push_back(raw_dps[axis]);  // reserved: no allocation
     if (still_[0].size() >= still_samples_) finishEstimation();
@@ -166,6 +182,22 @@ void SamplePipeline::reloadFilter(std::size_t mean_window, double mean_threshold
   if (kalman.r) settings_.kalman.r = kalman.r;
   params_ = params;
   if (phase_ == PipelinePhase::Running) startFilters();
+}
+
+void SamplePipeline::reloadRateModel(const std::optional<processing::RateEstimatorParameters>& rate_model) {
+  std::optional<processing::RateEstimatorParameters> p = rate_model;
+  // The warm-up shape counts from the estimator's first sample: continue the one that began
+  // at the pipeline's first sample, A·e^{−(t + Δ)/τ} = (A·e^{−Δ/τ})·e^{−t/τ}.
+  if (p && first_t_s_) {
+    const double elapsed = last_t_s_ - *first_t_s_ + 1.0 / p->rate_hz;
+    for (auto& axis : p->axes)
+      if (axis.warm_up_time_constant_s > 0.0)
+        axis.warm_up_amplitude_dps *= std::exp(-elapsed / axis.warm_up_time_constant_s);
+  }
+  std::optional<processing::RateEstimator> fresh;
+  if (p) fresh.emplace(*p);  // throws before anything changes
+  settings_.rate_model = p;
+  rate_ = std::move(fresh);
 }
 
 AllanStreams SamplePipeline::allanSnapshot() const {

@@ -12,6 +12,13 @@
 //    period, exactly as `gyroctl filter` identifies them from a file (identifyFilterChain).
 // While a still period is needed, samples are published raw only; the filters start on the
 // first sample after it.
+//
+// The `rate` stream (issue 11, docs/motion.md), beside the paper's chain and independent of it:
+//  - with a sensor model (`rate_model`, from filter.model): processing::RateEstimator on every
+//    sample from the first, fed (t, raw, temp) exactly as `gyroctl filter --model` feeds it
+//    from the recording, so that the two agree bit for bit;
+//  - without one: raw − the bias above (the start-up estimate, the config's or the model's
+//    constant), from the end of the still period; no temperature term, no still detection.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -21,6 +28,7 @@
 
 #include "processing/filter_chain.hpp"
 #include "processing/noise_fit.hpp"
+#include "processing/rate_estimator.hpp"
 #include "processing/rolling_allan.hpp"
 
 namespace gyrod::daemon {
@@ -30,6 +38,10 @@ using Vec3 = std::array<double, kAxes>;
 
 enum class BiasOrigin { Config, Model, Estimate };
 std::string_view toString(BiasOrigin origin);
+
+// What the `rate` stream subtracts from raw (STATUS rate_model).
+enum class RateModel { SensorModel, ConstantBias };
+std::string_view toString(RateModel model);
 
 struct PipelineSettings {
   double rate_hz = 50.0;
@@ -41,6 +53,8 @@ struct PipelineSettings {
   processing::KalmanOverrides kalman;  // given values; the rest are identified
   std::size_t allan_window_samples = 180000;
   std::vector<std::size_t> allan_cluster_sizes;  // empty = octave up to half the window
+  // The rate stream's model (RateModel::SensorModel); none = raw − bias (ConstantBias).
+  std::optional<processing::RateEstimatorParameters> rate_model;
 };
 
 enum class PipelinePhase { Estimating, Running };
@@ -49,10 +63,14 @@ struct ProcessedSample {
   std::uint64_t seq = 0;
   double t_s = 0.0;
   double temp_c = 0.0;
-  Vec3 raw{};             // as measured (bias not removed)
-  Vec3 mean{};            // mean filter output on raw − bias
-  Vec3 kalman{};          // Kalman output
-  bool filtered = false;  // false while estimating: mean/kalman not set
+  Vec3 raw{};                 // as measured (bias not removed)
+  Vec3 mean{};                // mean filter output on raw − bias
+  Vec3 kalman{};              // Kalman output
+  bool filtered = false;      // false while estimating: mean/kalman not set
+  Vec3 rate{};                // the rate stream: raw − rate_bias (then the optional low-pass)
+  Vec3 rate_bias{};           // b̂ subtracted from raw for rate
+  bool has_rate = false;      // false while a constant bias is still being estimated
+  std::optional<bool> still;  // the still detector's verdict (sensor model only)
 };
 
 struct AllanStreams {
@@ -96,6 +114,12 @@ class SamplePipeline {
   // New filter parameters (SIGHUP) without losing the stream: the bias and the identified
   // values are kept unless the new settings give them; the Allan statistics continue.
   void reloadFilter(std::size_t mean_window, double mean_threshold_dps, const processing::KalmanOverrides& kalman);
+  // A new rate model (SIGHUP): the estimator restarts (its residual bias from the model's, its
+  // still window empty); the model's warm-up shape continues from the pipeline's first sample.
+  // Validated before anything changes; throws std::invalid_argument.
+  void reloadRateModel(const std::optional<processing::RateEstimatorParameters>& rate_model);
+  RateModel rateModel() const { return rate_ ? RateModel::SensorModel : RateModel::ConstantBias; }
+  const processing::RateEstimator* rateEstimator() const { return rate_ ? &*rate_ : nullptr; }
 
   // Not per sample (allocates): the Allan curves of the window and since start.
   AllanStreams allanSnapshot() const;
@@ -129,9 +153,12 @@ class SamplePipeline {
   std::array<std::vector<double>, kAxes> still_;  // reserved once
   std::array<processing::FilterChainParameters, kAxes> params_{};
   std::vector<processing::AxisFilterChain> chains_;  // kAxes, built at start and on reload
+  std::optional<processing::RateEstimator> rate_;    // with a sensor model
   std::array<processing::RollingOverlappingAllan, kAxes> allan_raw_, allan_mean_, allan_kalman_;
   std::array<std::optional<processing::NoiseTermFit>, kAxes> noise_terms_;
   std::uint64_t processed_ = 0;
+  std::optional<double> first_t_s_;  // of the first sample: the warm-up shape's origin
+  double last_t_s_ = 0.0;
 };
 
 }  // namespace gyrod::daemon

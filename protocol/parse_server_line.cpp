@@ -80,6 +80,9 @@ RateSample rateOf(const json& j) {
   r.raw_dps = triple(j, "raw");
   r.mean_dps = triple(j, "mean");
   r.kalman_dps = triple(j, "kalman");
+  r.rate_dps = triple(j, "rate");
+  r.bias_dps = triple(j, "bias");
+  r.still = optionalFlag(j, "RATE", "still");
   return r;
 }
 
@@ -148,10 +151,10 @@ ClientStatus clientOf(const json& c) {
 
 // The STATUS fields this version reads; any other is kept as an OtherField.
 constexpr std::string_view kStatusFields[] = {
-    "class",         "uptime",        "samples",         "gaps",    "missing",       "bus_errors",      "resets",
-    "device_state",  "device_reason", "device_retrying", "device",  "rate",          "nominal_rate",    "temp",
-    "bias_source",   "recording",     "counters",        "clients", "clients_total", "clients_dropped", "lines_dropped",
-    "client_buffer", "client_list"};
+    "class",         "uptime",        "samples",         "gaps",     "missing", "bus_errors",    "resets",
+    "device_state",  "device_reason", "device_retrying", "device",   "rate",    "nominal_rate",  "temp",
+    "bias_source",   "rate_model",    "recording",       "counters", "clients", "clients_total", "clients_dropped",
+    "lines_dropped", "client_buffer", "client_list"};
 
 StatusReply statusOf(const json& j) {
   constexpr std::string_view cls = "STATUS";
@@ -171,6 +174,7 @@ StatusReply statusOf(const json& j) {
   d.nominal_rate_hz = optionalReal(j, cls, "nominal_rate");
   d.temp_c = optionalReal(j, cls, "temp");
   d.bias_source = optionalText(j, cls, "bias_source");
+  d.rate_model = optionalText(j, cls, "rate_model");
   d.recording = optionalText(j, cls, "recording");
   if (const json* counters = field(j, cls, "counters", &json::is_object, "an object")) {
     for (auto it = counters->begin(); it != counters->end(); ++it) {

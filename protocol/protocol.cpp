@@ -91,6 +91,9 @@ std::size_t formatRateLine(const RateSample& s, std::span<char, kMaxRateLineByte
   w.triple(R"(,"raw":[)", s.raw_dps);
   w.triple(R"(,"mean":[)", s.mean_dps);
   w.triple(R"(,"kalman":[)", s.kalman_dps);
+  w.triple(R"(,"rate":[)", s.rate_dps);
+  w.triple(R"(,"bias":[)", s.bias_dps);
+  if (s.still) w.text(*s.still ? R"(,"still":true)" : R"(,"still":false)");
   w.text("}");
   const std::size_t n = w.size();
   out[n] = '\n';
@@ -214,6 +217,7 @@ std::string statusLine(const StatusReport& d, const ServerStatus& s) {
   putIfFinite(j, "nominal_rate", d.nominal_rate_hz);
   putIfFinite(j, "temp", d.temp_c);
   if (d.bias_source) j["bias_source"] = *d.bias_source;
+  if (d.rate_model) j["rate_model"] = *d.rate_model;
   if (d.recording) j["recording"] = *d.recording;
   if (!d.device_counters.empty()) {
     json counters = json::object();

@@ -8,6 +8,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -35,12 +36,18 @@ inline constexpr std::array<std::string_view, 3> kStreamNames = {"raw", "mean", 
 
 // One sample of the three axes after each stage of the chain.
 struct RateSample {
+  static constexpr double kUnset = std::numeric_limits<double>::quiet_NaN();
   std::uint64_t seq = 0;               // sample sequence number, +1 per sample of the device
   double t_s = 0.0;                    // sample time, CLOCK_MONOTONIC [s]
   double temp_c = 0.0;                 // die temperature [°C]
   std::array<double, 3> raw_dps{};     // x, y, z angular rate as read [°/s]
   std::array<double, 3> mean_dps{};    // after the gross-error mean filter [°/s]
   std::array<double, 3> kalman_dps{};  // after the Kalman filter [°/s]
+  // Appended by issue 11: the stream to read while the board moves (docs/motion.md).
+  // Unset (NaN, so omitted from the line) unless the server fills them.
+  std::array<double, 3> rate_dps{kUnset, kUnset, kUnset};  // raw − bias_dps (then the optional low-pass) [°/s]
+  std::array<double, 3> bias_dps{kUnset, kUnset, kUnset};  // b̂: the bias subtracted for rate [°/s]
+  std::optional<bool> still;                               // the still detector's verdict; none = no detector
 };
 
 // Samples that will never come: seq, seq+1, ..., seq+count−1.
@@ -52,9 +59,9 @@ struct GapEvent {
 };
 inline constexpr std::size_t kMaxGapReasonBytes = 48;
 
-// Longest possible RATE line: 11 doubles of ≤ 24 characters in shortest round-trip form,
-// a 20-digit seq, the keys and punctuation (about 110) and the newline, rounded up.
-inline constexpr std::size_t kMaxRateLineBytes = 512;
+// Longest possible RATE line: 17 doubles of ≤ 24 characters in shortest round-trip form
+// (408), a 20-digit seq, the keys and punctuation (about 170) and the newline, rounded up.
+inline constexpr std::size_t kMaxRateLineBytes = 768;
 inline constexpr std::size_t kMaxGapLineBytes = 160;
 
 // Writes {"class":"RATE",...}\n into `out` and returns its length (newline included).
@@ -128,6 +135,7 @@ struct StatusReport {
   std::optional<double> nominal_rate_hz;    // configured sample rate [Hz]
   std::optional<double> temp_c;             // latest die temperature [°C]
   std::optional<std::string> bias_source;   // where the bias subtracted from raw comes from
+  std::optional<std::string> rate_model;    // what the rate stream subtracts: "model FILE" or "bias"
   std::optional<std::string> recording;     // file being recorded to
 };
 

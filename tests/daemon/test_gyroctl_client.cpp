@@ -157,6 +157,41 @@ TEST_F(GyroctlTest, WatchShowsRawAndKalmanPerAxisAndGaps) {
   }
 }
 
+TEST_F(GyroctlTest, WatchShowsRateFirstThenRawAndKalmanAndStillWhenGyrodSendsRate) {
+  const auto withRate = [](std::uint64_t k) {
+    protocol::RateSample s = syntheticSample(k);
+    s.rate_dps = {0.5 + static_cast<double>(k), -1.25, 30.0};
+    s.bias_dps = {0.01, 0.02, 0.03};
+    s.still = k % 2 == 0;
+    return s;
+  };
+  startServer();
+  auto next = std::make_shared<std::uint64_t>(0);
+  loop_.addPeriodicTimer(200us, [this, next, withRate](std::uint64_t) {
+    if (server_->watcherCount() == 0) return;
+    server_->publishRate(withRate((*next)++));
+  });
+  const CommandResult r = run({"watch", "--socket", socketPath(), "--count", "2"});
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const auto lines = splitLines(r.out);
+  ASSERT_EQ(lines.size(), 3u) << r.out;
+  EXPECT_LT(lines[0].find("rate x"), lines[0].find("raw x")) << lines[0];
+  EXPECT_LT(lines[0].find("raw z"), lines[0].find("kalman x")) << lines[0];
+  EXPECT_NE(lines[0].find("still"), std::string::npos) << lines[0];
+  for (std::size_t i = 0; i < 2; ++i) {
+    const protocol::RateSample s = withRate(i);
+    const auto w = words(lines[1 + i]);
+    ASSERT_EQ(w.size(), 12u) << lines[1 + i];
+    EXPECT_EQ(w[0], std::to_string(s.seq));
+    for (std::size_t a = 0; a < 3; ++a) {
+      EXPECT_EQ(w[2 + a], fixed(s.rate_dps[a], 5)) << lines[1 + i];
+      EXPECT_EQ(w[5 + a], fixed(s.raw_dps[a], 5)) << lines[1 + i];
+      EXPECT_EQ(w[8 + a], fixed(s.kalman_dps[a], 5)) << lines[1 + i];
+    }
+    EXPECT_EQ(w[11], i % 2 == 0 ? "yes" : "no");
+  }
+}
+
 TEST_F(GyroctlTest, StatusHumanAndJson) {
   content_.status.device_state = "streaming";
   content_.status.samples = 1234;

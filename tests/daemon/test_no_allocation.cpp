@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <new>
 
+#include "daemon/sample_pipeline.hpp"
 #include "server_fixture.hpp"
 
 namespace {
@@ -110,4 +111,34 @@ TEST_F(ServerFixture, PublishingAllocatesNothing) {
   CountAllocations gap;
   server_->publishGap({n, 2, "fifo_overflow"});
   EXPECT_EQ(gap.count(), 0u);
+}
+
+// The pipeline's per-sample step, the rate stream's RateEstimator included (a sensor model
+// with a temperature term, so the residual filter and the still detector both run).
+TEST(NoAllocation, PipelineProcessAllocatesNothingWithARateModel) {
+  daemon::PipelineSettings p;
+  p.bias_origin = daemon::BiasOrigin::Config;
+  p.kalman = {0.9, 0.001, 0.1};
+  p.allan_window_samples = 4096;
+  processing::RateEstimatorParameters model;
+  for (auto& axis : model.axes) {
+    axis.terms.arw_deg_per_sqrt_h = 0.9;
+    axis.temperature_coefficient_dps_per_c = 0.02;
+    axis.temperature_coefficient_std_dps_per_c = 0.002;
+  }
+  p.rate_model = model;
+  daemon::SamplePipeline pipeline(p);
+  std::size_t allocations = 0, still = 0;
+  for (std::uint64_t k = 0; k < 6000; ++k) {
+    const double noise = 0.01 * static_cast<double>(static_cast<int>(k * 7919 % 13) - 6);
+    const double turning = (k / 1000) % 2 == 1 ? 30.0 : 0.0;
+    CountAllocations c;
+    const daemon::ProcessedSample out =
+        pipeline.process(k, static_cast<double>(k) / 50.0, {noise, -noise, turning + noise}, 25.0 + 1e-3 * k);
+    allocations += c.count();
+    still += out.still.value_or(false) ? 1 : 0;
+  }
+  EXPECT_EQ(allocations, 0u);
+  EXPECT_GT(still, 0u);
+  EXPECT_LT(still, 6000u);
 }

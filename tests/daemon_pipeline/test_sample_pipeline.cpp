@@ -204,3 +204,90 @@ TEST(SamplePipeline, ABadKalmanReloadChangesNothing) {
   EXPECT_EQ(pipeline.filterParameters()[0].kalman.a, 0.9);
   EXPECT_EQ(pipeline.filterParameters()[0].kalman.r, 0.1);
 }
+
+namespace {
+
+// A sensor model with a temperature term and a warm-up shape, so that b̂ moves.
+RateEstimatorParameters rateModel() {
+  RateEstimatorParameters p;
+  p.rate_hz = 50.0;
+  const Vec3 bias{1.5, -0.25, 0.125};
+  for (std::size_t a = 0; a < kAxes; ++a) {
+    AxisBiasModel& m = p.axes[a];
+    m.bias_dps = bias[a];
+    m.terms.arw_deg_per_sqrt_h = 3.0 * 60.0 * 0.05 / std::sqrt(50.0) * 60.0;  // white noise 0.05 °/s at 50 Hz
+    m.terms.bias_instability_deg_per_h = 5.0;
+    m.temperature_coefficient_dps_per_c = 0.02 * static_cast<double>(a + 1);
+    m.temperature_coefficient_std_dps_per_c = 0.002;
+    m.temperature_reference_c = 30.0;
+    m.warm_up_amplitude_dps = 0.1;
+    m.warm_up_time_constant_s = 20.0;
+    m.bias_std_dps = 0.01;
+  }
+  return p;
+}
+
+}  // namespace
+
+TEST(SamplePipeline, RateWithASensorModelIsTheRateEstimatorsOutputFromTheFirstSample) {
+  const Stream s = noisyStream(3000, 4, {1.5, -0.25, 0.125});
+  PipelineSettings p = baseSettings();  // bias estimated: the paper's chain waits, the rate does not
+  p.rate_model = rateModel();
+  SamplePipeline pipeline(p);
+  EXPECT_EQ(pipeline.rateModel(), RateModel::SensorModel);
+  EXPECT_EQ(toString(pipeline.rateModel()), "model");
+  RateEstimator reference(rateModel());
+  std::size_t still = 0;
+  for (std::size_t i = 0; i < 3000; ++i) {
+    const Vec3 raw{s.x[0][i], s.x[1][i], s.x[2][i]};
+    const double t = 1234.5 + static_cast<double>(i) / 50.0;
+    const double temp = 25.0 + 0.001 * static_cast<double>(i);
+    const ProcessedSample out = pipeline.process(i, t, raw, temp);
+    const RateSample r = reference.update(t, raw, temp);
+    ASSERT_TRUE(out.has_rate) << i;
+    ASSERT_EQ(out.rate, r.rate_dps) << i;
+    ASSERT_EQ(out.rate_bias, r.bias_dps) << i;
+    ASSERT_EQ(out.still, std::optional<bool>(r.still)) << i;
+    still += r.still ? 1 : 0;
+  }
+  EXPECT_GT(still, 0u);  // the comparison covered residual updates
+}
+
+TEST(SamplePipeline, RateWithoutAModelIsRawMinusTheBiasOnceKnown) {
+  PipelineSettings p = baseSettings();
+  p.still_seconds = 1.0;
+  p.kalman = {0.5, 0.01, 0.02};
+  SamplePipeline pipeline(p);
+  EXPECT_EQ(pipeline.rateModel(), RateModel::ConstantBias);
+  for (int i = 0; i < 50; ++i) {
+    const ProcessedSample out = pipeline.process(i, i / 50.0, {1.0, 2.0, 3.0 + (i % 2)}, 25.0);
+    EXPECT_FALSE(out.has_rate) << i;  // as mean and kalman: from the sample after the still period
+  }
+  const ProcessedSample out = pipeline.process(50, 1.0, {1.5, 2.0, 4.0}, 25.0);
+  ASSERT_TRUE(out.has_rate);
+  EXPECT_EQ(out.rate_bias, pipeline.bias());
+  EXPECT_EQ(out.rate, (Vec3{1.5 - pipeline.bias()[0], 2.0 - pipeline.bias()[1], 4.0 - pipeline.bias()[2]}));
+  EXPECT_FALSE(out.still.has_value());
+}
+
+TEST(SamplePipeline, RateModelReloadValidatesFirstAndContinuesTheWarmUpShape) {
+  PipelineSettings p = baseSettings();
+  p.bias_origin = BiasOrigin::Config;
+  p.kalman = {0.9, 0.001, 0.1};
+  SamplePipeline pipeline(p);
+  for (int i = 0; i < 100; ++i) pipeline.process(i, 10.0 + i / 50.0, {0.1, 0.2, 0.3}, 30.0);
+  RateEstimatorParameters bad = rateModel();
+  bad.low_pass_hz = 40.0;  // past Nyquist
+  EXPECT_THROW(pipeline.reloadRateModel(bad), std::invalid_argument);
+  EXPECT_EQ(pipeline.rateModel(), RateModel::ConstantBias);  // a bad reload changes nothing
+
+  pipeline.reloadRateModel(rateModel());
+  ASSERT_EQ(pipeline.rateModel(), RateModel::SensorModel);
+  // 100 samples (2 s) have passed since the first: the warm-up term is A·e^{−2/τ}.
+  const ProcessedSample out = pipeline.process(100, 12.0, {0.1, 0.2, 0.3}, 30.0);
+  const double expected_warm_up = 0.1 * std::exp(-2.0 / 20.0);
+  EXPECT_NEAR(out.rate_bias[0], 1.5 + expected_warm_up, 1e-12);
+  EXPECT_NEAR(pipeline.rateEstimator()->parameters().axes[0].warm_up_amplitude_dps, expected_warm_up, 1e-15);
+  pipeline.reloadRateModel(std::nullopt);
+  EXPECT_EQ(pipeline.rateModel(), RateModel::ConstantBias);
+}

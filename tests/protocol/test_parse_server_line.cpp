@@ -219,3 +219,34 @@ TEST(RequestLine, ParsesBackToTheSameRequest) {
   EXPECT_TRUE(std::holds_alternative<AllanRequest>(parseRequest(requestLine(AllanRequest{}))));
   EXPECT_TRUE(std::holds_alternative<StatusRequest>(parseRequest(requestLine(StatusRequest{}))));
 }
+
+TEST(ParseServerLine, RateBiasAndStillRoundTripBitForBit) {
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> rate(0.0, 50.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    RateSample s;
+    s.seq = rng();
+    s.t_s = 1e3 + trial * 0.02;
+    s.temp_c = 25.0;
+    for (std::size_t i = 0; i < 3; ++i) {
+      s.raw_dps[i] = rate(rng);
+      s.mean_dps[i] = rate(rng);
+      s.kalman_dps[i] = rate(rng);
+      s.rate_dps[i] = rate(rng);
+      s.bias_dps[i] = rate(rng) * 1e-3;
+    }
+    s.still = trial % 2 == 0;
+    const RateSample back = parsed<RateSample>(rateLine(s));
+    expectSameRate(s, back);
+    for (std::size_t i = 0; i < 3; ++i) {
+      EXPECT_TRUE(sameBits(s.rate_dps[i], back.rate_dps[i]));
+      EXPECT_TRUE(sameBits(s.bias_dps[i], back.bias_dps[i]));
+    }
+    EXPECT_EQ(back.still, s.still);
+  }
+  // An older gyrod's line: no rate, bias or still.
+  const RateSample old = parsed<RateSample>(R"({"class":"RATE","seq":1,"t":2,"raw":[1,2,3]})");
+  EXPECT_TRUE(std::isnan(old.rate_dps[0]) && std::isnan(old.bias_dps[2]));
+  EXPECT_FALSE(old.still.has_value());
+  EXPECT_THROW(parseServerLine(R"({"class":"RATE","seq":1,"still":1})"), MalformedLine);
+}

@@ -243,3 +243,40 @@ TEST(ProtocolRequests, EachProblemIsNamed) {
     }
   }
 }
+
+TEST(ProtocolRate, RateBiasAndStillAreAppendedAndTheLongestLineFits) {
+  RateSample s;
+  s.seq = std::numeric_limits<std::uint64_t>::max();
+  const double longest = -2.2250738585072014e-308;  // 24 characters in shortest form
+  s.t_s = s.temp_c = longest;
+  s.raw_dps = s.mean_dps = s.kalman_dps = s.rate_dps = s.bias_dps = {longest, longest, longest};
+  s.still = false;
+  std::array<char, kMaxRateLineBytes> buf;
+  const std::size_t n = formatRateLine(s, buf);
+  EXPECT_LT(n, kMaxRateLineBytes);
+  const std::string line(buf.data(), n);
+  // Appended after the paper's fields, which keep their places.
+  EXPECT_LT(line.find("\"kalman\""), line.find("\"rate\"")) << line;
+  EXPECT_LT(line.find("\"rate\""), line.find("\"bias\"")) << line;
+  EXPECT_LT(line.find("\"bias\""), line.find("\"still\"")) << line;
+  const json j = parseLine(buf.data(), n);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_TRUE(sameDouble(j["rate"][i].get<double>(), longest));
+    EXPECT_TRUE(sameDouble(j["bias"][i].get<double>(), longest));
+  }
+  EXPECT_EQ(j["still"], false);
+  s.still = true;
+  EXPECT_EQ(parseLine(buf.data(), formatRateLine(s, buf))["still"], true);
+}
+
+TEST(ProtocolRate, UnsetRateBiasAndStillAreOmitted) {
+  RateSample s;
+  s.seq = 3;
+  s.t_s = 1.0;
+  s.temp_c = 20.0;
+  std::array<char, kMaxRateLineBytes> buf;
+  const json j = parseLine(buf.data(), formatRateLine(s, buf));
+  EXPECT_FALSE(j.contains("rate"));
+  EXPECT_FALSE(j.contains("bias"));
+  EXPECT_FALSE(j.contains("still"));
+}

@@ -77,6 +77,7 @@ nlohmann::json fullStatus() {
   d.rate_hz = d.nominal_rate_hz = 50.0;
   d.temp_c = 30.0;
   d.bias_source = "config";
+  d.rate_model = "bias";
   d.recording = "file.csv";
   protocol::ServerStatus s;
   s.client_list.push_back({1, 2, 3, true, 1, 1, 1, 1, true});
@@ -122,4 +123,16 @@ TEST(ProtocolDoc, GapReasonsAreTheDriverCauses) {
   const auto documented = firstColumnNames(section(readDoc(), "#### Gap reasons"));
   const auto causes = enumNames<driver::GapCause>([](auto c) { return std::string(driver::gapCauseName(c)); });
   EXPECT_EQ(documented, causes);
+}
+
+TEST(ProtocolDoc, RateFieldsAreTheOnesSent) {
+  protocol::RateSample s;
+  s.raw_dps = s.mean_dps = s.kalman_dps = s.rate_dps = s.bias_dps = {1.0, 2.0, 3.0};
+  s.still = true;
+  std::array<char, protocol::kMaxRateLineBytes> buf;
+  const std::size_t n = protocol::formatRateLine(s, buf);
+  std::set<std::string> sent;
+  const nlohmann::json line = nlohmann::json::parse(std::string(buf.data(), n - 1));
+  for (const auto& [key, value] : line.items()) sent.insert(key);
+  EXPECT_EQ(firstColumnNames(section(readDoc(), "### RATE")), sent);
 }

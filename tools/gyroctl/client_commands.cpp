@@ -46,7 +46,15 @@ struct WatchOptions {
   std::optional<std::uint64_t> count;
 };
 
-void printRateHeader() {
+// Two layouts. Once a RATE line carries `rate` the stream to read comes first, then raw and
+// the paper's kalman, then the still detector, with a new header where the switch happens;
+// until then (an older gyrod, or gyrod still estimating its start-up bias) raw and kalman.
+void printRateHeader(bool with_rate) {
+  if (with_rate) {
+    std::printf("%10s %12s  %10s %10s %10s  %10s %10s %10s  %10s %10s %10s %6s  [deg/s]\n", "seq", "t [s]", "rate x",
+                "rate y", "rate z", "raw x", "raw y", "raw z", "kalman x", "kalman y", "kalman z", "still");
+    return;
+  }
   std::printf("%10s %12s  %10s %10s %10s  %10s %10s %10s  [deg/s]\n", "seq", "t [s]", "raw x", "raw y", "raw z",
               "kalman x", "kalman y", "kalman z");
 }
@@ -61,15 +69,20 @@ void printAxisTriple(const std::array<double, 3>& v) {
   }
 }
 
-void printRate(const protocol::RateSample& r) {
+void printRate(const protocol::RateSample& r, bool with_rate) {
   std::printf("%10llu ", static_cast<unsigned long long>(r.seq));
   if (std::isfinite(r.t_s))
     std::printf("%12.3f ", r.t_s);
   else
     std::printf("%12s ", "-");
+  if (with_rate) {
+    printAxisTriple(r.rate_dps);
+    std::printf(" ");
+  }
   printAxisTriple(r.raw_dps);
   std::printf(" ");
   printAxisTriple(r.kalman_dps);
+  if (with_rate) std::printf(" %6s", r.still ? (*r.still ? "yes" : "no") : "-");
   std::printf("\n");
 }
 
@@ -84,7 +97,7 @@ int runWatch(const WatchOptions& opt) {
   if (opt.common.json) std::printf("%s\n", conn.versionLine().c_str());
   conn.sendLine(protocol::requestLine(protocol::WatchRequest{true, opt.decimate}));
   std::uint64_t rates = 0;
-  bool header_printed = false;
+  std::optional<bool> with_rate;  // the layout; none before the first RATE line
   while (!opt.count || rates < *opt.count) {
     const std::string line = conn.readLine(std::nullopt);
     const protocol::ServerMessage message = parseServerLine(line);
@@ -94,9 +107,12 @@ int runWatch(const WatchOptions& opt) {
     if (opt.common.json) {
       std::printf("%s\n", line.c_str());
     } else if (rate) {
-      if (!header_printed) printRateHeader();
-      header_printed = true;
-      printRate(*rate);
+      const bool carries_rate = std::isfinite(rate->rate_dps[0]) || rate->still.has_value();
+      if (!with_rate || (carries_rate && !*with_rate)) {
+        with_rate = carries_rate;
+        printRateHeader(*with_rate);
+      }
+      printRate(*rate, *with_rate);
     } else if (const auto* gap = std::get_if<protocol::GapNotice>(&message)) {
       printGap(*gap);
     }
@@ -298,6 +314,7 @@ void printStatus(const protocol::StatusReply& status) {
   printField("bus_errors", count(d.bus_errors));
   printField("resets", count(d.resets));
   printField("bias_source", d.bias_source);
+  printField("rate_model", d.rate_model);
   printField("recording", d.recording);
   printField("clients", count(s.clients));
   printField("clients_total", count(s.clients_total));
@@ -344,8 +361,10 @@ int runStatus(const CommonOptions& opt) {
 void addClientCommands(CLI::App& app, CommandRunner& run) {
   {
     auto opt = std::make_shared<WatchOptions>();
-    auto* sub =
-        app.add_subcommand("watch", "Show gyrod's live samples: seq, t, raw and Kalman rate per axis (RATE lines)");
+    auto* sub = app.add_subcommand(
+        "watch",
+        "Show gyrod's live samples: seq, t, then per axis rate (the stream to read while the board moves), raw "
+        "and the paper's Kalman, and the still detector (RATE lines)");
     addCommonOptions(sub, opt->common);
     sub->add_flag("--json", opt->common.json, "print gyrod's lines unchanged (one JSON object per line)");
     sub->add_option("--decimate", opt->decimate, "receive every N-th sample")
