@@ -192,3 +192,44 @@ TEST(GyroctlErrors, ImportBoundsLinesAndEscapesEchoedValues) {
   EXPECT_LT(r.err.size(), 400u) << r.err.size();
   EXPECT_FALSE(std::filesystem::exists(out));
 }
+
+// filter and model-check name the file and column (or line) too, never the processing
+// function that met the value first (yuleWalker, fitNoiseTerms, solveNonNegativeLeastSquares).
+TEST(GyroctlErrors, FilterAndModelCheckNameFileAndColumnNotFunctions) {
+  ScratchDir d;
+  std::string constant_text = "t,gx\n", huge_text = "t,gx\n";
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> noise(0.0, 0.1);
+  for (int i = 0; i < 2500; ++i) {
+    const std::string t = std::to_string(i * 0.02);
+    constant_text += t + ",0.5\n";
+    huge_text += t + "," + (i == 5 ? std::string("1e300") : std::to_string(noise(rng))) + "\n";
+  }
+  const auto constant = d.write("constant.csv", constant_text);
+  const auto huge = d.write("huge.csv", huge_text);
+  const std::string out = " -o " + (d.path() / "o.csv").string();
+  for (const std::string& command : {std::string("filter"), std::string("model-check --replicas 8")}) {
+    const std::string o = command == "filter" ? out : "";
+    const auto c = runGyroctl(command + " " + constant.string() + o, d.path());
+    expectOneLineError(c, constant.string() + ": column 'gx': ");
+    for (const char* internal : {"yuleWalker", "fitNoiseTerms", "solveNonNegativeLeastSquares", "Test:"})
+      EXPECT_EQ(c.err.find(internal), std::string::npos) << command << ": " << c.err;
+    expectOneLineError(runGyroctl(command + " " + huge.string() + o, d.path()),
+                       huge.string() + ":7: column 'gx': 1e+300 deg/s is beyond 1e+12 deg/s");
+  }
+  EXPECT_FALSE(std::filesystem::exists(d.path() / "o.csv"));
+}
+
+// A directory is said to be one by every command that reads a file.
+TEST(GyroctlErrors, ADirectoryIsNamedAsOne) {
+  ScratchDir d;
+  const auto dir = d.path() / "folder";
+  std::filesystem::create_directories(dir);
+  const std::string out = " -o " + (d.path() / "o.csv").string();
+  for (const std::string& command :
+       {std::string("analyze "), std::string("filter "), std::string("model-check "), std::string("import ")}) {
+    const std::string o = command == "filter " || command == "import " ? out : "";
+    expectOneLineError(runGyroctl(command + dir.string() + o, d.path()),
+                       dir.string() + ": cannot read: it is a directory, not a file");
+  }
+}
