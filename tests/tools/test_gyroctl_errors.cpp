@@ -233,3 +233,15 @@ TEST(GyroctlErrors, ADirectoryIsNamedAsOne) {
                        dir.string() + ": cannot read: it is a directory, not a file");
   }
 }
+
+// Why an axis got no calibration is written into the model file in the user's words too.
+TEST(GyroctlErrors, ModelFileNotesNameNoFunction) {
+  ScratchDir d;
+  const auto f = d.write("short.csv", whiteNoiseCsv(200, 50.0, 12));  // 4 s: too short for 10 s blocks
+  const auto model = d.path() / "m.toml";
+  const auto r = runGyroctl("analyze " + f.string() + " --write-model " + model.string(), d.path());
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const std::string text = gyrod::test::readWholeFile(model);
+  EXPECT_NE(text.find("# gx: no calibration ("), std::string::npos) << text.substr(0, 400);
+  EXPECT_EQ(text.find("fitTemperatureBias"), std::string::npos) << text.substr(0, 400);
+}

@@ -244,7 +244,7 @@ void calibrateAxisInto(recording::SensorModel& sensor, std::size_t slot, const s
   try {
     c = recording::calibrateAxis(secs, rec.axes[idx], rec.temp);
   } catch (const std::invalid_argument& e) {
-    notes.push_back(name + ": no calibration (" + e.what() + ")");
+    notes.push_back(name + ": no calibration (" + withoutFunctionName(e.what()) + ")");
     return;
   }
   sensor.calibration[slot] = c.calibration;

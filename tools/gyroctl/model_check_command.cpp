@@ -453,7 +453,7 @@ std::string extendedModelToml(const ModelCheckCliOptions& opt, const LoadedInput
     try {
       sensor.calibration[*slot] = recording::calibrateAxis(secs, rec.axes[in.axis_indices[k]], rec.temp).calibration;
     } catch (const std::invalid_argument& e) {
-      notes.push_back(name + ": no calibration (" + e.what() + ")");
+      notes.push_back(name + ": no calibration (" + withoutFunctionName(e.what()) + ")");
     }
   }
   validateSimulationModel(model);
