@@ -73,16 +73,20 @@ std::string withoutFunctionName(const std::string& message) {
 }
 
 TimingSummary checkTiming(const recording::Recording& rec, std::optional<double> rate_hz) {
+  if (rec.t.empty()) return summarizeTiming(std::nullopt, rec.lost);
+  processing::SampleTimingCheck check(rate_hz ? std::optional<double>(1.0 / *rate_hz) : std::nullopt);
+  for (std::size_t i = 0; i < rec.t.size(); ++i) check.add(rec.t[i], lineOfSample(rec, i));
+  return summarizeTiming(check.report(), rec.lost);
+}
+
+TimingSummary summarizeTiming(const std::optional<processing::SampleTimingReport>& t_report,
+                              const std::vector<recording::LostSamples>& lost) {
   TimingSummary summary;
-  summary.has_t = !rec.t.empty();
-  if (summary.has_t) {
-    processing::SampleTimingCheck check(rate_hz ? std::optional<double>(1.0 / *rate_hz) : std::nullopt);
-    for (std::size_t i = 0; i < rec.t.size(); ++i) check.add(rec.t[i], lineOfSample(rec, i));
-    summary.t = check.report();
-  }
-  summary.lost_records = rec.lost.size();
-  for (const auto& lost : rec.lost) summary.lost_samples += lost.count;
-  if (!rec.lost.empty()) summary.first_lost = rec.lost.front();
+  summary.has_t = t_report.has_value();
+  if (t_report) summary.t = *t_report;
+  summary.lost_records = lost.size();
+  for (const auto& record : lost) summary.lost_samples += record.count;
+  if (!lost.empty()) summary.first_lost = lost.front();
   return summary;
 }
 

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "formats/recording_csv.hpp"
 #include "processing/sample_timing.hpp"
@@ -36,6 +37,10 @@ struct TimingSummary {
 
 // rate_hz: --rate when given (then τ0 = 1 / rate), else τ0 is the median of the first intervals.
 TimingSummary checkTiming(const recording::Recording& rec, std::optional<double> rate_hz);
+// The same from a SampleTimingCheck a reader fed while parsing (t_report: nullopt without a t
+// column), with the recording's GAP and DROPPED records.
+TimingSummary summarizeTiming(const std::optional<processing::SampleTimingReport>& t_report,
+                              const std::vector<recording::LostSamples>& lost);
 
 // Irregular timing: with strict, throws RecordingError "FILE:LINE: ..." naming the first
 // offending interval or record; otherwise writes the warning lines to stderr. Silent when regular.
