@@ -4,7 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <random>
+#include <sstream>
+#include <tuple>
+#include <vector>
 
 #include "tools/run_command.hpp"
 
@@ -244,4 +248,31 @@ TEST(GyroctlErrors, ModelFileNotesNameNoFunction) {
   const std::string text = gyrod::test::readWholeFile(model);
   EXPECT_NE(text.find("# gx: no calibration ("), std::string::npos) << text.substr(0, 400);
   EXPECT_EQ(text.find("fitTemperatureBias"), std::string::npos) << text.substr(0, 400);
+}
+
+// Each command's minimum number of samples is the one its README section states.
+TEST(GyroctlErrors, MinimumSamplesAreTheDocumentedOnes) {
+  std::ifstream in(std::string(GYROD_TEST_DATA_DIR) + "/../../README.md");
+  ASSERT_TRUE(in);
+  std::stringstream readme_text;
+  readme_text << in.rdbuf();
+  const std::string readme = readme_text.str();
+  const auto section = [&readme](const std::string& title) {
+    const std::size_t at = readme.find("### `gyroctl " + title + "`");
+    return at == std::string::npos ? std::string() : readme.substr(at, readme.find("\n### ", at + 1) - at);
+  };
+  ScratchDir d;
+  const std::string out = " -o " + (d.path() / "o.csv").string();
+  const std::vector<std::tuple<std::string, std::string, std::size_t>> commands = {
+      {"analyze", "analyze", 100}, {"filter", "filter", 100}, {"model-check", "model-check --replicas 8", 2000}};
+  for (const auto& [title, command, minimum] : commands) {
+    EXPECT_NE(section(title).find("at least " + std::to_string(minimum) + " samples"), std::string::npos) << title;
+    const auto few = d.write(title + ".csv", whiteNoiseCsv(minimum - 1, 50.0, 13));
+    const auto r = runGyroctl(command + " " + few.string() + (title == "filter" ? out : ""), d.path());
+    expectOneLineError(r, few.string() + ": " + std::to_string(minimum - 1) + " samples are too few");
+    EXPECT_NE(r.err.find("need at least " + std::to_string(minimum)), std::string::npos) << r.err;
+    const auto enough = d.write(title + "-enough.csv", whiteNoiseCsv(minimum, 50.0, 13));
+    EXPECT_EQ(runGyroctl(command + " " + enough.string() + (title == "filter" ? out : ""), d.path()).exit_status, 0)
+        << title;
+  }
 }
