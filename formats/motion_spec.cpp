@@ -242,9 +242,12 @@ MotionProfile readMotionCsv(const std::string& path) {
   std::vector<std::size_t> columns;
   std::vector<MotionPoint> points;
   std::size_t header_line = 0;
-  std::string raw;
-  for (std::size_t line_no = 1; std::getline(in, raw); ++line_no) {
-    const std::string_view line = trimField(raw);
+  BoundedLineReader reader(in);  // a file without newlines costs at most the line limit
+  for (std::size_t line_no = 1;; ++line_no) {
+    const auto result = reader.next();
+    if (result == BoundedLineReader::Result::End) break;
+    if (result == BoundedLineReader::Result::TooLong) failFile(path, line_no, lineTooLongCause(reader.maxBytes()));
+    const std::string_view line = trimField(reader.line());
     if (line.empty() || line.front() == '#') continue;
     if (columns.empty()) {
       columns = readHeader(path, line_no, line);

@@ -75,6 +75,8 @@ Recording readRecordingCsv(const std::string& path) {
     first = *line;
     if (!skippable(first)) break;
   }
+  // A directory opens but cannot be read (EISDIR): that is not an empty file.
+  if (in.bad()) fail(path, line_no, std::string("read error: ") + std::strerror(errno));
   if (isSkippable(first)) fail(path, 0, "empty file: no header and no samples");
 
   enum class Role { T, Axis, Temp, Truth };

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "formats/csv_fields.hpp"
+#include "formats/motion_spec.hpp"
 #include "formats/quoted_value.hpp"
 #include "formats/recording_csv.hpp"
 
@@ -121,4 +122,34 @@ TEST(RecordingHostileInput, BadValuesAreEscapedAndCut) {
                    "…' (20001 bytes)");
   e = errorOf("t,g\x1b[2J\n", &path);
   EXPECT_EQ(e, path + ":1: unknown column 'g\\x1B[2J' (expected any of t,gx,gy,gz,temp,wx,wy,wz)");
+}
+
+// A directory opens as a stream but reads nothing: it must not pass for an empty file.
+TEST(RecordingHostileInput, ADirectoryIsNotAnEmptyFile) {
+  const fs::path dir = fs::temp_directory_path() / ("gyrod-hostile-dir-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::string message;
+  try {
+    (void)readRecordingCsv(dir.string());
+  } catch (const RecordingError& e) {
+    message = e.what();
+  }
+  fs::remove(dir);
+  EXPECT_EQ(message.rfind(dir.string() + ":", 0), 0u) << message;
+  EXPECT_NE(message.find("Is a directory"), std::string::npos) << message;
+  EXPECT_EQ(message.find("empty file"), std::string::npos) << message;
+}
+
+// The motion CSV of `simulate --motion` is bounded like a recording.
+TEST(RecordingHostileInput, AMotionCsvLineLongerThanTheLimitIsRefusedWithItsLine) {
+  TempFile f("t,wz\n0,1\n1," + std::string(kMaxLineBytes + 10, '2') + "\n2,3\n");
+  std::string message;
+  try {
+    (void)readMotionCsv(f.path());
+  } catch (const RecordingError& e) {
+    message = e.what();
+  }
+  EXPECT_EQ(message, f.path() + ":3: line longer than 65536 bytes (the limit for one line)");
+  TempFile g("t,wz\n0,1\n1,2");  // no newline at the end: still read
+  EXPECT_EQ(readMotionCsv(g.path()).rateAt(1.0)[2], 2.0);
 }

@@ -30,6 +30,8 @@ TEST(ProtocolRequests, DuplicateCmdIsRefusedNamingTheKey) {
   expectDuplicate(R"({"cmd":"status","cmd":"status"})", "cmd");  // even when both agree
   expectDuplicate(R"({"cmd":"watch","enable":true,"enable":false})", "enable");
   expectDuplicate(R"({"cmd":"watch","decimate":2,"cmd":"allan","decimate":3})", "cmd");
+  // The same key spelt with an escape is the same key once decoded.
+  expectDuplicate(R"({"cmd":"status","\u0063md":"watch"})", "cmd");
 }
 
 TEST(ProtocolRequests, DuplicateFieldHasItsOwnErrorCodeOnTheWire) {

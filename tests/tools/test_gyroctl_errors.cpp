@@ -4,7 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <random>
+#include <sstream>
+#include <tuple>
+#include <vector>
 
 #include "tools/run_command.hpp"
 
@@ -191,4 +195,84 @@ TEST(GyroctlErrors, ImportBoundsLinesAndEscapesEchoedValues) {
   expectOneLineError(r, wide.string() + ":1: sample rate '" + std::string(80, '7') + "…' (5001 bytes) is not");
   EXPECT_LT(r.err.size(), 400u) << r.err.size();
   EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+// filter and model-check name the file and column (or line) too, never the processing
+// function that met the value first (yuleWalker, fitNoiseTerms, solveNonNegativeLeastSquares).
+TEST(GyroctlErrors, FilterAndModelCheckNameFileAndColumnNotFunctions) {
+  ScratchDir d;
+  std::string constant_text = "t,gx\n", huge_text = "t,gx\n";
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> noise(0.0, 0.1);
+  for (int i = 0; i < 2500; ++i) {
+    const std::string t = std::to_string(i * 0.02);
+    constant_text += t + ",0.5\n";
+    huge_text += t + "," + (i == 5 ? std::string("1e300") : std::to_string(noise(rng))) + "\n";
+  }
+  const auto constant = d.write("constant.csv", constant_text);
+  const auto huge = d.write("huge.csv", huge_text);
+  const std::string out = " -o " + (d.path() / "o.csv").string();
+  for (const std::string& command : {std::string("filter"), std::string("model-check --replicas 8")}) {
+    const std::string o = command == "filter" ? out : "";
+    const auto c = runGyroctl(command + " " + constant.string() + o, d.path());
+    expectOneLineError(c, constant.string() + ": column 'gx': ");
+    for (const char* internal : {"yuleWalker", "fitNoiseTerms", "solveNonNegativeLeastSquares", "Test:"})
+      EXPECT_EQ(c.err.find(internal), std::string::npos) << command << ": " << c.err;
+    expectOneLineError(runGyroctl(command + " " + huge.string() + o, d.path()),
+                       huge.string() + ":7: column 'gx': 1e+300 deg/s is beyond 1e+12 deg/s");
+  }
+  EXPECT_FALSE(std::filesystem::exists(d.path() / "o.csv"));
+}
+
+// A directory is said to be one by every command that reads a file.
+TEST(GyroctlErrors, ADirectoryIsNamedAsOne) {
+  ScratchDir d;
+  const auto dir = d.path() / "folder";
+  std::filesystem::create_directories(dir);
+  const std::string out = " -o " + (d.path() / "o.csv").string();
+  for (const std::string& command :
+       {std::string("analyze "), std::string("filter "), std::string("model-check "), std::string("import ")}) {
+    const std::string o = command == "filter " || command == "import " ? out : "";
+    expectOneLineError(runGyroctl(command + dir.string() + o, d.path()),
+                       dir.string() + ": cannot read: it is a directory, not a file");
+  }
+}
+
+// Why an axis got no calibration is written into the model file in the user's words too.
+TEST(GyroctlErrors, ModelFileNotesNameNoFunction) {
+  ScratchDir d;
+  const auto f = d.write("short.csv", whiteNoiseCsv(200, 50.0, 12));  // 4 s: too short for 10 s blocks
+  const auto model = d.path() / "m.toml";
+  const auto r = runGyroctl("analyze " + f.string() + " --write-model " + model.string(), d.path());
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const std::string text = gyrod::test::readWholeFile(model);
+  EXPECT_NE(text.find("# gx: no calibration ("), std::string::npos) << text.substr(0, 400);
+  EXPECT_EQ(text.find("fitTemperatureBias"), std::string::npos) << text.substr(0, 400);
+}
+
+// Each command's minimum number of samples is the one its README section states.
+TEST(GyroctlErrors, MinimumSamplesAreTheDocumentedOnes) {
+  std::ifstream in(std::string(GYROD_TEST_DATA_DIR) + "/../../README.md");
+  ASSERT_TRUE(in);
+  std::stringstream readme_text;
+  readme_text << in.rdbuf();
+  const std::string readme = readme_text.str();
+  const auto section = [&readme](const std::string& title) {
+    const std::size_t at = readme.find("### `gyroctl " + title + "`");
+    return at == std::string::npos ? std::string() : readme.substr(at, readme.find("\n### ", at + 1) - at);
+  };
+  ScratchDir d;
+  const std::string out = " -o " + (d.path() / "o.csv").string();
+  const std::vector<std::tuple<std::string, std::string, std::size_t>> commands = {
+      {"analyze", "analyze", 100}, {"filter", "filter", 100}, {"model-check", "model-check --replicas 8", 2000}};
+  for (const auto& [title, command, minimum] : commands) {
+    EXPECT_NE(section(title).find("at least " + std::to_string(minimum) + " samples"), std::string::npos) << title;
+    const auto few = d.write(title + ".csv", whiteNoiseCsv(minimum - 1, 50.0, 13));
+    const auto r = runGyroctl(command + " " + few.string() + (title == "filter" ? out : ""), d.path());
+    expectOneLineError(r, few.string() + ": " + std::to_string(minimum - 1) + " samples are too few");
+    EXPECT_NE(r.err.find("need at least " + std::to_string(minimum)), std::string::npos) << r.err;
+    const auto enough = d.write(title + "-enough.csv", whiteNoiseCsv(minimum, 50.0, 13));
+    EXPECT_EQ(runGyroctl(command + " " + enough.string() + (title == "filter" ? out : ""), d.path()).exit_status, 0)
+        << title;
+  }
 }

@@ -20,6 +20,7 @@
 #include "processing/warm_up_fit.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
+#include "tools/gyroctl/series_checks.hpp"
 
 namespace gyrod::gyroctl {
 namespace {
@@ -30,37 +31,6 @@ using nlohmann::json;
 // Fewer samples than this cannot carry the tests (100 reverse-arrangement segments
 // need ≥ 10 samples each to mean anything) nor a useful Allan curve.
 constexpr std::size_t kMinimumSamples = 100;
-// Far beyond any gyro's range (the MPU-6050 tops out at 2000 °/s), and far enough below
-// the largest double that sums of squares over any recording stay finite: a larger
-// value is a broken file, and would otherwise surface as an overflow deep in the statistics.
-constexpr double kLargestAnalysableRateDps = 1e12;
-
-// Every input check before any output: a rejected file leaves stdout empty and names
-// FILE:LINE, never the internal function that happened to meet the value first.
-void requireAnalysableValues(const recording::Recording& rec, std::size_t axis_index) {
-  const auto& values = rec.axes[axis_index];
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    if (std::abs(values[i]) <= kLargestAnalysableRateDps) continue;
-    std::ostringstream s;
-    s << rec.path << ':' << (i < rec.line_numbers.size() ? rec.line_numbers[i] : i + 1) << ": column '"
-      << rec.axis_names[axis_index] << "': " << values[i] << " deg/s is beyond " << kLargestAnalysableRateDps
-      << " deg/s, more than any gyro measures (the statistics would overflow)";
-    throw recording::RecordingError(s.str());
-  }
-}
-
-// A processing function's std::invalid_argument begins with its own name ("fitLinearTrend:
-// ..."), which means nothing to a user: the tool names the file and the column instead.
-std::string withoutFunctionName(const std::string& message) {
-  const auto colon = message.find(": ");
-  if (colon == std::string::npos || colon == 0) return message;
-  for (std::size_t i = 0; i < colon; ++i) {
-    const char c = message[i];
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == ':')) return message;
-  }
-  return message.substr(colon + 2);
-}
-
 AxisAnalysis analyzeColumn(const recording::Recording& rec, std::size_t axis_index, const AnalysisOptions& options) {
   try {
     return analyzeAxis(rec.axes[axis_index], options);
@@ -77,6 +47,7 @@ struct AnalyzeOptions {
   std::string taus = "octave";
   bool no_detrend = false;
   bool json = false;
+  bool strict_timing = false;
   std::size_t mean_window = 20;
   double mean_threshold_dps = 0.3;
   std::size_t max_ar_order = 3;
@@ -273,7 +244,7 @@ void calibrateAxisInto(recording::SensorModel& sensor, std::size_t slot, const s
   try {
     c = recording::calibrateAxis(secs, rec.axes[idx], rec.temp);
   } catch (const std::invalid_argument& e) {
-    notes.push_back(name + ": no calibration (" + e.what() + ")");
+    notes.push_back(name + ": no calibration (" + withoutFunctionName(e.what()) + ")");
     return;
   }
   sensor.calibration[slot] = c.calibration;
@@ -324,6 +295,8 @@ int runAnalyze(const AnalyzeOptions& opt) {
   options.mean_threshold_dps = opt.mean_threshold_dps;
   options.max_ar_order = opt.max_ar_order;
   for (std::size_t idx : in.axis_indices) requireAnalysableValues(rec, idx);
+  const TimingSummary timing = checkTiming(rec, opt.rate_hz);
+  reportTiming(opt.file, timing, opt.strict_timing);
   std::vector<AxisAnalysis> analyses;
   analyses.reserve(in.axis_indices.size());
   for (std::size_t idx : in.axis_indices) analyses.push_back(analyzeColumn(rec, idx, options));
@@ -333,6 +306,7 @@ int runAnalyze(const AnalyzeOptions& opt) {
   doc["rate_hz"] = in.rate_hz;
   doc["samples"] = rec.size();
   doc["detrended"] = options.detrend;
+  doc["timing"] = timingJson(timing);
   doc["axes"] = json::object();
   if (!opt.json) {
     std::printf("gyroctl analyze %s: %zu samples at %g Hz (%s), %.1f s%s\n", opt.file.c_str(), rec.size(), in.rate_hz,
@@ -387,6 +361,8 @@ void addAnalyzeCommand(CLI::App& app, CommandRunner& run) {
       ->default_val("octave");
   sub->add_flag("--no-detrend", opt->no_detrend, "keep the constant and the linear trend");
   sub->add_flag("--json", opt->json, "one JSON document on stdout");
+  sub->add_flag("--strict-timing", opt->strict_timing,
+                "gaps or irregular spacing in t, or GAP/DROPPED records, are an error instead of a warning");
   sub->add_option("--mean-window", opt->mean_window, "mean filter window L [samples]")
       ->default_val(20)
       ->check(CLI::Range(std::size_t{1}, std::size_t{100000}));

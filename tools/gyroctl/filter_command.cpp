@@ -17,6 +17,7 @@
 #include "processing/rate_estimator.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
+#include "tools/gyroctl/series_checks.hpp"
 
 namespace gyrod::gyroctl {
 namespace {
@@ -40,6 +41,7 @@ struct FilterOptions {
   bool no_detrend = false;
   std::vector<double> bias_dps;  // --bias: subtract these constants instead of detrending
   std::string model;             // --model: add the rate stream's columns
+  bool strict_timing = false;
 };
 
 // Identifying the Kalman filter from the file (the AR(1) fit of the mean-filtered series and
@@ -120,6 +122,7 @@ int runFilter(const FilterOptions& opt) {
     if (!std::isfinite(b)) throw std::invalid_argument("--bias values must be finite numbers");
   const std::size_t n = rec.size();
   const double dt = 1.0 / in.rate_hz;
+  for (std::size_t axis = 0; axis < rec.axes.size(); ++axis) requireAnalysableValues(rec, axis);
   std::optional<RateColumns> rate_columns;  // first, so that a bad --model fails before any work
   if (!opt.model.empty()) rate_columns.emplace(opt, rec, in.rate_hz);
   const bool identifies = !(opt.ar_phi && opt.kalman_q && opt.kalman_r);
@@ -129,6 +132,7 @@ int runFilter(const FilterOptions& opt) {
       << ", or give --ar-phi, --kalman-q and --kalman-r)";
     throw recording::RecordingError(s.str());
   }
+  reportTiming(opt.file, checkTiming(rec, opt.rate_hz), opt.strict_timing);
 
   std::vector<std::vector<double>> chain_input;
   std::vector<FilterChainParameters> params;
@@ -144,7 +148,7 @@ int runFilter(const FilterOptions& opt) {
                                            KalmanOverrides{opt.ar_phi, opt.kalman_q, opt.kalman_r}));
     } catch (const std::invalid_argument& e) {
       throw recording::RecordingError(opt.file + ": column '" + rec.axis_names[axis] +
-                                      "': cannot identify the filter: " + e.what());
+                                      "': cannot identify the filter: " + withoutFunctionName(e.what()));
     }
     chain_input.push_back(std::move(x));
   }
@@ -212,6 +216,8 @@ void addFilterCommand(CLI::App& app, CommandRunner& run) {
                   "subtract these constants [deg/s], one per gyro column, instead of detrending (as gyrod does)")
       ->delimiter(',')
       ->excludes(no_detrend);
+  sub->add_flag("--strict-timing", opt->strict_timing,
+                "gaps or irregular spacing in t, or GAP/DROPPED records, are an error instead of a warning");
   sub->add_option("--model", opt->model,
                   "sensor model file (gyroctl analyze --write-model): add gx_rate,gx_bias per axis and still, "
                   "the rate stream of processing::RateEstimator (docs/calibration.md)");

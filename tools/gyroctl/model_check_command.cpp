@@ -30,6 +30,7 @@
 #include "processing/warm_up_fit.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
+#include "tools/gyroctl/series_checks.hpp"
 
 namespace gyrod::gyroctl {
 namespace {
@@ -42,6 +43,7 @@ struct ModelCheckCliOptions {
   std::optional<double> rate_hz;
   std::string axis = "all";
   bool json = false;
+  bool strict_timing = false;
   std::string report_dir;
   std::uint64_t seed = 1;
   std::size_t replicas = 40;
@@ -451,7 +453,7 @@ std::string extendedModelToml(const ModelCheckCliOptions& opt, const LoadedInput
     try {
       sensor.calibration[*slot] = recording::calibrateAxis(secs, rec.axes[in.axis_indices[k]], rec.temp).calibration;
     } catch (const std::invalid_argument& e) {
-      notes.push_back(name + ": no calibration (" + e.what() + ")");
+      notes.push_back(name + ": no calibration (" + withoutFunctionName(e.what()) + ")");
     }
   }
   validateSimulationModel(model);
@@ -485,10 +487,18 @@ int runModelCheck(const ModelCheckCliOptions& opt) {
   options.seed = opt.seed;
   options.replicas = opt.replicas;
   options.threads = opt.threads;
+  for (std::size_t idx : in.axis_indices) requireAnalysableValues(rec, idx);
+  const TimingSummary timing = checkTiming(rec, opt.rate_hz);
+  reportTiming(opt.file, timing, opt.strict_timing);
   std::vector<std::pair<std::string, AxisModelCheck>> results;
   for (std::size_t idx : in.axis_indices) {
     AxisModelCheckInput axis{rec.axes[idx], in.rate_hz, rec.temp, rec.t};
-    results.emplace_back(rec.axis_names[idx], checkAxisModel(axis, options));
+    try {
+      results.emplace_back(rec.axis_names[idx], checkAxisModel(axis, options));
+    } catch (const std::invalid_argument& e) {
+      throw recording::RecordingError(opt.file + ": column '" + rec.axis_names[idx] +
+                                      "': " + withoutFunctionName(e.what()));
+    }
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (opt.json) {
@@ -499,6 +509,7 @@ int runModelCheck(const ModelCheckCliOptions& opt) {
     doc["seed"] = opt.seed;
     doc["replicas"] = opt.replicas;
     doc["elapsed_s"] = seconds;
+    doc["timing"] = timingJson(timing);
     doc["axes"] = json::object();
     for (const auto& [name, r] : results) doc["axes"][name] = axisJson(r);
     std::cout << doc.dump(1) << '\n';
@@ -532,6 +543,8 @@ void addModelCheckCommand(CLI::App& app, CommandRunner& run) {
   sub->add_option("--rate", opt->rate_hz, "sample rate [Hz] (default: from t, else 50)");
   sub->add_option("--axis", opt->axis, "gx, gy, gz or all")->default_val("all");
   sub->add_flag("--json", opt->json, "one JSON document on stdout");
+  sub->add_flag("--strict-timing", opt->strict_timing,
+                "gaps or irregular spacing in t, or GAP/DROPPED records, are an error instead of a warning");
   sub->add_option("--report", opt->report_dir, "write report.md with plots (gnuplot, when installed) into this folder");
   sub->add_option("--seed", opt->seed, "seed of the replicas")->default_val(1);
   sub->add_option("--replicas", opt->replicas, "replicas per round (the null distributions)")
