@@ -61,12 +61,12 @@ void printTable(const StreamComparison& c, const StreamComparisonSetup& setup) {
   row("at rest: peak ratio (to raw)", c, [](const StreamFigures& f) { return cell(f.peak_ratio, "%.4f"); });
   std::printf("\n");
   std::printf(
-      "Seed %llu; %zu steps; raw's variance at rest %.4g (°/s)²; the paper's chain ran with L = %zu, "
+      "Seed %llu; %zu steps; raw's variance at rest %.4g (°/s)²;\nthe paper's chain ran with L = %zu, "
       "r = %g °/s, A = %.4f, Q = %.3g, R = %.3g (x axis).\n",
       static_cast<unsigned long long>(setup.seed), c.steps, c.raw_variance_dps2, c.paper[0].mean_window,
       c.paper[0].mean_threshold_dps, c.paper[0].kalman.a, c.paper[0].kalman.q, c.paper[0].kalman.r);
   std::printf(
-      "Warm-up, worst axis: rate's bias estimate before the final still %.4f °/s from the truth; "
+      "Warm-up, worst axis: rate's bias estimate before the final still %.4f °/s from the truth;\n"
       "the start-up estimate's %.4f °/s.\n",
       c.rate_bias_error_dps, c.startup_bias_error_dps);
 }
