@@ -255,6 +255,29 @@ void readMockMotion(const Section& s, MockConfig& m) {
   m.motion = *v;
 }
 
+// [mock] warm_up ("DELTA_C,TAU_S", as gyroctl simulate --warm-up) and
+// temperature_coefficient_dps_per_c (one number, or [x, y, z]): the simulator's board warms up and
+// its bias follows through the coupling (docs/mock-device.md).
+void readMockWarmUp(const Section& s, MockConfig& m) {
+  if (auto v = s.string("warm_up"); v && !v->empty()) {
+    if (m.source == MockSource::Replay) s.failValue("warm_up", "applies to source = \"simulator\" only");
+    try {
+      (void)processing::withWarmUp({}, recording::parseWarmUpSpec(*v));
+    } catch (const std::invalid_argument& e) {
+      s.failValue("warm_up", e.what());
+    }
+    m.warm_up = *v;
+  }
+  const std::string key = "temperature_coefficient_dps_per_c";
+  const std::string requirement = "must be a finite number in °/s per °C, or an array of 3 of them [x, y, z]";
+  const auto k = s.numbers(
+      key, [](double v) { return std::isfinite(v); }, requirement);
+  if (!k) return;
+  if (m.source == MockSource::Replay) s.failValue(key, "applies to source = \"simulator\" only");
+  if (k->size() != 1 && k->size() != 3) s.failValue(key, requirement);
+  m.temperature_coefficient_dps_per_c = k->size() == 1 ? std::vector<double>(3, k->front()) : *k;
+}
+
 void readMock(const Section& s, MockConfig& m) {
   if (auto v = s.choice("source", kMockSourceNames)) m.source = *v == 0 ? MockSource::Simulator : MockSource::Replay;
   if (auto v = s.string("replay_file")) m.replay_file = *v;
@@ -269,6 +292,7 @@ void readMock(const Section& s, MockConfig& m) {
     m.speed = *v;
   }
   readMockMotion(s, m);
+  readMockWarmUp(s, m);
   if (!s.has("faults")) return;
   if (!s.node("faults")->is_table()) s.failType(*s.node("faults"), "faults", "must be a table");
   const Section f(s.file(), *s.node("faults")->as_table(), s.qualified("faults"),
@@ -427,7 +451,8 @@ GyrodConfig readConfig(const formats::TomlDocument& doc, ReferenceChecks checks)
   readRecord(section("record", {"path", "rotate_mb", "rotate_minutes", "flush_interval_s", "fsync_each_flush", "keep"}),
              config.record);
   readLog(section("log", {"level"}), config.log);
-  const auto mock = section("mock", {"source", "replay_file", "seed", "speed", "motion", "faults"});
+  const auto mock = section("mock", {"source", "replay_file", "seed", "speed", "motion", "warm_up",
+                                     "temperature_coefficient_dps_per_c", "faults"});
   readMock(mock, config.mock);
   if (checks == ReferenceChecks::On) checkReferences(filter, socket, mock, config);
   return config;

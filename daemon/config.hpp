@@ -135,6 +135,11 @@ struct MockConfig {
   // The board's true rotation as a motion spec (formats/motion_spec.hpp: profiles such as
   // "constant:axis=z,rate=30,start=10", or a CSV t,wx,wy,wz); empty = at rest. Simulator only.
   std::string motion;
+  // A warm-up "DELTA_C,TAU_S" (formats/motion_spec.hpp parseWarmUpSpec): the die temperature rises
+  // by DELTA_C from the model's start; empty = the model's curve. Simulator only.
+  std::string warm_up;
+  // The bias's temperature coupling per axis [°/s per °C] (3 values); empty = the model's.
+  std::vector<double> temperature_coefficient_dps_per_c;
   MockFaults faults;
   bool operator==(const MockConfig&) const = default;
 };

@@ -106,8 +106,12 @@ DeviceParts makeDeviceParts(const GyrodConfig& config) {
     if (mc.source == MockSource::Replay) {
       b.source = replaySource(mc.replay_file, config.device.dlpf);
     } else {
-      const processing::SimulationModel model =
+      processing::SimulationModel model =
           config.filter.model.empty() ? defaultMockModel() : recording::readModelToml(config.filter.model);
+      if (!mc.warm_up.empty())
+        model.temperature = processing::withWarmUp(model.temperature, recording::parseWarmUpSpec(mc.warm_up));
+      for (std::size_t a = 0; a < mc.temperature_coefficient_dps_per_c.size(); ++a)
+        model.axes[a].extra.temperature_coefficient_dps_per_c = mc.temperature_coefficient_dps_per_c[a];
       const processing::MotionProfile motion =
           mc.motion.empty() ? processing::MotionProfile{} : recording::motionFromSpec(mc.motion);
       b.source = std::make_unique<driver::SimulatorSignalSource>(
@@ -138,6 +142,7 @@ DeviceParts makeDeviceParts(const GyrodConfig& config) {
     else
       d << mc.speed << "x real time";
     if (!mc.motion.empty()) d << ", motion " << mc.motion;
+    if (!mc.warm_up.empty()) d << ", warm-up " << mc.warm_up;
     d << ')';
     b.description = d.str();
     return b;

@@ -273,4 +273,35 @@ MotionProfile motionFromSpec(const std::string& spec) {
   return isMotionProfileText(spec) ? parseMotionProfileText(spec) : readMotionCsv(spec);
 }
 
+namespace {
+std::vector<double> finiteNumbers(std::string_view text, std::string_view what) {
+  std::vector<double> out;
+  for (std::string_view field : splitFields(text)) {
+    const auto number = parseNumber(field);
+    if (!number || !std::isfinite(*number))
+      throw std::invalid_argument(std::string(what) + ": '" + std::string(field) + "' is not a finite number (in '" +
+                                  std::string(text) + "')");
+    out.push_back(*number);
+  }
+  return out;
+}
+}  // namespace
+
+processing::WarmUp parseWarmUpSpec(std::string_view text) {
+  const std::vector<double> v = finiteNumbers(text, "warm-up");
+  if (v.size() != 2)
+    throw std::invalid_argument("warm-up: expected DELTA_C,TAU_S (e.g. 15,300), got '" + std::string(text) + "'");
+  if (!(v[1] > 0.0))
+    throw std::invalid_argument("warm-up: the time constant TAU_S must be > 0 s, got '" + std::string(text) + "'");
+  return {v[0], v[1]};
+}
+
+std::array<double, processing::kSimulatedAxes> parseAxisValues(std::string_view text, std::string_view what) {
+  const std::vector<double> v = finiteNumbers(text, what);
+  if (v.size() == 1) return {v[0], v[0], v[0]};
+  if (v.size() == 3) return {v[0], v[1], v[2]};
+  throw std::invalid_argument(std::string(what) + ": expected one value for all axes or three (x,y,z), got '" +
+                              std::string(text) + "'");
+}
+
 }  // namespace gyrod::recording

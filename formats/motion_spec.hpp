@@ -9,10 +9,12 @@
 // Text whose part before the first ':' is a lowercase word is read as profiles (so a typo
 // in a profile's name is reported as such, not as a missing file); anything else is a path
 // (write ./name for a file whose name starts with a word and a colon).
+#include <array>
 #include <string>
 #include <string_view>
 
 #include "processing/motion_profile.hpp"
+#include "processing/noise_simulator.hpp"
 
 namespace gyrod::recording {
 
@@ -29,5 +31,14 @@ processing::MotionProfile readMotionCsv(const std::string& path);
 
 // Either of the two above, chosen by isMotionProfileText().
 processing::MotionProfile motionFromSpec(const std::string& spec);
+
+// A warm-up as `gyroctl simulate --warm-up` and gyrod's `[mock] warm_up` write it: "DELTA_C,TAU_S"
+// (the die temperature rises by DELTA_C °C with time constant TAU_S s, e.g. "15,300"). Throws
+// std::invalid_argument naming the value ("warm-up: ...").
+processing::WarmUp parseWarmUpSpec(std::string_view text);
+
+// One value for all three axes, or three values x,y,z ("0.03" or "0.03,-0.02,0.015"): the
+// temperature coupling in °/s per °C. Throws std::invalid_argument naming `what` and the value.
+std::array<double, processing::kSimulatedAxes> parseAxisValues(std::string_view text, std::string_view what);
 
 }  // namespace gyrod::recording

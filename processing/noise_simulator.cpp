@@ -132,6 +132,20 @@ void validateSimulationModel(const SimulationModel& model) {
   requireNonNegative(temp.noise_std_c, "temperature.noise_std_c");
 }
 
+TemperatureModel withWarmUp(TemperatureModel temperature, const WarmUp& warm_up) {
+  requireFinite(warm_up.delta_c, "warm-up temperature rise delta_c");
+  requirePositive(warm_up.time_constant_s, "warm-up time constant");
+  temperature.final_c = temperature.start_c + warm_up.delta_c;
+  temperature.time_constant_s = warm_up.time_constant_s;
+  return temperature;
+}
+
+double temperatureCouplingDps(const AxisExtraEffects& extra, const TemperatureModel& temp, double t_s) {
+  if (extra.temperature_coefficient_dps_per_c == 0.0) return 0.0;
+  const double true_temp = temp.final_c + (temp.start_c - temp.final_c) * portable::exp(-t_s / temp.time_constant_s);
+  return extra.temperature_coefficient_dps_per_c * (true_temp - extra.temperature_reference_c);
+}
+
 std::vector<GaussMarkovComponent> flickerGaussMarkovBank(double flat_allan_variance, double tau0_s, double duration_s) {
   requireNonNegative(flat_allan_variance, "flicker Allan variance level");
   requirePositive(tau0_s, "tau0_s");
@@ -293,11 +307,7 @@ double NoiseSimulator::extraEffectAt(std::size_t a, std::uint64_t index) {
   ExtraState& s = extras_[a];
   const double t = static_cast<double>(index) / model_.rate_hz;
   double v = 0.0;
-  if (e.temperature_coefficient_dps_per_c != 0.0) {
-    const TemperatureModel& temp = model_.temperature;
-    const double true_temp = temp.final_c + (temp.start_c - temp.final_c) * portable::exp(-t / temp.time_constant_s);
-    v += e.temperature_coefficient_dps_per_c * (true_temp - e.temperature_reference_c);
-  }
+  if (e.temperature_coefficient_dps_per_c != 0.0) v += temperatureCouplingDps(e, model_.temperature, t);
   for (const SinusoidEffect& sin : e.sinusoids)
     v += sin.amp_dps * portableSinOfCycles(sin.freq_hz * t + sin.phase_rad / (2.0 * std::numbers::pi));
   if (e.gauss_markov_sigma_dps > 0.0) {

@@ -81,6 +81,21 @@ struct TemperatureModel {
   double noise_std_c = 0.0;
 };
 
+// A warm-up (docs/simulator.md "Warm-up"): the die temperature rises by delta_c from the
+// model's start_c with time constant time_constant_s; through each axis's temperature coupling
+// (AxisExtraEffects::temperature_coefficient_dps_per_c) the bias follows it.
+struct WarmUp {
+  double delta_c = 0.0;
+  double time_constant_s = 0.0;
+};
+// `temperature` warming up from its start_c: final_c = start_c + delta_c, the time constant
+// replaced (the noise kept). Throws std::invalid_argument naming the value (delta finite,
+// time constant finite and > 0).
+TemperatureModel withWarmUp(TemperatureModel temperature, const WarmUp& warm_up);
+// The temperature coupling k·(T(t) − T_ref) of one axis at t, on the noise-free curve (0 when
+// k is 0): what next() adds at the output rate, and what the mock adds to the analog rate.
+double temperatureCouplingDps(const AxisExtraEffects& extra, const TemperatureModel& temperature, double t_s);
+
 struct SimulationModel {
   std::array<AxisNoiseModel, kSimulatedAxes> axes;
   TemperatureModel temperature;

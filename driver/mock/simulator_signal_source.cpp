@@ -32,6 +32,13 @@ AnalogSample SimulatorSignalSource::nextTick(double /*t_s*/) {
   const processing::SimulatedSample s = simulator_->nextAnalog();
   AnalogSample a;
   a.rate_dps = s.rate_dps;
+  // The temperature coupling is one of the simulator's output-rate effects, which the mock does
+  // not take (its output rate is the driver's); a warm-up needs it, and it is slow, so it joins
+  // the analog rate here. Nothing is added (not even 0.0) to an axis without one.
+  const processing::SimulationModel& model = simulator_->model();
+  for (std::size_t axis = 0; axis < a.rate_dps.size(); ++axis)
+    if (model.axes[axis].extra.temperature_coefficient_dps_per_c != 0.0)
+      a.rate_dps[axis] += processing::temperatureCouplingDps(model.axes[axis].extra, model.temperature, s.t_s);
   a.temperature_c = s.temperature_c;
   return a;
 }

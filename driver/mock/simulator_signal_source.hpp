@@ -5,8 +5,11 @@
 // The mock applies the DLPF, decimation, saturation and quantisation itself, so they act on
 // the motion as on the chip.
 //
-// Not included: the two terms the simulator defines at the *output* rate — angle
-// quantization noise Q and the AR(p) component — because the mock's output rate is set by
+// The temperature coupling k·(T(t) − T_ref) of the model's [x.extra] (the bias following a
+// warm-up) is added to the analog rate, so it passes the DLPF like the rest of the bias.
+//
+// Not included: the terms the simulator defines at the *output* rate — angle
+// quantization noise Q, the AR(p) component and the other extra effects — because the mock's output rate is set by
 // the driver through SMPLRT_DIV at run time, not by the model. A model that relies on
 // them is simulated faithfully only by `gyroctl simulate`.
 #include <cstdint>

@@ -58,3 +58,26 @@ TEST(ConfigMockMotion, CsvSpecIsReadAndItsErrorsNameBothFiles) {
             std::string::npos);
   std::filesystem::remove_all(dir);
 }
+
+TEST(ConfigMockWarmUp, WarmUpAndCouplingAreReadAndChecked) {
+  const GyrodConfig c =
+      parseConfig("[mock]\nwarm_up = \"15,300\"\ntemperature_coefficient_dps_per_c = [0.03, -0.02, 0.015]\n", "x.toml");
+  EXPECT_EQ(c.mock.warm_up, "15,300");
+  EXPECT_EQ(c.mock.temperature_coefficient_dps_per_c, (std::vector<double>{0.03, -0.02, 0.015}));
+  EXPECT_EQ(parseConfig("[mock]\ntemperature_coefficient_dps_per_c = 0.01\n", "x.toml")
+                .mock.temperature_coefficient_dps_per_c,
+            (std::vector<double>{0.01, 0.01, 0.01}));
+  EXPECT_TRUE(GyrodConfig{}.mock.warm_up.empty());
+  EXPECT_TRUE(GyrodConfig{}.mock.temperature_coefficient_dps_per_c.empty());
+  EXPECT_EQ(errorOf("[mock]\nwarm_up = \"15\"\n"),
+            "x.toml:2: key 'mock.warm_up': warm-up: expected DELTA_C,TAU_S (e.g. 15,300), got '15' (got \"15\")");
+  EXPECT_EQ(
+      errorOf("[mock]\n\nwarm_up = \"15,-1\"\n"),
+      "x.toml:3: key 'mock.warm_up': warm-up: the time constant TAU_S must be > 0 s, got '15,-1' (got \"15,-1\")");
+  EXPECT_NE(errorOf("[mock]\ntemperature_coefficient_dps_per_c = [1, 2]\n")
+                .find("x.toml:2: key 'mock.temperature_coefficient_dps_per_c'"),
+            std::string::npos);
+  EXPECT_NE(errorOf("[mock]\nsource = \"replay\"\nreplay_file = \"r.csv\"\nwarm_up = \"15,300\"\n")
+                .find("applies to source = \"simulator\" only"),
+            std::string::npos);
+}

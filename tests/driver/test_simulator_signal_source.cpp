@@ -48,3 +48,31 @@ TEST(SimulatorSignalSource, ChipOutputCarriesTheModelsBiasAndArw) {
   // ~600 independent 1 s intervals: the relative standard error of σ is about 1/√(2·600/1.5).
   EXPECT_NEAR(measured, expected, 5 * expected / std::sqrt(800.0));
 }
+
+TEST(SimulatorSignalSource, AWarmUpMovesTheBiasThroughTheTemperatureCoupling) {
+  // No noise: the chip's output is the bias, the coupling k·(T(t) − 25 °C) and the quantisation.
+  SimulationModel model;
+  model.axes[0].bias_dps = 1.0;
+  model.axes[0].extra.temperature_coefficient_dps_per_c = 0.03;
+  model.temperature = gyrod::processing::withWarmUp(model.temperature, {15.0, 60.0});  // 25 → 40 °C
+  SimulatorSignalSource source(model, 4, 42, 3600.0);
+  Rig rig(source);
+  std::vector<double> x, y, temperature;
+  rig.mock.setSampleObserver([&](const SampleRecord& s) {
+    x.push_back(s.gyro[0] / 131.0);
+    y.push_back(s.gyro[1] / 131.0);
+    temperature.push_back(s.temperature / 340.0 + 36.53);
+  });
+  rig.wake(4, 19);
+  rig.advance(300 * kNsPerSecond);
+  ASSERT_GT(x.size(), 14000u);
+  for (std::size_t i = 0; i < x.size(); i += 10) {
+    // The bias follows the temperature the chip reports: half an LSB of each quantisation, and
+    // the DLPF's 10 ms lag on a rise of at most 0.0075 °/s per s.
+    ASSERT_NEAR(x[i], 1.0 + 0.03 * (temperature[i] - 25.0), 0.5 / 131.0 + 0.03 * 0.5 / 340.0 + 1e-4) << "sample " << i;
+    ASSERT_EQ(y[i], 0.0);  // an axis without a coupling stays at its bias
+  }
+  EXPECT_NEAR(temperature.front(), 25.0, 0.5);
+  EXPECT_NEAR(temperature.back(), 25.0 + 15.0 * (1.0 - std::exp(-5.0)), 0.05);
+  EXPECT_NEAR(x.back(), 1.0 + 0.03 * 15.0 * (1.0 - std::exp(-5.0)), 1.0 / 131.0);
+}

@@ -151,3 +151,48 @@ TEST(GyrodMotion, BadMotionSpecExitsWithExConfigNamingFileLineAndKey) {
   EXPECT_NE(log.find("mock.motion"), std::string::npos) << log;
   EXPECT_NE(log.find("unknown key 'ampl'"), std::string::npos) << log;
 }
+
+// [mock] warm_up and temperature_coefficient_dps_per_c: the die warms up (+20 °C, τ = 4 s of
+// sensor time, so that 12 s show it) and x's bias follows at 0.1 °/s per °C, the others stay.
+TEST(GyrodMotion, MockWarmUpMovesTheBiasWithTheTemperature) {
+  ScratchDir d;
+  std::ostringstream c;
+  c << "[device]\nbackend = \"mock\"\nrate_hz = 50\n"
+    << "[bias]\nsource = \"config\"\nvalues = [-3.34, 1.09, -0.5]\n"
+    << "[filter.kalman]\na = 0.9\nq = 0.0001\nr = 0.01\n"
+    << "[socket]\npath = \"" << (d.path() / "gyrod.sock").string() << "\"\n"
+    << "[mock]\nspeed = 50\nseed = 6\nwarm_up = \"20,4\"\ntemperature_coefficient_dps_per_c = [0.1, 0.0, 0.0]\n";
+  const auto cfg = d.write("gyrod.toml", c.str());
+  GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt");
+  LineClient watcher((d.path() / "gyrod.sock").string());
+  ASSERT_TRUE(watcher.connected()) << readWholeFile(d.path() / "log.txt");
+  ASSERT_TRUE(watcher.readLine());  // VERSION
+  ASSERT_TRUE(watcher.send("{\"cmd\":\"watch\"}\n"));
+  std::vector<json> rates;
+  while (rates.size() < 600) {  // 12 s of sensor time
+    const auto line = watcher.readLine(20s);
+    ASSERT_TRUE(line.has_value()) << readWholeFile(d.path() / "log.txt");
+    json j = json::parse(*line);
+    if (j["class"] == "RATE") rates.push_back(std::move(j));
+  }
+  gyrod.signal(SIGTERM);
+  ASSERT_EQ(gyrod.waitExit(2000ms), std::optional<int>(0)) << readWholeFile(d.path() / "log.txt");
+  std::array<std::vector<double>, 3> early, late;
+  std::vector<double> early_temp, late_temp;
+  // The first second watched and the last three (the watch starts a little after gyrod).
+  for (std::size_t i = 0; i < rates.size(); ++i) {
+    const bool is_early = i < 50, is_late = i >= rates.size() - 150;
+    if (!is_early && !is_late) continue;
+    (is_early ? early_temp : late_temp).push_back(rates[i]["temp"].get<double>());
+    for (int a = 0; a < 3; ++a) (is_early ? early : late)[a].push_back(rates[i]["raw"][a].get<double>());
+  }
+  const double warmed = momentsOf(late_temp).mean - momentsOf(early_temp).mean;
+  EXPECT_GT(warmed, 5.0);  // 28 °C + 20·(1 − e^{−t/4 s}) rises by 8–14 °C between the two windows
+  for (int a = 0; a < 3; ++a) {
+    const Moments e = momentsOf(early[a]), l = momentsOf(late[a]);
+    ASSERT_GE(e.n, 20u);
+    const double tolerance =
+        5.0 * e.std * std::sqrt(1.0 / static_cast<double>(e.n) + 1.0 / static_cast<double>(l.n)) + 1.0 / 131.0;
+    EXPECT_NEAR(l.mean - e.mean, a == 0 ? 0.1 * warmed : 0.0, tolerance) << "axis " << a;
+  }
+}

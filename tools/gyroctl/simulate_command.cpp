@@ -30,7 +30,9 @@ struct SimulateOptions {
   std::optional<double> rate_hz;
   std::uint64_t seed = 1;
   std::optional<int> dlpf, fs_sel;
-  std::string motion;  // empty: at rest, and no truth columns (the output stays as it always was)
+  std::string warm_up;                  // DELTA_C,TAU_S; empty: the model's temperature curve
+  std::string temperature_coefficient;  // K or KX,KY,KZ [°/s per °C]; empty: the model's coupling
+  std::string motion;                   // empty: at rest, and no truth columns (the output stays as it always was)
   std::string output;
 };
 
@@ -93,6 +95,11 @@ int runSimulate(const SimulateOptions& opt) {
   if (opt.rate_hz) model.rate_hz = *opt.rate_hz;
   if (opt.dlpf) model.dlpf_cfg = *opt.dlpf;
   if (opt.fs_sel) model.fs_sel = *opt.fs_sel;
+  if (!opt.warm_up.empty()) model.temperature = withWarmUp(model.temperature, recording::parseWarmUpSpec(opt.warm_up));
+  if (!opt.temperature_coefficient.empty()) {
+    const auto k = recording::parseAxisValues(opt.temperature_coefficient, "--temperature-coefficient");
+    for (std::size_t a = 0; a < kSimulatedAxes; ++a) model.axes[a].extra.temperature_coefficient_dps_per_c = k[a];
+  }
 
   requireDurationWithinBound(opt.duration_s);
   // Both validate: std::invalid_argument (bad model or profile text) and RecordingError (bad
@@ -149,6 +156,11 @@ void addSimulateCommand(CLI::App& app, CommandRunner& run) {
   sub->add_option("--seed", opt->seed, "random seed (same seed, same file on every machine)")->default_val(1);
   sub->add_option("--dlpf", opt->dlpf, "DLPF_CFG 0..6 (default: the model file's, else no DLPF)");
   sub->add_option("--fs-sel", opt->fs_sel, "FS_SEL 0..3: quantise and saturate (default: the model file's, else not)");
+  sub->add_option("--warm-up", opt->warm_up,
+                  "DELTA_C,TAU_S: the die temperature rises by DELTA_C from the model's start with time constant "
+                  "TAU_S; the bias follows through the temperature coupling (docs/simulator.md)");
+  sub->add_option("--temperature-coefficient", opt->temperature_coefficient,
+                  "K or KX,KY,KZ [deg/s per C]: the bias's temperature coupling (reference: the model's, 25 C)");
   sub->add_option("--motion", opt->motion,
                   "true rotation: profiles such as step:axis=z,at=5,rate=10 (summed with +), or a CSV t,wx,wy,wz; "
                   "adds the truth columns wx,wy,wz (docs/simulator.md)");
