@@ -8,10 +8,11 @@
 # A key or option added to the program and not to its man page (or the reverse) fails here.
 # The man pages' convention (see their headers): a documented option or key is a .TP item
 # whose first line is .B/.BI/.BR naming it; gyroctl's commands and gyrod.toml's tables are .SS.
-# Usage: check-man-pages.sh MAN_DIR GYROD GYROCTL
+# The bash completions (completion/) must offer the same commands and options.
+# Usage: check-man-pages.sh SOURCE_DIR GYROD GYROCTL
 # GYROD_TEST_EMULATOR (e.g. "qemu-aarch64-static -L SYSROOT") runs a cross build's binaries.
 set -euo pipefail
-man_dir=$1
+man_dir=$1/man completion_dir=$1/completion
 read -r -a emulator <<<"${GYROD_TEST_EMULATOR:-}"
 gyrod_bin=$2 gyroctl_bin=$3
 run_gyrod() { "${emulator[@]}" "$gyrod_bin" "$@"; }
@@ -47,11 +48,11 @@ compare() {  # compare LABEL PROGRAM_LIST MAN_LIST
   local missing extra
   missing=$(comm -23 "$2" "$3") extra=$(comm -13 "$2" "$3")
   if [ -n "$missing" ]; then
-    echo "FAIL: $1: in the program but not in the man page:"; sed "s/^/  /" <<<"$missing"
+    echo "FAIL: $1: in the program, not in the file:"; echo "  ${missing//$'\n'/$'\n'  }"
     failures=$((failures + 1))
   fi
   if [ -n "$extra" ]; then
-    echo "FAIL: $1: in the man page but not in the program:"; sed "s/^/  /" <<<"$extra"
+    echo "FAIL: $1: in the file, not in the program:"; echo "  ${extra//$'\n'/$'\n'  }"
     failures=$((failures + 1))
   fi
   if [ -z "$missing$extra" ]; then echo "ok: $1 ($(wc -l <"$2") names)"; fi
@@ -77,6 +78,19 @@ done <"$work/commands.prog"
 sort -u -o "$work/gyroctl.prog" "$work/gyroctl.prog"
 awk -F'\t' '{ print $1 " --" $2 }' "$work/gyroctl.items" | sort -u >"$work/gyroctl.man"
 compare "gyroctl(1) options" "$work/gyroctl.prog" "$work/gyroctl.man"
+
+# The completions: gyrod's option list, gyroctl's commands and each command's options.
+sed -nE 's/^ *local options="([^"]*)".*/\1/p' "$completion_dir/gyrod" | tr ' ' '\n' | sed -n 's/^--//p' |
+  grep -vx help | sort -u >"$work/gyrod.completion"
+compare "completion/gyrod options" "$work/gyrod.prog" "$work/gyrod.completion"
+# shellcheck disable=SC1091
+(source "$completion_dir/gyroctl" && sed -nE 's/^ *local commands="([^"]*)".*/\1/p' "$completion_dir/gyroctl" |
+  tr ' ' '\n' | sort -u >"$work/commands.completion" &&
+  while read -r command; do
+    _gyroctl_options "$command" | tr ' ' '\n' | sed "s/^/$command /"
+  done <"$work/commands.completion" | sort -u >"$work/gyroctl.completion")
+compare "completion/gyroctl commands" "$work/commands.prog" "$work/commands.completion"
+compare "completion/gyroctl options" "$work/gyroctl.prog" "$work/gyroctl.completion"
 
 # gyrod.toml(5): ask gyrod for the valid names of each table, recursing into every key that
 # is itself a table (an array of tables answers the same way).
