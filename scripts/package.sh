@@ -129,6 +129,8 @@ sed -e "s|@VERSION@|$version|" -e "s|@ARCH@|$arch|" -e "s|@MAINTAINER@|$maintain
   -e "s|@INSTALLED_SIZE@|$installed_size|" -e "s|@SHLIBS_DEPENDS@|$shlibs|" \
   packaging/debian/control.in >"$root/DEBIAN/control"
 cp packaging/debian/conffiles "$root/DEBIAN/conffiles"
+mkdir -p "$root/usr/share/lintian/overrides"
+cp packaging/debian/lintian-overrides "$root/usr/share/lintian/overrides/gyrod"
 install -m 0755 packaging/debian/postinst packaging/debian/prerm packaging/debian/postrm "$root/DEBIAN/"
 while read -r conffile; do
   [ -f "$root$conffile" ] || die "conffile $conffile is not in the package (cmake --install did not install it)"

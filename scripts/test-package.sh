@@ -18,18 +18,31 @@ fail() {
   echo "test-package: FAIL: $*" >&2
   exit 1
 }
-ok() { echo "test-package: ok: $*"; }
+ok() { echo "test-package: ok: $* [$(($(date +%s) - started)) s]"; }
+# apt-get, waiting for another apt or dpkg run to finish (plain dpkg would fail on the lock).
+apt_get() { apt-get -y -qq -o DPkg::Lock::Timeout=600 "$@" >/dev/null 2>"$work_dir/apt.log" || {
+  cat "$work_dir/apt.log" >&2
+  return 1
+}; }
+work_dir=$(mktemp -d)
+chmod 0755 "$work_dir" # user gyrod reaches its socket folder inside
+trap 'rm -rf "$work_dir"' EXIT
 
 if dpkg-query -W -f='${Status}' gyrod 2>/dev/null | grep -qv 'not-installed'; then
   echo "test-package: purging the gyrod package installed before"
-  dpkg --purge gyrod >/dev/null
+  apt_get purge gyrod
 fi
 
 deb=$(scripts/package.sh amd64 | tail -1)
 version=$(dpkg-deb -f "$deb" Version)
 ok "built $deb ($(($(date +%s) - started)) s)"
+# lintian when installed (not a build dependency): errors and warnings fail.
+if command -v lintian >/dev/null 2>&1; then
+  lintian --fail-on error,warning "$deb" || fail "lintian $deb"
+  ok "lintian: no error or warning"
+fi
 
-apt-get install -y -qq "./$deb" >/dev/null 2>&1 || apt-get install -y "./$deb" || fail "apt-get install ./$deb"
+apt_get install "./$deb" || fail "apt-get install ./$deb"
 [ "$(dpkg-query -W -f='${Status}' gyrod)" = "install ok installed" ] || fail "gyrod is not 'install ok installed'"
 ok "installed gyrod $version"
 
@@ -88,11 +101,12 @@ ok "bash completions load"
 
 # gyrod from its installed path, as user gyrod, on the mock (ten times real time, so that the
 # start-up bias estimate of /etc/gyrod/gyrod.toml takes 1 s), and gyroctl reading one RATE line.
-run=$(mktemp -d)
+run=$work_dir/run
+mkdir "$run"
 chown gyrod:gyrod "$run"
 setpriv --reuid=gyrod --regid=gyrod --init-groups /usr/sbin/gyrod --backend mock --mock-speed 10 --socket "$run/gyrod.sock" 2>"$run/gyrod.log" &
 gyrod_pid=$!
-trap 'kill "$gyrod_pid" 2>/dev/null || true; rm -rf "$run"' EXIT
+trap 'kill "$gyrod_pid" 2>/dev/null || true; rm -rf "$work_dir"' EXIT
 for _ in $(seq 100); do
   [ -S "$run/gyrod.sock" ] && break
   kill -0 "$gyrod_pid" 2>/dev/null || fail "gyrod exited: $(cat "$run/gyrod.log")"
@@ -103,21 +117,21 @@ line=$(timeout 30 /usr/bin/gyroctl watch --socket "$run/gyrod.sock" --json --cou
 [ -n "$line" ] || fail "no RATE line"
 kill -TERM "$gyrod_pid"
 wait "$gyrod_pid" || fail "gyrod did not exit 0 on SIGTERM: $(cat "$run/gyrod.log")"
-trap 'rm -rf "$run"' EXIT
+trap 'rm -rf "$work_dir"' EXIT
 ok "gyrod (as user gyrod) on the mock, gyroctl watch: ${line:0:100}..."
 
 # Reinstall (postinst's upgrade path): a changed conffile is kept.
 echo "# changed by test-package.sh" >>/etc/gyrod/gyrod.toml
-dpkg -i "$deb" >/dev/null || fail "reinstalling $deb"
+apt_get install --reinstall "./$deb" || fail "reinstalling $deb"
 grep -q '^# changed by test-package.sh$' /etc/gyrod/gyrod.toml || fail "reinstalling replaced the changed conffile"
 ok "reinstall keeps the changed conffile"
 
 # Remove: the conffile stays. Then purge: nothing the package installed or made stays.
 mkdir -p /var/lib/gyrod && touch /var/lib/gyrod/recording.csv /etc/gyrod/sensor.toml
 dpkg -L gyrod | while read -r path; do [ -d "$path" ] || echo "$path"; done >"$run/files"
-dpkg --remove gyrod >/dev/null || fail "dpkg --remove gyrod"
+apt_get remove gyrod || fail "apt-get remove gyrod"
 [ -f /etc/gyrod/gyrod.toml ] || fail "remove deleted the conffile"
-dpkg --purge gyrod >/dev/null || fail "dpkg --purge gyrod"
+apt_get purge gyrod || fail "apt-get purge gyrod"
 dpkg-query -W -f='${Status}' gyrod 2>/dev/null | grep -qv 'not-installed' && fail "gyrod still known to dpkg after purge"
 left=$(while read -r path; do [ ! -e "$path" ] || echo "$path"; done <"$run/files")
 [ -z "$left" ] || fail "left after purge: $left"

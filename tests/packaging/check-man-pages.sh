@@ -96,7 +96,8 @@ compare "completion/gyroctl options" "$work/gyroctl.prog" "$work/gyroctl.complet
 # is itself a table (an array of tables answers the same way).
 valid_names() {  # valid_names TOML_TEXT -> the comma list of "valid sections|keys: ...", or nothing
   printf '%b' "$1" >"$work/probe.toml"
-  run_gyrod --config "$work/probe.toml" --backend mock 2>&1 >/dev/null |
+  # timeout and a private socket: should a probe ever be valid, gyrod would start serving.
+  timeout 10 "${emulator[@]}" "$gyrod_bin" --config "$work/probe.toml" --backend mock --socket "$work/probe.sock" 2>&1 >/dev/null |
     sed -nE 's/.*\(valid (sections|keys): ([^)]*)\).*/\2/p' | tr ',' '\n' | tr -d ' ' || true
 }
 : >"$work/toml.prog"
