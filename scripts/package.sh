@@ -13,6 +13,7 @@
 # `scripts/cross-test.sh ARCH`, and this script stops when they are absent. The tree is
 # reconfigured with the Debian install paths (prefix /usr, /etc, units in /lib/systemd/system as
 # on bookworm), which changes no compiled file, and only gyrod and gyroctl are (re)built.
+# The same tree and SOURCE_DATE_EPOCH give the same .deb, byte for byte.
 # Needs: cmake, dpkg-dev (dpkg-shlibdeps for amd64), binutils (readelf), gzip.
 # Environment: GYROD_DEB_MAINTAINER ("Name <address>"), SOURCE_DATE_EPOCH (file times and the
 # changelog's date; default: the last commit's time), GYROD_DEB_CROSS_DEPENDS=1 (work out Depends
