@@ -10,13 +10,13 @@
 # whose first line is .B/.BI/.BR naming it; gyroctl's commands and gyrod.toml's tables are .SS.
 # The bash completions (completion/) must offer the same commands and options.
 # Usage: check-man-pages.sh SOURCE_DIR GYROD GYROCTL
-# GYROD_TEST_EMULATOR (e.g. "qemu-aarch64-static -L SYSROOT") runs a cross build's binaries.
+# GYROD_TEST_LAUNCHER (e.g. "qemu-aarch64-static -L SYSROOT") runs a cross build's binaries.
 set -euo pipefail
 man_dir=$1/man completion_dir=$1/completion
-read -r -a emulator <<<"${GYROD_TEST_EMULATOR:-}"
+read -r -a launcher <<<"${GYROD_TEST_LAUNCHER:-}"
 gyrod_bin=$2 gyroctl_bin=$3
-run_gyrod() { "${emulator[@]}" "$gyrod_bin" "$@"; }
-run_gyroctl() { "${emulator[@]}" "$gyroctl_bin" "$@"; }
+run_gyrod() { "${launcher[@]}" "$gyrod_bin" "$@"; }
+run_gyroctl() { "${launcher[@]}" "$gyroctl_bin" "$@"; }
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 failures=0
@@ -97,7 +97,7 @@ compare "completion/gyroctl options" "$work/gyroctl.prog" "$work/gyroctl.complet
 valid_names() {  # valid_names TOML_TEXT -> the comma list of "valid sections|keys: ...", or nothing
   printf '%b' "$1" >"$work/probe.toml"
   # timeout and a private socket: should a probe ever be valid, gyrod would start serving.
-  timeout 10 "${emulator[@]}" "$gyrod_bin" --config "$work/probe.toml" --backend mock --socket "$work/probe.sock" 2>&1 >/dev/null |
+  timeout 10 "${launcher[@]}" "$gyrod_bin" --config "$work/probe.toml" --backend mock --socket "$work/probe.sock" 2>&1 >/dev/null |
     sed -nE 's/.*\(valid (sections|keys): ([^)]*)\).*/\2/p' | tr ',' '\n' | tr -d ' ' || true
 }
 : >"$work/toml.prog"
