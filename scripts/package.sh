@@ -14,7 +14,7 @@
 # reconfigured with the Debian install paths (prefix /usr, /etc, units in /lib/systemd/system as
 # on bookworm), which changes no compiled file, and only gyrod and gyroctl are (re)built.
 # The same tree and SOURCE_DATE_EPOCH give the same .deb, byte for byte.
-# Needs: cmake, dpkg-dev (dpkg-shlibdeps for amd64), binutils (readelf), gzip.
+# Needs: cmake, binutils (readelf, objcopy), gzip; dpkg-dev when present (dpkg-shlibdeps).
 # Environment: GYROD_DEB_MAINTAINER ("Name <address>"), SOURCE_DATE_EPOCH (file times and the
 # changelog's date; default: the last commit's time), GYROD_DEB_CROSS_DEPENDS=1 (work out Depends
 # as for a cross build, to compare it with dpkg-shlibdeps's).
@@ -106,7 +106,7 @@ find "$root/usr/share/man" -type f -name '*.[0-9]' -exec gzip -9n {} +
 # library packages, with the same shlibs, on every architecture).
 cross_depends() {  # cross_depends SONAME -> the dependency the host's shlibs file gives for it
   local soname=$1 multiarch owner name soversion dependency
-  multiarch=$(dpkg-architecture -qDEB_HOST_MULTIARCH)
+  multiarch=$(gcc -print-multiarch 2>/dev/null || echo x86_64-linux-gnu)
   owner=$(dpkg -S "/lib/$multiarch/$soname" "/usr/lib/$multiarch/$soname" 2>/dev/null | head -1 | cut -d: -f1) || true
   [ -n "$owner" ] || die "no package on this machine provides $soname: install its $(dpkg --print-architecture) package"
   name=${soname%%.so.*} soversion=${soname#*.so.}
@@ -115,7 +115,9 @@ cross_depends() {  # cross_depends SONAME -> the dependency the host's shlibs fi
   echo "${dependency:-$owner (>= $(dpkg-query -W -f='${Version}' "$owner" | sed -E 's/^[0-9]+://; s/-[^-]*$//'))}"
 }
 binaries=("$root/usr/sbin/gyrod" "$root/usr/bin/gyroctl")
-if [ "$arch" = "$(dpkg --print-architecture)" ] && [ -z "${GYROD_DEB_CROSS_DEPENDS:-}" ]; then
+# dpkg-shlibdeps is in dpkg-dev, which a machine set up by scripts/install-deps.sh may lack.
+if [ "$arch" = "$(dpkg --print-architecture)" ] && [ -z "${GYROD_DEB_CROSS_DEPENDS:-}" ] &&
+  command -v dpkg-shlibdeps >/dev/null 2>&1; then
   mkdir -p "$work/debian"
   echo "Source: gyrod" >"$work/debian/control"
   shlibs=$(cd "$work" && dpkg-shlibdeps -O "${binaries[@]/#$work\//-e}" 2>/dev/null | sed -n 's/^shlibs:Depends=//p')
