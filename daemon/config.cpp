@@ -12,6 +12,7 @@
 #include <grp.h>
 #include <unistd.h>
 
+#include "daemon/memory_budget.hpp"
 #include "driver/mpu6050_config.hpp"
 #include "formats/model_toml.hpp"
 #include "formats/motion_spec.hpp"
@@ -25,7 +26,7 @@ using Section = formats::TomlSection;
 using formats::shortest;
 
 const std::vector<std::string_view> kSections = {"device", "gpio",   "bias", "filter", "allan",
-                                                 "socket", "record", "log",  "mock"};
+                                                 "socket", "record", "log",  "mock",   "limits"};
 const std::vector<std::string_view> kBiasSourceNames = {"estimate", "model", "config"};
 const std::vector<std::string_view> kMockSourceNames = {"simulator", "replay"};
 
@@ -234,6 +235,42 @@ void readRecord(const Section& s, RecordConfig& r) {
   }
 }
 
+void readLimits(const Section& s, LimitsConfig& l) {
+  if (auto v = s.number("memory_mb")) {
+    if (!(*v >= 16.0 && *v <= 1e9)) s.failValue("memory_mb", "must be 16..1e9 MB (10^6 bytes)");
+    l.memory_mb = *v;
+  }
+}
+
+// The memory the configuration needs against limits.memory_mb and, with the reference
+// checks, against what the kernel would grant; named at the line of the key that sizes most
+// of it (its value echoed), else of the key it is multiplied by, else of memory_mb.
+void checkMemory(const formats::TomlDocument& doc, const GyrodConfig& config, ReferenceChecks checks) {
+  const MemoryNeed need = memoryNeeded(config);
+  auto problem = memoryBudgetProblem(need, config.limits.memory_mb * 1e6,
+                                     "limits.memory_mb = " + formats::shortest(config.limits.memory_mb) + " MB");
+  if (!problem && checks == ReferenceChecks::On)
+    if (const auto kernel = kernelMemoryLimit()) problem = memoryBudgetProblem(need, kernel->bytes, kernel->name);
+  if (!problem) return;
+  const auto* node = doc.root().at_path(problem->key).node();
+  std::string where = doc.file() + ": ", suffix;
+  if (node) {
+    where = doc.location(node->source());
+    suffix = " (got " + formats::tomlRendered(*node) + ")";
+  } else {
+    for (const char* other : {"device.rate_hz", "limits.memory_mb"}) {
+      if (const auto* n = doc.root().at_path(other).node()) {
+        where = doc.location(n->source());
+        break;
+      }
+    }
+    const auto item =
+        std::find_if(need.items.begin(), need.items.end(), [&](const MemoryItem& i) { return i.key == problem->key; });
+    suffix = " (" + item->value + ", the default)";
+  }
+  throw ConfigError(where + "key '" + problem->key + "': " + problem->message + suffix);
+}
+
 void readLog(const Section& s, LogConfig& l) {
   if (auto v = s.choice("level", kLogLevelNames)) l.level = kLogLevels[*v];
 }
@@ -429,7 +466,9 @@ GyrodConfig readConfig(const formats::TomlDocument& doc, ReferenceChecks checks)
   readLog(section("log", {"level"}), config.log);
   const auto mock = section("mock", {"source", "replay_file", "seed", "speed", "motion", "faults"});
   readMock(mock, config.mock);
+  readLimits(section("limits", {"memory_mb"}), config.limits);
   if (checks == ReferenceChecks::On) checkReferences(filter, socket, mock, config);
+  checkMemory(doc, config, checks);
   return config;
 }
 

@@ -141,6 +141,7 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
   if (!config_.socket.group.empty()) socket_options.group = config_.socket.group;
   ServerOptions server_options;
   server_options.client_buffer_bytes = config_.socket.client_buffer_kib * 1024;
+  server_options.max_clients = kMaxSocketClients;  // as the memory budget counts them
   server_ = std::make_unique<UnixSocketServer>(loop_, openListeningSocket(socket_options), *this, server_options);
 
   if (config_.record.enabled()) {
