@@ -95,7 +95,9 @@ Recorder::Recorder(RecorderOptions options) : options_(std::move(options)), ring
     throw std::invalid_argument("Recorder: header comments too long (" + std::to_string(header_bytes) +
                                 " bytes, at most " + std::to_string(kMaxHeaderBytes) + ")");
 
-  const fs::path p(options_.path);
+  std::error_code ec;
+  const fs::path p =
+      fs::is_directory(options_.path, ec) ? fs::path(options_.path) / kDefaultRecordingName : fs::path(options_.path);
   directory_ = p.has_parent_path() ? p.parent_path().string() : ".";
   stem_ = p.stem().string();
   extension_ = p.extension().string();

@@ -51,9 +51,13 @@ class RecorderError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The base name used inside a folder given as the recording path.
+inline constexpr const char* kDefaultRecordingName = "gyro.csv";
+
 struct RecorderOptions {
   // Base name dir/stem.ext. Files are dir/stem-YYYYmmddTHHMMSSZ-NNNNNN.ext (UTC time of
   // opening, then an index that makes the name unique), so name order is creation order.
+  // An existing folder records into it: folder/gyro-YYYYmmddTHHMMSSZ-NNNNNN.csv.
   std::string path;
   std::size_t ring_capacity = 4096;  // records; rounded up to a power of two
   std::uint64_t rotate_bytes = 0;    // new file before one would exceed this size; 0 = never
