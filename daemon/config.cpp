@@ -16,6 +16,7 @@
 #include "driver/mpu6050_config.hpp"
 #include "formats/model_toml.hpp"
 #include "formats/motion_spec.hpp"
+#include "formats/quoted_value.hpp"
 #include "formats/recording_csv.hpp"
 #include "formats/toml_document.hpp"
 
@@ -29,6 +30,12 @@ const std::vector<std::string_view> kSections = {"device", "gpio",   "bias", "fi
                                                  "socket", "record", "log",  "mock",   "limits"};
 const std::vector<std::string_view> kBiasSourceNames = {"estimate", "model", "config"};
 const std::vector<std::string_view> kMockSourceNames = {"simulator", "replay"};
+
+// A name from the file as a message shows it: a long or hostile one bounded and escaped.
+std::string shownName(std::string_view name) {
+  const std::string quoted = formats::quotedValue(name);
+  return quoted == "'" + std::string(name) + "'" ? std::string(name) : quoted;
+}
 
 bool isAllDigits(std::string_view s) {
   return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
@@ -432,14 +439,14 @@ GyrodConfig readConfig(const formats::TomlDocument& doc, ReferenceChecks checks)
     const auto where = doc.location(key.source());
     if (std::find(kSections.begin(), kSections.end(), name) == kSections.end()) {
       if (node.is_table())
-        throw ConfigError(where + "unknown section [" + std::string(name) + "] (valid sections: " +
+        throw ConfigError(where + "unknown section [" + shownName(name) + "] (valid sections: " +
                           formats::joinedNames(kSections) + ")" + formats::didYouMean(name, kSections));
-      throw ConfigError(where + "unknown key '" + std::string(name) +
-                        "' at top level (keys belong in a section: " + formats::joinedNames(kSections) + ")");
+      throw ConfigError(where + "unknown key " + formats::quotedValue(name) +
+                        " at top level (keys belong in a section: " + formats::joinedNames(kSections) + ")");
     }
     if (!node.is_table())
-      throw ConfigError(where + "key '" + std::string(name) + "': must be a section [" + std::string(name) + "] (got " +
-                        formats::tomlTypeAndValue(node) + ")");
+      throw ConfigError(where + "key " + formats::quotedValue(name) + ": must be a section [" + shownName(name) +
+                        "] (got " + formats::tomlTypeAndValue(node) + ")");
   }
   const toml::table empty;
   const auto section = [&](std::string_view name, std::vector<std::string_view> keys) {

@@ -88,3 +88,24 @@ TEST(ConfigLimits, TheRecorderRingFollowsTheMockSpeed) {
   c.device.backend = DeviceBackend::I2c;
   EXPECT_EQ(recordedSamplesPerSecond(c), 50.0);
 }
+
+// Values and names from the file are echoed bounded (80 characters) and escaped, so that a
+// hostile file cannot flood the terminal or act on it (formats/quoted_value.hpp).
+TEST(ConfigEcho, BadValuesAndNamesAreQuotedBoundedAndEscaped) {
+  const std::string long_value(100000, 'x');
+  const std::string e = errorOf("[log]\nlevel = \"" + long_value + "\"\n");
+  EXPECT_TRUE(contains(e, "x.toml:2: key 'log.level': must be one of")) << e;
+  EXPECT_TRUE(contains(e, "(got '" + std::string(80, 'x') + "…' (100000 bytes))")) << e;
+  EXPECT_LT(e.size(), 300u);
+  const std::string esc = errorOf("[log]\nlevel = \"\\u001b[2J\\u202Eevil\"\n");
+  EXPECT_TRUE(contains(esc, "(got '\\x1B[2J\\u{202E}evil')")) << esc;
+  EXPECT_EQ(esc.find('\x1b'), std::string::npos);
+  const std::string key = errorOf("[device]\n\"a\\u001bb\" = 1\n");
+  EXPECT_TRUE(contains(key, "unknown key 'a\\x1Bb' in [device]")) << key;
+  const std::string section = errorOf("[\"s\\u202E\"]\nx = 1\n");
+  EXPECT_TRUE(contains(section, "unknown section ['s\\u{202E}']")) << section;
+  const std::string top = errorOf("\"k\\u0007\" = 1\n");
+  EXPECT_TRUE(contains(top, "unknown key 'k\\x07' at top level")) << top;
+  // An ordinary value reads as before.
+  EXPECT_TRUE(contains(errorOf("[log]\nlevel = \"verbose\"\n"), "(got \"verbose\")"));
+}
