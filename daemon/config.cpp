@@ -255,9 +255,11 @@ void readLimits(const Section& s, LimitsConfig& l) {
 void checkMemory(const formats::TomlDocument& doc, const GyrodConfig& config, ReferenceChecks checks) {
   const MemoryNeed need = memoryNeeded(config);
   auto problem = memoryBudgetProblem(need, config.limits.memory_mb * 1e6,
-                                     "limits.memory_mb = " + formats::shortest(config.limits.memory_mb) + " MB");
+                                     "limits.memory_mb = " + formats::shortest(config.limits.memory_mb) + " MB",
+                                     "limits.memory_mb");
   if (!problem && checks == ReferenceChecks::On)
-    if (const auto kernel = kernelMemoryLimit()) problem = memoryBudgetProblem(need, kernel->bytes, kernel->name);
+    if (const auto kernel = kernelMemoryLimit())
+      problem = memoryBudgetProblem(need, kernel->bytes, kernel->name, kernel->raise);
   if (!problem) return;
   const auto* node = doc.root().at_path(problem->key).node();
   std::string where = doc.file() + ": ", suffix;

@@ -64,7 +64,7 @@ double ramAndSwapBytes() {
 }  // namespace
 
 std::optional<MemoryBudgetProblem> memoryBudgetProblem(const MemoryNeed& need, double budget_bytes,
-                                                       const std::string& budget_name) {
+                                                       const std::string& budget_name, const std::string& raise) {
   if (!(need.total_bytes > budget_bytes)) return std::nullopt;
   std::map<std::string, double> by_key;
   for (const auto& item : need.items) by_key[item.key] += item.bytes;
@@ -78,7 +78,7 @@ std::optional<MemoryBudgetProblem> memoryBudgetProblem(const MemoryNeed& need, d
     m << (first ? "" : "; ") << item.what << " = " << megabytes(item.bytes);
     first = false;
   }
-  m << "); lower " << top->first << " or raise limits.memory_mb";
+  m << "); lower " << top->first << " or raise " << raise;
   return MemoryBudgetProblem{top->first, m.str()};
 }
 
@@ -89,10 +89,11 @@ std::optional<KernelMemoryLimit> kernelMemoryLimit() {
     const double in_use = mappedBytesNow();
     limit = KernelMemoryLimit{static_cast<double>(as.rlim_cur) - in_use - kThreadStacksBytes,
                               "what RLIMIT_AS leaves (" + megabytes(static_cast<double>(as.rlim_cur)) + ", " +
-                                  megabytes(in_use) + " mapped at start)"};
+                                  megabytes(in_use) + " mapped at start)",
+                              "RLIMIT_AS (ulimit -v, systemd LimitAS=)"};
   }
   if (const double ram = ramAndSwapBytes(); ram > 0.0 && (!limit || ram < limit->bytes))
-    limit = KernelMemoryLimit{ram, "this machine's RAM and swap (" + megabytes(ram) + ")"};
+    limit = KernelMemoryLimit{ram, "this machine's RAM and swap (" + megabytes(ram) + ")", "the swap space"};
   return limit;
 }
 

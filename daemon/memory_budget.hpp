@@ -39,9 +39,10 @@ struct MemoryBudgetProblem {
   std::string key;
   std::string message;
 };
-// `budget_name` says where the budget comes from ("limits.memory_mb = 1024 MB").
+// `budget_name` says where the budget comes from ("limits.memory_mb = 1024 MB"), `raise`
+// what may be raised instead of lowering the key ("limits.memory_mb").
 std::optional<MemoryBudgetProblem> memoryBudgetProblem(const MemoryNeed& need, double budget_bytes,
-                                                       const std::string& budget_name);
+                                                       const std::string& budget_name, const std::string& raise);
 
 // What the kernel would grant this process at most, and why: the address space left under
 // RLIMIT_AS (less what is mapped now and the threads' stacks), and RAM plus swap (with the
@@ -49,7 +50,8 @@ std::optional<MemoryBudgetProblem> memoryBudgetProblem(const MemoryNeed& need, d
 // when neither can be read.
 struct KernelMemoryLimit {
   double bytes = 0.0;
-  std::string name;  // "RLIMIT_AS 300 MB, 25 MB in use" or "RAM + swap 8000 MB"
+  std::string name;   // "what RLIMIT_AS leaves (300 MB, 25 MB mapped at start)", "this machine's RAM and swap (...)"
+  std::string raise;  // "RLIMIT_AS (ulimit -v, LimitAS=)", "the machine's memory"
 };
 std::optional<KernelMemoryLimit> kernelMemoryLimit();
 

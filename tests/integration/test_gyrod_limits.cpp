@@ -95,6 +95,36 @@ TEST(GyrodLimits, WhatTheKernelWouldRefuseExits78NamingRlimitAs) {
   EXPECT_EQ(lineCount(log), 1u) << log;
   EXPECT_NE(log.find(":5: key 'allan.window_s': gyrod would need "), std::string::npos) << log;
   EXPECT_NE(log.find("what RLIMIT_AS leaves (419 MB"), std::string::npos) << log;
+  EXPECT_NE(log.find("lower allan.window_s or raise RLIMIT_AS"), std::string::npos) << log;
+#endif
+}
+
+static void limitAddressSpaceTo120Mb() {
+  rlimit limit{};
+  ::getrlimit(RLIMIT_AS, &limit);
+  limit.rlim_cur = 120ull << 20;
+  ::setrlimit(RLIMIT_AS, &limit);
+}
+
+TEST(GyrodLimits, AFailedAllocationIsOneLineAndExit71NotACrash) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space: no RLIMIT_AS under it";
+#else
+  ScratchDir d;
+  // A 100 MB configuration file cannot be read into 120 MB of address space (the text and its copy).
+  std::string text = "[device]\nbackend = \"mock\"\n";
+  const std::string comment = "#" + std::string(999, 'x') + "\n";
+  text.reserve(text.size() + 100000 * comment.size());
+  for (int i = 0; i < 100000; ++i) text += comment;
+  const auto cfg = d.write("big.toml", text);
+  text.clear();
+  text.shrink_to_fit();
+  GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt", limitAddressSpaceTo120Mb);
+  EXPECT_EQ(gyrod.waitExit(10000ms), std::optional<int>(71));
+  const std::string log = readWholeFile(d.path() / "log.txt");
+  EXPECT_EQ(log,
+            "gyrod: out of memory: an allocation failed (std::bad_alloc); the configuration's [limits] "
+            "memory_mb budget does not cover it, or the machine is short of memory\n");
 #endif
 }
 
