@@ -147,6 +147,10 @@ TEST(GyrodLimits, AFailedRecordingWriteIsInStatusTheRecordingAndTheShutdownLine)
   EXPECT_GE(r["errors"].get<std::uint64_t>(), 1u);
   EXPECT_EQ(r["dropped"].get<std::uint64_t>(), 0u);
   EXPECT_NE(r["last_error"].get<std::string>().find(": File too large"), std::string::npos) << r;
+  const auto shown = runGyroctl("status --socket '" + (d.path() / "gyrod.sock").string() + "'", d.path());
+  EXPECT_EQ(shown.exit_status, 0) << shown.err;
+  EXPECT_NE(shown.out.find("lost to write errors"), std::string::npos) << shown.out;
+  EXPECT_NE(shown.out.find("File too large"), std::string::npos) << shown.out;
   gyrod.signal(SIGTERM);
   EXPECT_EQ(gyrod.waitExit(3000ms), std::optional<int>(0));
   const std::string log = readWholeFile(d.path() / "log.txt");
