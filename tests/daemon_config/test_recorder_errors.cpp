@@ -4,6 +4,7 @@
 // ignored), as a full disk refuses it with ENOSPC.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/mount.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -115,4 +116,40 @@ TEST(RecorderWriteErrors, AFileThatCannotBeCreatedLosesRecordsWithTheCause) {
   EXPECT_EQ(rec.stats().written, 1u);  // into the open file (its name is gone, not the file)
   EXPECT_EQ(rec.stats().lost_to_errors, 9u);
   EXPECT_NE(rec.lastError().find("No such file or directory"), std::string::npos) << rec.lastError();
+}
+
+// A real full disk where the test may mount a 64 KiB tmpfs (root); skipped elsewhere.
+TEST(RecorderWriteErrors, AFullDiskIsADroppedLineWithReasonDiskFullOnceThereIsRoomAgain) {
+  TempDir d;
+  const fs::path tiny = d.path("tiny");
+  fs::create_directories(tiny);
+  if (::mount("tmpfs", tiny.c_str(), "tmpfs", 0, "size=64k") != 0) GTEST_SKIP() << "cannot mount a tmpfs here";
+  struct Unmount {
+    fs::path dir;
+    ~Unmount() { ::umount2(dir.c_str(), MNT_DETACH); }
+  } unmount{tiny};
+  {
+    std::ofstream ballast(tiny / "ballast", std::ios::binary);
+    ballast << std::string(48 * 1024, 'b');
+  }
+  RecorderOptions o;
+  o.path = (tiny / "gyro.csv").string();
+  o.flush_interval_s = 3600.0;
+  Recorder rec(o);
+  const std::string file = rec.currentFile();
+  for (int i = 0; i < 1000; ++i) rec.pushSample(0.02 * i, 0.001 * i, -0.5, 0.25, 25.5);  // ~30 kB of lines
+  rec.flush();
+  const RecorderStats full = rec.stats();
+  EXPECT_GT(full.lost_to_errors, 0u);
+  EXPECT_EQ(full.written + full.lost_to_errors, 1000u);
+  EXPECT_NE(rec.lastError().find("No space left on device"), std::string::npos) << rec.lastError();
+  fs::remove(tiny / "ballast");
+  for (int i = 1000; i < 1010; ++i) rec.pushSample(0.02 * i, 0.0, 0.0, 0.0, 25.5);
+  rec.stop();
+  EXPECT_EQ(rec.stats().lost_announced, full.lost_to_errors);
+  const auto recording = gyrod::recording::readRecordingCsv(file);
+  EXPECT_EQ(recording.size(), full.written + 10);
+  ASSERT_EQ(recording.lost.size(), 1u);
+  EXPECT_EQ(recording.lost[0].reason, "disk_full");
+  EXPECT_EQ(recording.lost[0].count, full.lost_to_errors);
 }
