@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "daemon/command_line.hpp"
 #include "daemon/config.hpp"
 #include "daemon/memory_budget.hpp"
 
@@ -108,4 +109,15 @@ TEST(ConfigEcho, BadValuesAndNamesAreQuotedBoundedAndEscaped) {
   EXPECT_TRUE(contains(top, "unknown key 'k\\x07' at top level")) << top;
   // An ordinary value reads as before.
   EXPECT_TRUE(contains(errorOf("[log]\nlevel = \"verbose\"\n"), "(got \"verbose\")"));
+}
+
+TEST(ConfigRecordFlag, AFolderWithASlashIsRecordedInto) {
+  GyrodConfig c;
+  CommandLineOverrides o;
+  o.record_path = "/var/lib/gyrod/";
+  applyOverrides(c, o);
+  EXPECT_EQ(c.record.path, "/var/lib/gyrod/gyro.csv");
+  o.record_path = "/tmp/x.csv";
+  applyOverrides(c, o);
+  EXPECT_EQ(c.record.path, "/tmp/x.csv");
 }
