@@ -7,6 +7,7 @@
 #include <sstream>
 #include <vector>
 
+#include "daemon/recorder.hpp"
 #include "formats/toml_document.hpp"
 
 #ifndef GYROD_VERSION
@@ -25,9 +26,9 @@ void applyOverrides(GyrodConfig& config, const CommandLineOverrides& o) {
     config.socket.path = *o.socket_path;
   }
   if (o.record_path) {
-    if (!o.record_path->empty() && o.record_path->back() == '/')
-      throw ConfigError("--record: must name a file, not a directory (got \"" + *o.record_path + "\")");
+    // A folder (DIR/ or an existing DIR) is recorded into, as DIR/gyro-<time>-<index>.csv.
     config.record.path = *o.record_path;
+    if (!o.record_path->empty() && o.record_path->back() == '/') config.record.path += kDefaultRecordingName;
   }
   if (o.mock_speed) {
     if (!(*o.mock_speed > 0.0 && *o.mock_speed <= 1000.0))
@@ -47,7 +48,8 @@ GyrodCommandLine parseGyrodCommandLine(int argc, const char* const* argv, const 
   };
   app.add_option("--backend", backend, "Device backend")->check(CLI::IsMember(strings(kBackendNames)));
   app.add_option("--socket", socket_path, "Unix socket path (socket.path)");
-  app.add_option("--record", record_path, "Record raw samples to this file (record.path); \"\" = off");
+  app.add_option("--record", record_path,
+                 "Record raw samples to this file (record.path), or into this folder; \"\" = off");
   app.add_option("--mock-speed", mock_speed, "Mock device speed, 1 = real time (mock.speed)");
   app.add_option("--log-level", log_level, "Log level")->check(CLI::IsMember(strings(kLogLevelNames)));
   app.set_version_flag("--version", std::string("gyrod ") + GYROD_VERSION);

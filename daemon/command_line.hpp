@@ -10,6 +10,18 @@ namespace gyrod::daemon {
 
 // sysexits.h EX_USAGE: the command line itself is wrong (unknown flag, bad flag value).
 inline constexpr int kExitUsageError = 64;
+// sysexits.h EX_OSERR: an allocation failed (std::bad_alloc), whatever allocated. The
+// configuration's memory check (daemon/memory_budget.hpp) stops what it can foresee with 78.
+inline constexpr int kExitOutOfMemory = 71;
+// gyrod's exit statuses: 0 after SIGTERM/SIGINT (or --help, --version), kExitUsageError,
+// kExitConfigError (config.hpp), kExitOutOfMemory, and 1 for any other failure at start-up
+// (e.g. the socket cannot be bound).
+
+// The one line gyrod prints when an allocation failed; a literal, since printing must not
+// allocate then.
+inline constexpr const char* kOutOfMemoryMessage =
+    "gyrod: out of memory: an allocation failed (std::bad_alloc); the configuration's [limits] memory_mb "
+    "budget does not cover it, or the machine is short of memory";
 
 inline constexpr std::string_view kDefaultConfigPath = "/etc/gyrod/gyrod.toml";
 

@@ -12,9 +12,11 @@
 #include <grp.h>
 #include <unistd.h>
 
+#include "daemon/memory_budget.hpp"
 #include "driver/mpu6050_config.hpp"
 #include "formats/model_toml.hpp"
 #include "formats/motion_spec.hpp"
+#include "formats/quoted_value.hpp"
 #include "formats/recording_csv.hpp"
 #include "formats/toml_document.hpp"
 
@@ -25,9 +27,15 @@ using Section = formats::TomlSection;
 using formats::shortest;
 
 const std::vector<std::string_view> kSections = {"device", "gpio",   "bias", "filter", "allan",
-                                                 "socket", "record", "log",  "mock"};
+                                                 "socket", "record", "log",  "mock",   "limits"};
 const std::vector<std::string_view> kBiasSourceNames = {"estimate", "model", "config"};
 const std::vector<std::string_view> kMockSourceNames = {"simulator", "replay"};
+
+// A name from the file as a message shows it: a long or hostile one bounded and escaped.
+std::string shownName(std::string_view name) {
+  const std::string quoted = formats::quotedValue(name);
+  return quoted == "'" + std::string(name) + "'" ? std::string(name) : quoted;
+}
 
 bool isAllDigits(std::string_view s) {
   return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
@@ -234,6 +242,44 @@ void readRecord(const Section& s, RecordConfig& r) {
   }
 }
 
+void readLimits(const Section& s, LimitsConfig& l) {
+  if (auto v = s.number("memory_mb")) {
+    if (!(*v >= 16.0 && *v <= 1e9)) s.failValue("memory_mb", "must be 16..1e9 MB (10^6 bytes)");
+    l.memory_mb = *v;
+  }
+}
+
+// The memory the configuration needs against limits.memory_mb and, with the reference
+// checks, against what the kernel would grant; named at the line of the key that sizes most
+// of it (its value echoed), else of the key it is multiplied by, else of memory_mb.
+void checkMemory(const formats::TomlDocument& doc, const GyrodConfig& config, ReferenceChecks checks) {
+  const MemoryNeed need = memoryNeeded(config);
+  auto problem = memoryBudgetProblem(need, config.limits.memory_mb * 1e6,
+                                     "limits.memory_mb = " + formats::shortest(config.limits.memory_mb) + " MB",
+                                     "limits.memory_mb");
+  if (!problem && checks == ReferenceChecks::On)
+    if (const auto kernel = kernelMemoryLimit())
+      problem = memoryBudgetProblem(need, kernel->bytes, kernel->name, kernel->raise);
+  if (!problem) return;
+  const auto* node = doc.root().at_path(problem->key).node();
+  std::string where = doc.file() + ": ", suffix;
+  if (node) {
+    where = doc.location(node->source());
+    suffix = " (got " + formats::tomlRendered(*node) + ")";
+  } else {
+    for (const char* other : {"device.rate_hz", "limits.memory_mb"}) {
+      if (const auto* n = doc.root().at_path(other).node()) {
+        where = doc.location(n->source());
+        break;
+      }
+    }
+    const auto item =
+        std::find_if(need.items.begin(), need.items.end(), [&](const MemoryItem& i) { return i.key == problem->key; });
+    suffix = " (" + item->value + ", the default)";
+  }
+  throw ConfigError(where + "key '" + problem->key + "': " + problem->message + suffix);
+}
+
 void readLog(const Section& s, LogConfig& l) {
   if (auto v = s.choice("level", kLogLevelNames)) l.level = kLogLevels[*v];
 }
@@ -419,14 +465,14 @@ GyrodConfig readConfig(const formats::TomlDocument& doc, ReferenceChecks checks)
     const auto where = doc.location(key.source());
     if (std::find(kSections.begin(), kSections.end(), name) == kSections.end()) {
       if (node.is_table())
-        throw ConfigError(where + "unknown section [" + std::string(name) + "] (valid sections: " +
+        throw ConfigError(where + "unknown section [" + shownName(name) + "] (valid sections: " +
                           formats::joinedNames(kSections) + ")" + formats::didYouMean(name, kSections));
-      throw ConfigError(where + "unknown key '" + std::string(name) +
-                        "' at top level (keys belong in a section: " + formats::joinedNames(kSections) + ")");
+      throw ConfigError(where + "unknown key " + formats::quotedValue(name) +
+                        " at top level (keys belong in a section: " + formats::joinedNames(kSections) + ")");
     }
     if (!node.is_table())
-      throw ConfigError(where + "key '" + std::string(name) + "': must be a section [" + std::string(name) + "] (got " +
-                        formats::tomlTypeAndValue(node) + ")");
+      throw ConfigError(where + "key " + formats::quotedValue(name) + ": must be a section [" + shownName(name) +
+                        "] (got " + formats::tomlTypeAndValue(node) + ")");
   }
   const toml::table empty;
   const auto section = [&](std::string_view name, std::vector<std::string_view> keys) {
@@ -454,7 +500,9 @@ GyrodConfig readConfig(const formats::TomlDocument& doc, ReferenceChecks checks)
   const auto mock = section("mock", {"source", "replay_file", "seed", "speed", "motion", "warm_up",
                                      "temperature_coefficient_dps_per_c", "faults"});
   readMock(mock, config.mock);
+  readLimits(section("limits", {"memory_mb"}), config.limits);
   if (checks == ReferenceChecks::On) checkReferences(filter, socket, mock, config);
+  checkMemory(doc, config, checks);
   return config;
 }
 

@@ -98,6 +98,13 @@ struct RecordConfig {
   bool operator==(const RecordConfig&) const = default;
 };
 
+// Resources the configuration may claim; checked at load, before anything is allocated
+// (daemon/memory_budget.hpp computes the figure).
+struct LimitsConfig {
+  double memory_mb = 1024.0;  // 10^6 bytes; the Allan window at 1 kHz x 1 h needs ~650
+  bool operator==(const LimitsConfig&) const = default;
+};
+
 struct LogConfig {
   spdlog::level::level_enum level = spdlog::level::info;
   bool operator==(const LogConfig&) const = default;
@@ -154,12 +161,15 @@ struct GyrodConfig {
   RecordConfig record;
   LogConfig log;
   MockConfig mock;
+  LimitsConfig limits;
   bool operator==(const GyrodConfig&) const = default;
 };
 
 // Whether the files and names a configuration refers to (filter.model, socket.group,
-// mock.replay_file when replaying) are checked as well: reading them needs the system
-// the daemon runs on, so text parsed on its own does not by default.
+// mock.replay_file when replaying) are checked as well, and the memory the configuration
+// needs against what the kernel would grant (RLIMIT_AS, RAM and swap): both need the system
+// the daemon runs on, so text parsed on its own does not by default. limits.memory_mb is
+// checked either way.
 enum class ReferenceChecks { Off, On };
 
 // Parses and validates TOML text; `source_name` is the file name used in messages.

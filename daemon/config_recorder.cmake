@@ -5,6 +5,7 @@ find_package(Threads REQUIRED)
 add_library(gyrod_daemon_config STATIC
   ${CMAKE_CURRENT_LIST_DIR}/command_line.cpp
   ${CMAKE_CURRENT_LIST_DIR}/config.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/memory_budget.cpp
   ${CMAKE_CURRENT_LIST_DIR}/recorder.cpp)
 target_include_directories(gyrod_daemon_config PUBLIC ${PROJECT_SOURCE_DIR})
 target_link_libraries(gyrod_daemon_config

@@ -141,10 +141,12 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
   if (!config_.socket.group.empty()) socket_options.group = config_.socket.group;
   ServerOptions server_options;
   server_options.client_buffer_bytes = config_.socket.client_buffer_kib * 1024;
+  server_options.max_clients = kMaxSocketClients;  // as the memory budget counts them
   server_ = std::make_unique<UnixSocketServer>(loop_, openListeningSocket(socket_options), *this, server_options);
 
   if (config_.record.enabled()) {
-    RecorderOptions options = recorderOptions(config_.record, config_.device.rate_hz);
+    // Sized for the samples per second it really receives: the accelerated mock's included.
+    RecorderOptions options = recorderOptions(config_.record, recordedSamplesPerSecond(config_));
     options.header_comments.push_back("gyrod " + std::string(GYROD_RELEASE) + " recording of " + device_.description);
     options.header_comments.push_back(
         "raw rates as read from the chip (bias not removed); GAP lines mark lost samples");
@@ -217,9 +219,17 @@ Gyrod::~Gyrod() = default;
 int Gyrod::run() {
   loop_.run();
   ::sd_notify(0, "STOPPING=1");
-  if (recorder_) recorder_->stop();
-  spdlog::info("stopped after {} samples, {} gaps ({} samples lost); longest loop turn {} us", samples_published_,
-               gaps_, missing_samples_,
+  std::string recording;
+  if (recorder_) {
+    recorder_->stop();
+    const RecorderStats s = recorder_->stats();
+    const std::string last_error = recorder_->lastError();
+    recording = fmt::format(
+        "; recording: {} written, {} dropped (ring full), {} lost to write errors ({} failed calls{})", s.written,
+        s.dropped, s.lost_to_errors, s.write_errors, last_error.empty() ? std::string() : ", last: " + last_error);
+  }
+  spdlog::info("stopped after {} samples, {} gaps ({} samples lost by the device){}; longest loop turn {} us",
+               samples_published_, gaps_, missing_samples_, recording,
                std::chrono::duration_cast<std::chrono::microseconds>(loop_.longestTurn()).count());
   return 0;
 }
@@ -412,7 +422,12 @@ StatusReport Gyrod::statusReport() {
   }
   r.bias_source = bias.str();
   r.rate_model = rateModelDescription();
-  if (recorder_) r.recording = recorder_->currentFile();
+  if (recorder_) {
+    r.recording = recorder_->currentFile();
+    const RecorderStats stats = recorder_->stats();
+    r.recorder = protocol::RecorderStatus{stats.written, stats.dropped, stats.lost_to_errors, stats.write_errors,
+                                          recorder_->lastError()};
+  }
   return r;
 }
 

@@ -14,6 +14,7 @@
 #include "daemon/config.hpp"
 #include "daemon/device_backend.hpp"
 #include "daemon/event_loop.hpp"
+#include "daemon/memory_budget.hpp"
 #include "daemon/noise_refit_worker.hpp"
 #include "daemon/recorder.hpp"
 #include "daemon/sample_pipeline.hpp"

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <new>
 
 #include "daemon/command_line.hpp"
 #include "daemon/config.hpp"
@@ -30,9 +31,7 @@ void setUpLogging(spdlog::level::level_enum level) {
   spdlog::set_default_logger(logger);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int runGyrod(int argc, char** argv) {
   using namespace gyrod::daemon;
   // Before any thread starts (the recorder's writer), so that signals reach only the
   // loop's signalfd. SIGPIPE: writes to a vanished client fail with EPIPE instead.
@@ -59,8 +58,22 @@ int main(int argc, char** argv) {
   } catch (const ConfigError& e) {  // e.g. a model file named by filter.model that is not one
     spdlog::critical("{}", e.what());
     return kExitConfigError;
+  } catch (const std::bad_alloc&) {
+    throw;  // main's one line, printed without allocating
   } catch (const std::exception& e) {
     spdlog::critical("{}", e.what());
     return 1;
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return runGyrod(argc, argv);
+  } catch (const std::bad_alloc&) {
+    std::fputs(gyrod::daemon::kOutOfMemoryMessage, stderr);
+    std::fputc('\n', stderr);
+    return gyrod::daemon::kExitOutOfMemory;
   }
 }

@@ -15,6 +15,7 @@
 #include <cstring>
 #include <ctime>
 #include <filesystem>
+#include <new>
 
 #include "formats/recording_format.hpp"
 
@@ -94,7 +95,9 @@ Recorder::Recorder(RecorderOptions options) : options_(std::move(options)), ring
     throw std::invalid_argument("Recorder: header comments too long (" + std::to_string(header_bytes) +
                                 " bytes, at most " + std::to_string(kMaxHeaderBytes) + ")");
 
-  const fs::path p(options_.path);
+  std::error_code ec;
+  const fs::path p =
+      fs::is_directory(options_.path, ec) ? fs::path(options_.path) / kDefaultRecordingName : fs::path(options_.path);
   directory_ = p.has_parent_path() ? p.parent_path().string() : ".";
   stem_ = p.stem().string();
   extension_ = p.extension().string();
@@ -179,6 +182,7 @@ RecorderStats Recorder::stats() const noexcept {
   s.dropped = dropped_.load(std::memory_order_relaxed);
   s.written = written_.load(std::memory_order_acquire);
   s.lost_to_errors = lost_.load(std::memory_order_relaxed);
+  s.lost_announced = lost_announced_count_.load(std::memory_order_relaxed);
   s.write_errors = write_errors_.load(std::memory_order_relaxed);
   s.flushes = flushes_.load(std::memory_order_acquire);
   s.files_opened = files_opened_.load(std::memory_order_relaxed);
@@ -188,6 +192,11 @@ RecorderStats Recorder::stats() const noexcept {
 std::string Recorder::currentFile() const {
   std::lock_guard lock(file_mutex_);
   return current_file_;
+}
+
+std::string Recorder::lastError() const {
+  std::lock_guard lock(file_mutex_);
+  return last_error_;
 }
 
 std::vector<std::string> Recorder::files() const {
@@ -218,7 +227,14 @@ void Recorder::writerLoop() {
     if (stopping_) break;
     const auto requested = flush_requests_;
     lock.unlock();
-    flushOnce(false);
+    try {
+      flushOnce(false);
+    } catch (const std::bad_alloc&) {  // formatting grows pending_: those lines are lost, counted
+      for (const auto& l : pending_lines_) lost_.fetch_add(l.record ? 1 : 0, std::memory_order_relaxed);
+      pending_.clear();
+      pending_lines_.clear();
+      reportError("format lines", ENOMEM);
+    }
     lock.lock();
     flushes_done_ = requested;
     flushed_.notify_all();
@@ -236,9 +252,10 @@ void Recorder::flushOnce(bool final_flush) {
   }
 
   recording::RecordingLine line;
+  announceLosses(line);
   RecorderRecord r;
   const auto dropLine = [&](std::uint64_t count) {
-    appendLine(recording::formatDroppedLine(line, count, "ring_full"), false);
+    appendLine(recording::formatDroppedLine(line, count, "ring_full"), false, 0, count);
     drops_reported_ += count;
   };
   while (ring_.tryPop(r)) {
@@ -257,21 +274,36 @@ void Recorder::flushOnce(bool final_flush) {
   flushes_.fetch_add(1, std::memory_order_release);
 }
 
-void Recorder::appendLine(std::string_view line, bool is_record) {
+void Recorder::appendLine(std::string_view line, bool is_record, std::uint64_t announces_lost,
+                          std::uint64_t announces_drops) {
   pending_.append(line);
-  pending_lines_.push_back({pending_.size(), is_record});
+  pending_lines_.push_back({pending_.size(), is_record, announces_lost, announces_drops});
+}
+
+// Losses whose DROPPED line is not in a file yet: records a failed write lost, and ring drops
+// announced in a page whose write failed. First in the flush, so the line sits where the
+// hole in t begins to show (or just after, when the file changed).
+void Recorder::announceLosses(recording::RecordingLine& line) {
+  const auto lost = lost_.load(std::memory_order_relaxed) - lost_announced_count_.load(std::memory_order_relaxed);
+  if (lost > 0) appendLine(recording::formatDroppedLine(line, lost, loss_reason_), false, lost, 0);
+  if (drops_unwritten_ > 0) {
+    appendLine(recording::formatDroppedLine(line, drops_unwritten_, "ring_full"), false, 0, drops_unwritten_);
+    drops_unwritten_ = 0;
+  }
 }
 
 void Recorder::writePending() {
   std::size_t begin = 0;
   for (std::size_t i = 0; i < pending_lines_.size(); ++i) {
-    const auto [line_end, record] = pending_lines_[i];
+    const auto [line_end, record, announces_lost, announces_drops] = pending_lines_[i];
     const std::string_view line(pending_.data() + begin, line_end - begin);
     begin = line_end;
     if (fd_ < 0 && !openNextFile({})) {
       // No file to write to (e.g. the directory was removed): these lines are lost.
-      for (std::size_t j = i; j < pending_lines_.size(); ++j)
+      for (std::size_t j = i; j < pending_lines_.size(); ++j) {
         if (pending_lines_[j].record) lost_.fetch_add(1, std::memory_order_relaxed);
+        drops_unwritten_ += pending_lines_[j].announces_drops;
+      }
       break;
     }
     if (options_.rotate_bytes > 0 && file_records_ + page_records_ > 0 &&
@@ -300,6 +332,8 @@ void Recorder::writePending() {
     }
     page_.append(line);
     if (record) ++page_records_;
+    page_announces_lost_ += announces_lost;
+    page_announces_drops_ += announces_drops;
     if ((file_bytes_ + page_.size()) % page_size_ == 0) emitPage();
   }
   emitPage();
@@ -312,6 +346,7 @@ void Recorder::emitPage() {
   if (page_.empty()) return;
   if (fd_ < 0) {
     lost_.fetch_add(page_records_, std::memory_order_relaxed);
+    drops_unwritten_ += page_announces_drops_;
   } else {
     std::size_t done = 0;
     while (done < page_.size()) {
@@ -327,20 +362,27 @@ void Recorder::emitPage() {
         ::lseek(fd_, static_cast<off_t>(file_bytes_), SEEK_SET);
       reportError("write to " + currentFile(), error_number);
       lost_.fetch_add(page_records_, std::memory_order_relaxed);
-      page_.clear();
-      page_records_ = 0;
+      drops_unwritten_ += page_announces_drops_;
+      clearPage();
       return;
     }
     file_bytes_ += page_.size();
     file_records_ += page_records_;
+    lost_announced_count_.fetch_add(page_announces_lost_, std::memory_order_relaxed);
     written_.fetch_add(page_records_, std::memory_order_release);
     if (in_error_) {
       spdlog::info("recorder: writing to {} again", currentFile());
       in_error_ = false;
     }
   }
+  clearPage();
+}
+
+void Recorder::clearPage() {
   page_.clear();
   page_records_ = 0;
+  page_announces_lost_ = 0;
+  page_announces_drops_ = 0;
 }
 
 bool Recorder::openNextFile(const std::string& previous_name) {
@@ -413,6 +455,11 @@ void Recorder::pruneOldFiles() {
 
 void Recorder::reportError(const std::string& what, int error_number) {
   write_errors_.fetch_add(1, std::memory_order_relaxed);
+  loss_reason_ = error_number == ENOSPC || error_number == EDQUOT ? "disk_full" : "write_error";
+  {
+    std::lock_guard lock(file_mutex_);
+    last_error_ = what + ": " + std::strerror(error_number);
+  }
   // One message per episode: a full disk would otherwise log every flush.
   if (!in_error_) spdlog::error("recorder: {}: {}", what, std::strerror(error_number));
   in_error_ = true;

@@ -4,7 +4,13 @@
 // line per sample with every value in its shortest round-trip form (reads back bit-exact),
 // and '#' comment lines for everything else:
 //   # GAP seq=123 t=2.46 count=4 reason=fifo_overflow     samples the device lost
-//   # DROPPED count=7 reason=ring_full                     samples the recorder lost
+//   # DROPPED count=7 reason=ring_full                     samples the recorder lost:
+//                                                          ring_full (the writer fell behind),
+//                                                          disk_full (ENOSPC, EDQUOT) or
+//                                                          write_error (any other failed write)
+// A loss to a failed write is announced by a DROPPED line at the next write that succeeds
+// (in the same file, or the next one after a rotation); while the disk stays full no line
+// can say so, and the counts (stats(), STATUS "recorder", the shutdown line) do.
 // This file owns the ring, the writer thread, the files and their rotation.
 //
 // The event loop pushes fixed-size records into a preallocated single-producer /
@@ -36,6 +42,7 @@
 
 #include "daemon/config.hpp"
 #include "daemon/spsc_ring.hpp"
+#include "formats/recording_format.hpp"
 
 namespace gyrod::daemon {
 
@@ -44,9 +51,13 @@ class RecorderError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The base name used inside a folder given as the recording path.
+inline constexpr const char* kDefaultRecordingName = "gyro.csv";
+
 struct RecorderOptions {
   // Base name dir/stem.ext. Files are dir/stem-YYYYmmddTHHMMSSZ-NNNNNN.ext (UTC time of
   // opening, then an index that makes the name unique), so name order is creation order.
+  // An existing folder records into it: folder/gyro-YYYYmmddTHHMMSSZ-NNNNNN.csv.
   std::string path;
   std::size_t ring_capacity = 4096;  // records; rounded up to a power of two
   std::uint64_t rotate_bytes = 0;    // new file before one would exceed this size; 0 = never
@@ -66,6 +77,7 @@ struct RecorderStats {
   std::uint64_t dropped = 0;         // records refused because the ring was full
   std::uint64_t written = 0;         // records whose lines write() has accepted
   std::uint64_t lost_to_errors = 0;  // records whose lines could not be written (disk full, I/O error)
+  std::uint64_t lost_announced = 0;  // of those, announced by a DROPPED line now in a file
   std::uint64_t write_errors = 0;    // failed write()/open() calls
   std::uint64_t flushes = 0;         // completed flushes
   std::uint64_t files_opened = 0;
@@ -112,6 +124,9 @@ class Recorder {
 
   RecorderStats stats() const noexcept;  // any thread
   std::string currentFile() const;       // any thread
+  // The last failed write, open or sync: "write to FILE: No space left on device"; empty if
+  // none failed. Any thread.
+  std::string lastError() const;
   // Recording files of this base name in its directory, oldest first.
   std::vector<std::string> files() const;
 
@@ -120,9 +135,14 @@ class Recorder {
   bool pushRecord(const RecorderRecord& r) noexcept;
   void writerLoop();
   void flushOnce(bool final_flush);
-  void appendLine(std::string_view line, bool is_record);
+  // `announces_lost` / `announces_drops`: records lost to write errors / dropped from a full
+  // ring that this DROPPED line announces, counted as announced once the line is written.
+  void appendLine(std::string_view line, bool is_record, std::uint64_t announces_lost = 0,
+                  std::uint64_t announces_drops = 0);
+  void announceLosses(recording::RecordingLine& line);
   void writePending();
   void emitPage();
+  void clearPage();
   bool openNextFile(const std::string& previous_name);
   void closeFile();
   void pruneOldFiles();
@@ -143,22 +163,29 @@ class Recorder {
   std::uint64_t file_records_ = 0;   // sample/gap lines in the current file
   std::int64_t file_opened_ns_ = 0;  // steady clock
   std::uint64_t next_index_ = 0;
-  std::uint64_t drops_reported_ = 0;  // dropped records already announced in a file
+  std::uint64_t drops_reported_ = 0;         // dropped records announced (or in lines on their way to a file)
+  std::uint64_t drops_unwritten_ = 0;        // of those, announced in a page whose write failed: to announce again
+  const char* loss_reason_ = "write_error";  // the cause of the last failed write (a DROPPED reason)
   // Lines formatted but not yet written; padding and rotation are decided when they are
   // written, since both depend on the position in the file.
   std::string pending_;
   struct PendingLine {
     std::size_t end;  // offset in pending_ just past the line's '\n'
     bool record;      // a sample or gap (counted), not a comment
+    std::uint64_t announces_lost;
+    std::uint64_t announces_drops;
   };
   std::vector<PendingLine> pending_lines_;
   std::string page_;                // bytes for the current page of the file, not yet written
   std::uint64_t page_records_ = 0;  // records in page_
-  bool in_error_ = false;           // last write failed (log once per episode)
+  std::uint64_t page_announces_lost_ = 0, page_announces_drops_ = 0;  // DROPPED counts in page_
+  bool in_error_ = false;                                             // last write failed (log once per episode)
   std::atomic<std::uint64_t> written_{0}, lost_{0}, write_errors_{0}, flushes_{0}, files_opened_{0};
+  std::atomic<std::uint64_t> lost_announced_count_{0};
 
-  mutable std::mutex file_mutex_;  // guards current_file_
+  mutable std::mutex file_mutex_;  // guards current_file_ and last_error_
   std::string current_file_;
+  std::string last_error_;
 
   std::mutex wake_mutex_;
   std::condition_variable wake_;

@@ -7,6 +7,8 @@
 #include <limits>
 #include <sstream>
 
+#include "formats/quoted_value.hpp"
+
 namespace gyrod::formats {
 namespace {
 
@@ -64,7 +66,13 @@ std::string tomlTypeName(const toml::node& n) {
 }
 
 std::string tomlRendered(const toml::node& n) {
-  if (auto s = n.as_string()) return "\"" + s->get() + "\"";
+  if (auto s = n.as_string()) {
+    // A short printable value keeps TOML's double quotes; a long or hostile one is shown
+    // bounded and escaped (quotedValue), so that a message is one short line a terminal
+    // displays as it is.
+    std::string quoted = quotedValue(s->get());
+    return quoted == "'" + s->get() + "'" ? "\"" + s->get() + "\"" : quoted;
+  }
   if (auto i = n.as_integer()) return std::to_string(i->get());
   if (auto f = n.as_floating_point()) return shortest(f->get());
   if (auto b = n.as_boolean()) return b->get() ? "true" : "false";
@@ -117,7 +125,8 @@ TomlSection::TomlSection(const std::string& file, const toml::table& table, std:
     (void)node;
     if (std::find(keys_.begin(), keys_.end(), key.str()) != keys_.end()) continue;
     std::ostringstream s;
-    s << location(key.source()) << "unknown key '" << key.str() << "' in [" << name_
+    // quotedValue: a key is text from the file as well ('name' when short and printable).
+    s << location(key.source()) << "unknown key " << quotedValue(key.str()) << " in [" << name_
       << "] (valid keys: " << joinedNames(keys_) << ")" << didYouMean(key.str(), keys_);
     throw TomlError(s.str());
   }

@@ -154,7 +154,7 @@ constexpr std::string_view kStatusFields[] = {
     "class",         "uptime",        "samples",         "gaps",     "missing", "bus_errors",    "resets",
     "device_state",  "device_reason", "device_retrying", "device",   "rate",    "nominal_rate",  "temp",
     "bias_source",   "rate_model",    "recording",       "counters", "clients", "clients_total", "clients_dropped",
-    "lines_dropped", "client_buffer", "client_list"};
+    "lines_dropped", "client_buffer", "client_list",     "recorder"};
 
 StatusReply statusOf(const json& j) {
   constexpr std::string_view cls = "STATUS";
@@ -176,6 +176,14 @@ StatusReply statusOf(const json& j) {
   d.bias_source = optionalText(j, cls, "bias_source");
   d.rate_model = optionalText(j, cls, "rate_model");
   d.recording = optionalText(j, cls, "recording");
+  if (const json* recorder = field(j, cls, "recorder", &json::is_object, "an object")) {
+    RecorderStatus& rs = d.recorder.emplace();
+    rs.written = count(*recorder, cls, "written");
+    rs.dropped = count(*recorder, cls, "dropped");
+    rs.lost = count(*recorder, cls, "lost");
+    rs.errors = count(*recorder, cls, "errors");
+    rs.last_error = optionalText(*recorder, cls, "last_error").value_or("");
+  }
   if (const json* counters = field(j, cls, "counters", &json::is_object, "an object")) {
     for (auto it = counters->begin(); it != counters->end(); ++it) {
       if (!it->is_number_unsigned()) malformed(cls, "counter \"" + it.key() + "\" must be an integer >= 0");

@@ -219,6 +219,14 @@ std::string statusLine(const StatusReport& d, const ServerStatus& s) {
   if (d.bias_source) j["bias_source"] = *d.bias_source;
   if (d.rate_model) j["rate_model"] = *d.rate_model;
   if (d.recording) j["recording"] = *d.recording;
+  if (d.recorder) {
+    json recorder = {{"written", d.recorder->written},
+                     {"dropped", d.recorder->dropped},
+                     {"lost", d.recorder->lost},
+                     {"errors", d.recorder->errors}};
+    if (!d.recorder->last_error.empty()) recorder["last_error"] = d.recorder->last_error;
+    j["recorder"] = std::move(recorder);
+  }
   if (!d.device_counters.empty()) {
     json counters = json::object();
     for (const NamedCount& c : d.device_counters) counters[c.name] = c.value;

@@ -22,7 +22,7 @@
 namespace gyrod::protocol {
 
 inline constexpr int kProtocolMajor = 1;  // incompatible changes
-inline constexpr int kProtocolMinor = 1;  // compatible additions (new classes, new fields)
+inline constexpr int kProtocolMinor = 2;  // compatible additions (new classes, new fields)
 
 // A client line longer than this (not counting the '\n' and an optional '\r') is refused
 // with an ERROR and the client is disconnected.
@@ -119,6 +119,18 @@ struct NamedCount {
 };
 
 // What the daemon knows about itself (STATUS); empty optionals are omitted.
+// The recorder's accounting (STATUS "recorder", while recording). Every record it did not
+// write is announced in the recording by a "# DROPPED count=N reason=R" line as soon as a
+// write succeeds again.
+struct RecorderStatus {
+  std::uint64_t written = 0;  // sample and gap lines written to the recording
+  std::uint64_t dropped = 0;  // records refused because the recorder's ring was full (ring_full)
+  std::uint64_t lost = 0;     // records lost to failed writes (disk_full, write_error)
+  std::uint64_t errors = 0;   // failed write, create, sync or close calls
+  std::string last_error;     // the last of them with its cause; empty (omitted) when none
+  bool operator==(const RecorderStatus&) const = default;
+};
+
 struct StatusReport {
   double uptime_s = 0.0;                    // since the daemon started [s]
   std::uint64_t samples = 0;                // samples published since start
@@ -137,6 +149,7 @@ struct StatusReport {
   std::optional<std::string> bias_source;   // where the bias subtracted from raw comes from
   std::optional<std::string> rate_model;    // what the rate stream subtracts: "model FILE" or "bias"
   std::optional<std::string> recording;     // file being recorded to
+  std::optional<RecorderStatus> recorder;   // the recorder's counts, while recording
 };
 
 // What the server knows about its clients; added to every STATUS line.

@@ -19,13 +19,16 @@ namespace gyrod::test {
 
 class GyrodProcess {
  public:
-  // Starts gyrod with `args`; stdout and stderr go to `log_path`.
-  GyrodProcess(const std::vector<std::string>& args, const std::filesystem::path& log_path) {
+  // Starts gyrod with `args`; stdout and stderr go to `log_path`. `in_child` runs in the
+  // child before exec (e.g. setrlimit): it must only make system calls.
+  GyrodProcess(const std::vector<std::string>& args, const std::filesystem::path& log_path,
+               void (*in_child)() = nullptr) {
     pid_ = ::fork();
     if (pid_ == 0) {
       const int fd = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
       ::dup2(fd, 1);
       ::dup2(fd, 2);
+      if (in_child) in_child();
       std::vector<std::string> all = {std::string(GYROD_BIN_DIR) + "/gyrod"};
       all.insert(all.end(), args.begin(), args.end());
       std::vector<char*> argv;

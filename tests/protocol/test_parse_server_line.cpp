@@ -250,3 +250,16 @@ TEST(ParseServerLine, RateBiasAndStillRoundTripBitForBit) {
   EXPECT_FALSE(old.still.has_value());
   EXPECT_THROW(parseServerLine(R"({"class":"RATE","seq":1,"still":1})"), MalformedLine);
 }
+
+TEST(ParseServerLine, StatusRecorderRoundTrips) {
+  StatusReport d;
+  d.device_state = "streaming";
+  d.recorder = RecorderStatus{10, 2, 300, 4, "write to a.csv: No space left on device"};
+  const auto reply = std::get<StatusReply>(parseServerLine(statusLine(d, {})));
+  EXPECT_EQ(reply.daemon.recorder, d.recorder);
+  EXPECT_TRUE(reply.other_fields.empty());
+  d.recorder->last_error.clear();  // omitted, read back empty
+  EXPECT_EQ(std::get<StatusReply>(parseServerLine(statusLine(d, {}))).daemon.recorder, d.recorder);
+  d.recorder.reset();
+  EXPECT_FALSE(std::get<StatusReply>(parseServerLine(statusLine(d, {}))).daemon.recorder);
+}

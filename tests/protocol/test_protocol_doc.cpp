@@ -79,6 +79,7 @@ nlohmann::json fullStatus() {
   d.bias_source = "config";
   d.rate_model = "bias";
   d.recording = "file.csv";
+  d.recorder = protocol::RecorderStatus{1, 2, 3, 4, "write to file.csv: No space left on device"};
   protocol::ServerStatus s;
   s.client_list.push_back({1, 2, 3, true, 1, 1, 1, 1, true});
   return nlohmann::json::parse(protocol::statusLine(d, s));
@@ -93,6 +94,8 @@ TEST(ProtocolDoc, StatusFieldsAreTheOnesSent) {
     sent.insert(key);
     if (key == "client_list")
       for (const auto& [client_key, v] : value[0].items()) sent.insert("client_list[]." + client_key);
+    if (key == "recorder")
+      for (const auto& [recorder_key, v] : value.items()) sent.insert("recorder." + recorder_key);
   }
   std::set<std::string> documented = firstColumnNames(section(readDoc(), "### STATUS"));
   std::erase_if(documented, [](const std::string& n) { return n.starts_with("counters."); });  // below

@@ -316,6 +316,10 @@ void printStatus(const protocol::StatusReply& status) {
   printField("bias_source", d.bias_source);
   printField("rate_model", d.rate_model);
   printField("recording", d.recording);
+  if (const auto& r = d.recorder)
+    printField("recorder", count(r->written) + " written, " + count(r->dropped) + " dropped (ring full), " +
+                               count(r->lost) + " lost to write errors (" + count(r->errors) + " failed calls)" +
+                               (r->last_error.empty() ? "" : "; last: " + r->last_error));
   printField("clients", count(s.clients));
   printField("clients_total", count(s.clients_total));
   printField("clients_dropped", count(s.clients_dropped));
