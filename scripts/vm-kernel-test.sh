@@ -6,6 +6,8 @@
 # chip does by itself). tests/vm/init.sh runs the checks and sets QEMU's exit status.
 #
 #   scripts/vm-kernel-test.sh [--build-dir DIR] [--timeout SECONDS]
+#   scripts/vm-kernel-test.sh --prepare-only   (the kernel and modules only; prints their folder,
+#                                              for scripts/vm-systemd-test.sh)
 #
 # Downloads (the kernel, its headers and source, busybox) are cached in build/vm/. Nothing
 # is installed except, when missing, qemu-system-x86 (apt). Exit status 0 = every check passed.
@@ -14,18 +16,20 @@ cd "$(dirname "$0")/.."
 root=$PWD
 build_dir=build
 timeout_s=600
+prepare_only=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --build-dir) build_dir=$2; shift 2 ;;
     --timeout) timeout_s=$2; shift 2 ;;
-    *) echo "usage: $0 [--build-dir DIR] [--timeout SECONDS]" >&2; exit 2 ;;
+    --prepare-only) prepare_only=1; shift ;;
+    *) echo "usage: $0 [--build-dir DIR] [--timeout SECONDS] | --prepare-only" >&2; exit 2 ;;
   esac
 done
 
 vm=$root/build/vm
 debs=$vm/debs
 mkdir -p "$debs"
-log() { printf '[vm-kernel-test %(%T)T] %s\n' -1 "$*"; }
+log() { printf '[vm-kernel-test %(%T)T] %s\n' -1 "$*" >&2; }
 t_start=$(date +%s)
 
 if ! command -v qemu-system-x86_64 >/dev/null; then
@@ -88,6 +92,12 @@ if [ ! -f "$gpio_sim/gpio-sim-oot.ko" ]; then
   printf 'obj-m := gpio-sim-oot.o\ngpio-sim-oot-y := gpio-sim.o irq_sim.o\n' >"$gpio_sim/Kbuild"
   make -s -C "$hdr/usr/src/linux-headers-$kver" M="$gpio_sim" modules >"$gpio_sim/build.log" 2>&1 ||
     { cat "$gpio_sim/build.log" >&2; exit 1; }
+fi
+
+if [ $prepare_only = 1 ]; then
+  cp "$gpio_sim/gpio-sim-oot.ko" "$kernel_dir/"
+  echo "$kernel_dir"
+  exit 0
 fi
 
 # --- the initramfs ---

@@ -38,12 +38,13 @@ vm_chip preload /dev/i2c-0 || { fail preload "vm_chip preload failed"; finish; }
 vm_chip emulate /dev/i2c-0 &
 
 # --- helpers ---
-# conf NAME BUS ADDRESS [GPIO_CHIP]: /tmp/NAME.toml (bias from the config: no still period)
+# conf NAME BUS ADDRESS [GPIO_CHIP]: /tmp/NAME.toml (bias from the config; the Kalman filter
+# is identified over a still period of 200 samples, which vm_chip's constant frames refuse)
 conf() {
   {
     printf '[device]\nbackend = "i2c"\nbus = %s\naddress = %s\n[gpio]\nchip = "%s"\n' "$2" "$3" "$4"
     [ -n "$4" ] && printf 'line = 0\n'
-    printf '[bias]\nsource = "config"\n'
+    printf '[bias]\nsource = "config"\nstill_seconds = 4\n'
   } >/tmp/$1.toml
 }
 # start NAME: gyrod in the background on /tmp/NAME.toml; its pid in $gyrod_pid
@@ -143,17 +144,27 @@ edges_pid=$!
 start gpio
 gpio_pid=$gyrod_pid
 if wait_samples gpio 20 60; then
+  m0=$(status gpio | field data_ready_missed)
+  s0=$(samples gpio)
   r=$(rate gpio 4)
-  missed=$(status gpio | field data_ready_missed)
-  # One frame per wake-up (vm_chip holds FIFO_COUNT at 8): ~50/s on edges, ~12/s without.
-  if [ "$r" -ge 35 ]; then pass edges "$r samples/s on 50 Hz edges, data_ready_missed=$missed"; else
-    fail edges "$r samples/s on 50 Hz edges (want >= 35), data_ready_missed=$missed"
+  m1=$(status gpio | field data_ready_missed)
+  s1=$(samples gpio)
+  # One frame per wake-up (vm_chip holds FIFO_COUNT at 8): ~50/s on edges, at most ~11/s from
+  # the watchdog alone (every 88 ms). On a loaded host the guest's edges come late and the
+  # watchdog takes a few: most samples must still have been announced by an edge.
+  watchdog=$((m1 - m0))
+  delivered=$((s1 - s0))
+  if [ "$r" -ge 15 ] && [ $((watchdog * 4)) -lt "$delivered" ]; then
+    pass edges "$r samples/s on 50 Hz edges; $watchdog of $delivered read by the watchdog"
+  else
+    fail edges "$r samples/s on 50 Hz edges (want >= 15); $watchdog of $delivered read by the watchdog (want < 1/4)"
     show gpio
   fi
   # The timestamps come from the kernel's edge stamps through the sample clock: 20 ms apart.
   watch_json gpio 20 /tmp/gpio-watch.json
-  steps=$(sed -n 's/.*"class":"RATE".*"t":\([0-9.]*\).*/\1/p' /tmp/gpio-watch.json |
-    awk 'NR > 1 { d = $1 - p; if (d < lo || NR == 2) lo = d; if (d > hi) hi = d } { p = $1 }
+  # Per sequence step: a sample refused with a still period leaves a hole in the stream.
+  steps=$(sed -n 's/.*"class":"RATE","seq":\([0-9]*\),"t":\([0-9.]*\).*/\1 \2/p' /tmp/gpio-watch.json |
+    awk 'NR > 1 { d = ($2 - p) / ($1 - q); if (d < lo || NR == 2) lo = d; if (d > hi) hi = d } { q = $1; p = $2 }
          END { printf "%d steps of %.4f .. %.4f s", NR - 1, lo, hi; exit !(NR == 20 && lo > 0.018 && hi < 0.022) }')
   if [ $? -eq 0 ]; then pass edge-timestamps "$steps (50 Hz)"; else
     fail edge-timestamps "$steps (want 19 of 0.018 .. 0.022 s)"
@@ -192,6 +203,18 @@ if wait_samples gpio 20 60; then
     pass no-edges "$r samples/s from the watchdog, data_ready_missed $m0 -> $m1: $(logline gpio 'no data-ready edge')"
   else
     fail no-edges "$r samples/s, data_ready_missed $m0 -> $m1"
+    show gpio
+  fi
+
+  # vm_chip's frames never change: each still period is refused once (zero variance) and
+  # starts again, and no other sample is skipped (it used to refuse every sample after it).
+  n=$(samples gpio)
+  refused=$(grep -c "cannot identify the filter" /tmp/gpio.log)
+  other=$(grep "skipped" /tmp/gpio.log | grep -vc "cannot identify the filter")
+  if [ "$refused" -ge 1 ] && [ "$refused" -le $((n / 200 + 1)) ] && [ "$other" = 0 ]; then
+    pass constant-signal "$refused still periods of 200 refused in $n samples: $(logline gpio 'cannot identify' | cut -c1-160)"
+  else
+    fail constant-signal "$refused refused, $other other skipped samples in $n"
     show gpio
   fi
 else
