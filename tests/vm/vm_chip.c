@@ -3,6 +3,7 @@
 //
 //   vm_chip preload BUS            WHO_AM_I, TEMP_OUT, FIFO_COUNT and FIFO frames (values below)
 //   vm_chip emulate BUS            forever: clear DEVICE_RESET after a reset write, keep the cells
+//   vm_chip silence BUS            FIFO_COUNT = 0: the chip stops producing samples (stop emulate first)
 //   vm_chip edges PULL_FILE N US   N rising edges on a gpio-sim line, one every US microseconds
 //   vm_chip rdwr BUS               exit 0 if I2C_RDWR fails with EOPNOTSUPP (an SMBus-only adapter)
 //   vm_chip asuser UID CMD...      run CMD as UID (for the non-root check)
@@ -183,6 +184,10 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (!strcmp(mode, "emulate") && argc == 3) return emulate(argv[2]);
+  if (!strcmp(mode, "silence") && argc == 3) {
+    writeWord(openBus(argv[2]), kFifoCount, 0);
+    return 0;
+  }
   if (!strcmp(mode, "edges") && argc == 5) return edges(argv[2], atol(argv[3]), atol(argv[4]));
   if (!strcmp(mode, "rdwr") && argc == 3) return rdwrUnsupported(argv[2]);
   if (!strcmp(mode, "asuser") && argc >= 4) {
@@ -192,7 +197,8 @@ int main(int argc, char** argv) {
     die(argv[3]);
   }
   if (!strcmp(mode, "exit") && argc == 3) return debugExit(atoi(argv[2]));
-  fprintf(stderr,
-          "usage: vm_chip preload|emulate BUS | edges PULL_FILE N US | rdwr BUS | asuser UID CMD... | exit CODE\n");
+  fprintf(
+      stderr,
+      "usage: vm_chip preload|emulate|silence BUS | edges PULL_FILE N US | rdwr BUS | asuser UID CMD... | exit CODE\n");
   return 2;
 }
