@@ -96,8 +96,8 @@ fi
 
 busybox=$vm/busybox
 [ -x "$busybox" ] || { dpkg-deb --fsys-tarfile "$busybox_deb" | tar -xO ./bin/busybox >"$busybox"; chmod +x "$busybox"; }
+cp "$gpio_sim/gpio-sim-oot.ko" "$kernel_dir/" # one folder with every module the guests load
 if [ $prepare_only = 1 ]; then
-  cp "$gpio_sim/gpio-sim-oot.ko" "$kernel_dir/"
   echo "$kernel_dir"
   exit 0
 fi
@@ -117,7 +117,7 @@ strip -o "$rd/usr/bin/gyroctl" "$bin/gyroctl"
 for lib in $(ldd "$bin/gyrod" "$bin/gyroctl" | awk '/=> \//{print $3} /^\t\/lib/{print $1}' | sort -u); do
   mkdir -p "$rd$(dirname "$lib")" && strip -o "$rd$lib" "$lib"
 done
-cp "$kernel_dir"/*.ko "$gpio_sim/gpio-sim-oot.ko" "$rd/lib/modules/"
+cp "$kernel_dir"/*.ko "$rd/lib/modules/"
 cp "$root/tests/vm/init.sh" "$rd/init" && chmod +x "$rd/init"
 echo 'root:x:0:0:root:/:/bin/sh' >"$rd/etc/passwd"
 echo 'nobody:x:65534:65534:nobody:/:/bin/false' >>"$rd/etc/passwd"

@@ -121,7 +121,7 @@ Wants=vm-chip-emulate.service
 After=vm-chip-emulate.service systemd-sysusers.service systemd-udev-trigger.service systemd-journald.service
 [Service]
 Type=oneshot
-Environment=VM_INSTALLED=$installed
+Environment="VM_INSTALLED=$installed"
 ExecStart=/usr/local/bin/vm-systemd-checks
 StandardOutput=journal+console
 StandardError=journal+console
