@@ -61,7 +61,7 @@ else
     -DBUILD_TESTING=OFF $(command -v ccache >/dev/null && echo -DCMAKE_CXX_COMPILER_LAUNCHER=ccache) \
     >"$sd/cmake.log" 2>&1 || { tail -n 20 "$sd/cmake.log" >&2; exit 1; }
   cmake --build "$build" -j2 --target gyrod gyroctl >>"$sd/cmake.log" 2>&1 || { tail -n 30 "$sd/cmake.log" >&2; exit 1; }
-  DESTDIR=$r cmake --install "$build" >>"$sd/cmake.log" 2>&1 || { tail -n 20 "$sd/cmake.log" >&2; exit 1; }
+  DESTDIR=$r cmake --install "$build" --strip >>"$sd/cmake.log" 2>&1 || { tail -n 20 "$sd/cmake.log" >&2; exit 1; }
   installed="cmake --install (prefix /usr)"
 fi
 [ -f "$r/usr/lib/systemd/system/gyrod.service" ] || [ -f "$r/lib/systemd/system/gyrod.service" ] ||
