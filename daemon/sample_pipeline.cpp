@@ -98,22 +98,38 @@ void SamplePipeline::startFilters() {
 }
 
 void SamplePipeline::finishEstimation() {
-  for (std::size_t axis = 0; axis < kAxes; ++axis) {
-    auto& x = still_[axis];
-    if (settings_.bias_origin == BiasOrigin::Estimate) {
-      long double sum = 0.0L;
-      for (double v : x) sum += v;
-      bias_[axis] = static_cast<double>(sum / static_cast<long double>(x.size()));
+  // Worked on copies: a still period that cannot identify the filter (a sensor whose output
+  // never changes gives zero variance) changes nothing and starts again, rather than being
+  // retried and refused at every following sample with the samples piling up.
+  Vec3 bias = bias_;
+  std::array<processing::FilterChainParameters, kAxes> params = params_;
+  try {
+    for (std::size_t axis = 0; axis < kAxes; ++axis) {
+      auto& x = still_[axis];
+      if (settings_.bias_origin == BiasOrigin::Estimate) {
+        long double sum = 0.0L;
+        for (double v : x) sum += v;
+        bias[axis] = static_cast<double>(sum / static_cast<long double>(x.size()));
+      }
+      for (double& v : x) v -= bias[axis];
+      if (kalmanIdentified()) {
+        params[axis] =
+            processing::identifyFilterChain(x, settings_.mean_window, settings_.mean_threshold_dps, settings_.kalman);
+      } else {
+        params[axis].kalman = {*settings_.kalman.a, *settings_.kalman.q, *settings_.kalman.r, 0.0, {}};
+      }
     }
-    for (double& v : x) v -= bias_[axis];
-    if (kalmanIdentified()) {
-      params_[axis] =
-          processing::identifyFilterChain(x, settings_.mean_window, settings_.mean_threshold_dps, settings_.kalman);
-    } else {
-      params_[axis].kalman = {*settings_.kalman.a, *settings_.kalman.q, *settings_.kalman.r, 0.0, {}};
-    }
-    std::vector<double>().swap(x);  // the still period is over: give the memory back
+  } catch (const std::invalid_argument& e) {
+    for (auto& x : still_) x.clear();  // capacity kept: the next still period allocates nothing
+    std::ostringstream msg;
+    msg << "the still period cannot identify the filter (" << e.what()
+        << "; a sensor whose output never changes?): estimating again over the next " << settings_.still_seconds
+        << " s";
+    throw std::invalid_argument(msg.str());
   }
+  bias_ = bias;
+  params_ = params;
+  for (auto& x : still_) std::vector<double>().swap(x);  // the still period is over: give the memory back
   startFilters();
 }
 

@@ -291,3 +291,39 @@ TEST(SamplePipeline, RateModelReloadValidatesFirstAndContinuesTheWarmUpShape) {
   pipeline.reloadRateModel(std::nullopt);
   EXPECT_EQ(pipeline.rateModel(), RateModel::ConstantBias);
 }
+
+// A sensor whose output never changes (seen on Linux's i2c-stub, scripts/vm-kernel-test.sh):
+// the still period cannot identify the filter. The pipeline says so once per still period
+// and starts it again; it used to refuse every following sample.
+TEST(SamplePipeline, AStillPeriodWithoutVarianceIsRefusedOnceAndStartsAgain) {
+  PipelineSettings p = baseSettings();
+  p.bias_origin = BiasOrigin::Config;
+  p.still_seconds = 4.0;  // 200 samples
+  SamplePipeline pipeline(p);
+  const Vec3 constant{1.0, -2.0, 5.0};
+  std::size_t refused = 0;
+  for (std::size_t i = 0; i < 1000; ++i) {
+    try {
+      const ProcessedSample out = pipeline.process(i, i / 50.0, constant, 30.0);
+      EXPECT_EQ(out.raw, constant);
+      EXPECT_FALSE(out.filtered);
+    } catch (const std::invalid_argument& e) {
+      ++refused;
+      EXPECT_EQ(i % 200, 199u) << "refused at sample " << i;
+      EXPECT_NE(std::string(e.what()).find("zero variance"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(refused, 5u);
+  EXPECT_EQ(pipeline.phase(), PipelinePhase::Estimating);
+
+  // Noise arrives: the next still period identifies the filter as on a fresh start.
+  const Stream s = noisyStream(200, 3, {0.0, 0.0, 0.0});
+  for (std::size_t i = 0; i < 200; ++i)
+    pipeline.process(1000 + i, (1000 + i) / 50.0, {s.x[0][i], s.x[1][i], s.x[2][i]}, 30.0);
+  ASSERT_EQ(pipeline.phase(), PipelinePhase::Running);
+  for (std::size_t axis = 0; axis < kAxes; ++axis) {
+    const FilterChainParameters expected = identifyFilterChain(s.x[axis], 20, 0.3, {});
+    EXPECT_EQ(pipeline.filterParameters()[axis].kalman.a, expected.kalman.a);
+    EXPECT_EQ(pipeline.filterParameters()[axis].kalman.q, expected.kalman.q);
+  }
+}
