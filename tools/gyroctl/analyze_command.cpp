@@ -42,8 +42,8 @@ void requireAnalysableValues(const recording::Recording& rec, std::size_t axis_i
   for (std::size_t i = 0; i < values.size(); ++i) {
     if (std::abs(values[i]) <= kLargestAnalysableRateDps) continue;
     std::ostringstream s;
-    s << rec.path << ':' << (i < rec.line_numbers.size() ? rec.line_numbers[i] : i + 1) << ": column '"
-      << rec.axis_names[axis_index] << "': " << values[i] << " deg/s is beyond " << kLargestAnalysableRateDps
+    s << rec.path << ':' << rec.lineOfSample(i) << ": column '" << rec.axis_names[axis_index] << "': " << values[i]
+      << " deg/s is beyond " << kLargestAnalysableRateDps
       << " deg/s, more than any gyro measures (the statistics would overflow)";
     throw recording::RecordingError(s.str());
   }

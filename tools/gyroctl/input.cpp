@@ -11,7 +11,8 @@
 
 namespace gyrod::gyroctl {
 
-LoadedInput loadInput(const std::string& path, std::optional<double> rate_hz, const std::string& axis) {
+LoadedInput loadInput(const std::string& path, std::optional<double> rate_hz, const std::string& axis,
+                      const recording::ReadOptions& read) {
   LoadedInput in;
   if (rate_hz && !(std::isfinite(*rate_hz) && *rate_hz > 0.0)) {
     std::ostringstream s;
@@ -19,7 +20,7 @@ LoadedInput loadInput(const std::string& path, std::optional<double> rate_hz, co
     throw std::invalid_argument(s.str());
   }
   requireNotADirectory(path);
-  in.recording = recording::readRecordingCsv(path);
+  in.recording = recording::readRecordingCsv(path, read);
   const auto& rec = in.recording;
   if (!rec.t.empty()) {
     const double from_t = recording::sampleRateFromTimes(rec);

@@ -17,7 +17,9 @@ struct LoadedInput {
 
 // rate: from --rate when given; must agree with the t column (1 % tolerance) if present.
 // axis: "all" or a column name. Throws RecordingError naming the file and the problem.
-LoadedInput loadInput(const std::string& path, std::optional<double> rate_hz, const std::string& axis);
+// `read` passes on to readRecordingCsv (line numbers kept or not, progress).
+LoadedInput loadInput(const std::string& path, std::optional<double> rate_hz, const std::string& axis,
+                      const recording::ReadOptions& read = {});
 
 // Refuses a directory as an input file, saying so (reading one would look like an empty
 // file). FIFOs and devices stay readable: `analyze /dev/stdin` works.
