@@ -84,8 +84,8 @@ TEST(RecordingReading, TheLineLimitHoldsAcrossAChunkBoundary) {
     (void)readRecordingCsv(f.path());
     FAIL() << "accepted a line longer than the limit";
   } catch (const RecordingError& e) {
-    EXPECT_EQ(std::string(e.what()),
-              f.path() + ":" + std::to_string(lines_before + 1) + ": line longer than 65536 bytes (the limit for one line)");
+    EXPECT_EQ(std::string(e.what()), f.path() + ":" + std::to_string(lines_before + 1) +
+                                         ": line longer than 65536 bytes (the limit for one line)");
   }
 }
 
