@@ -61,7 +61,7 @@ run() {
   printf '| %s | %s s | %d MB |\n' "$label" "$wall" $((kb / 1024))
 }
 
-echo "$samples samples, one axis: $(du -m "$one" | cut -f1) MB of CSV; load: $(cut -d' ' -f1-3 /proc/loadavg)"
+echo "$samples samples, one axis: $(du -mL "$one" | cut -f1) MB of CSV; load: $(cut -d' ' -f1-3 /proc/loadavg)"
 echo
 echo "| | wall | peak memory |"
 echo "|---|---|---|"

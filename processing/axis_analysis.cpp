@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "processing/parallel_share.hpp"
+
 namespace gyrod::processing {
 
 double varianceAboutMean(std::span<const double> x) {
@@ -25,6 +27,29 @@ double peakDeviationFromMean(std::span<const double> x) {
   for (double v : x) peak = std::max(peak, std::abs(static_cast<double>(v - mean)));
   return peak;
 }
+
+namespace {
+
+// GrossErrorMeanFilter's output over x, in contiguous shares on the cores. Its output is a
+// function of the window's samples in time order only, so a share starting at i0 first feeds
+// its own filter the L − 1 samples before i0 (or all from 0 while the window is filling) and
+// then gives the same bits as one filter run from the start. x is finite (the tests on the
+// raw series have checked it), so no share throws.
+std::vector<double> meanFiltered(std::span<const double> x, std::size_t window, double threshold) {
+  std::vector<double> out(x.size());
+  const GrossErrorMeanFilter validated(window, threshold);  // throws for bad parameters here, not in a thread
+  forEachShare(
+      x.size(),
+      [&](std::size_t first, std::size_t end) {
+        GrossErrorMeanFilter mean(window, threshold);
+        for (std::size_t i = first >= window - 1 ? first - (window - 1) : 0; i < first; ++i) mean.update(x[i]);
+        for (std::size_t i = first; i < end; ++i) out[i] = mean.update(x[i]);
+      },
+      std::size_t{1} << 16);
+  return out;
+}
+
+}  // namespace
 
 AxisAnalysis analyzeAxis(std::span<const double> rate_dps, const AnalysisOptions& options) {
   return analyzeAxis(std::vector<double>(rate_dps.begin(), rate_dps.end()), options);
@@ -58,11 +83,7 @@ AxisAnalysis analyzeAxis(std::vector<double>&& rate_dps, const AnalysisOptions& 
   // 4–6. Mean filter, AR models of its output, Kalman on AR(1) (§4–5). The mean filter runs
   // once: its output identifies the Kalman and then feeds it, exactly as AxisFilterChain
   // (mean filter, then Kalman) would on the same series.
-  std::vector<double> filtered(x.size());
-  {
-    GrossErrorMeanFilter mean(options.mean_window, options.mean_threshold_dps);
-    for (std::size_t i = 0; i < x.size(); ++i) filtered[i] = mean.update(x[i]);
-  }
+  std::vector<double> filtered = meanFiltered(x, options.mean_window, options.mean_threshold_dps);
   a.filter = identifyFilterChainFromMeanFiltered(x, filtered, options.mean_window, options.mean_threshold_dps,
                                                  options.kalman_overrides);
   a.ar = yuleWalker(filtered, options.max_ar_order);
