@@ -363,22 +363,20 @@ std::vector<int> noiseTypesForTable(std::span<const double> rate, std::span<cons
   const auto isPowerOfTwo = [](std::size_t m) { return (m & (m - 1)) == 0; };
   const auto octaveChain = [&] {
     const std::size_t top = distinct.empty() ? 0 : distinct.back();
-    std::vector<double> sums;
+    // The next level is formed before this one is handed to the decision, so that at most
+    // one and a half series' worth of sums is held.
+    std::vector<double> sums(count);
+    for (std::size_t i = 0; i < count; ++i) sums[i] = rate[i] - mean;
     for (std::size_t m = 1; m <= top; m *= 2) {
-      if (m == 1) {
-        sums.resize(count);
-        for (std::size_t i = 0; i < count; ++i) sums[i] = rate[i] - mean;
-      } else {
-        const std::size_t n = count / m;
-        for (std::size_t k = 0; k < n; ++k) sums[k] = sums[2 * k] + sums[2 * k + 1];
-        sums.resize(n);
-      }
+      std::vector<double> next(count / (2 * m));
+      for (std::size_t k = 0; k < next.size(); ++k) next[k] = sums[2 * k] + sums[2 * k + 1];
       const auto at = std::lower_bound(distinct.begin(), distinct.end(), m);
-      if (at == distinct.end() || *at != m) continue;
-      std::vector<double> z(sums.size());
-      const double md = static_cast<double>(m);
-      for (std::size_t k = 0; k < z.size(); ++k) z[k] = sums[k] / md;
-      distinct_alpha[static_cast<std::size_t>(at - distinct.begin())] = lag1NoiseIdOfAverages(std::move(z));
+      if (at != distinct.end() && *at == m) {
+        const double md = static_cast<double>(m);
+        for (double& v : sums) v /= md;
+        distinct_alpha[static_cast<std::size_t>(at - distinct.begin())] = lag1NoiseIdOfAverages(std::move(sums));
+      }
+      sums = std::move(next);
     }
   };
   std::vector<std::size_t> others;  // indices into distinct
