@@ -113,6 +113,41 @@ std::size_t expectedLines(std::FILE* file, std::size_t line_bytes) {
   return static_cast<std::size_t>(st.st_size) / std::max<std::size_t>(line_bytes, 1) * 3 / 2 + 16;
 }
 
+enum class Role { T, Axis, Temp, Truth };
+using ColumnRole = std::pair<Role, std::size_t>;  // what a column feeds, and which axis
+
+// The columns of a header line; fills rec.axis_names and sizes rec.axes.
+std::vector<ColumnRole> headerRoles(const std::string& path, std::size_t line_no, std::string_view first,
+                                    Recording& rec) {
+  std::vector<ColumnRole> roles;
+  const auto names = splitFields(first);
+  if (names.size() == 1 && first.find(',') == std::string_view::npos &&
+      std::find(kKnownColumns.begin(), kKnownColumns.end(), names[0]) == kKnownColumns.end())
+    fail(path, line_no,
+         formats::quotedValue(names[0]) + " is neither a number nor a header of columns t,gx,gy,gz,temp");
+  for (auto name : names) {
+    if (std::find(kKnownColumns.begin(), kKnownColumns.end(), name) == kKnownColumns.end())
+      fail(path, line_no,
+           "unknown column " + formats::quotedValue(name) + " (expected any of t,gx,gy,gz,temp,wx,wy,wz)");
+    for (std::size_t j = 0; j < roles.size(); ++j)
+      if (names[j] == name) fail(path, line_no, "column '" + std::string(name) + "' appears twice");
+    if (name == "t") {
+      roles.push_back({Role::T, 0});
+    } else if (name == "temp") {
+      roles.push_back({Role::Temp, 0});
+    } else if (const auto truth = std::find(kTruthColumns.begin(), kTruthColumns.end(), name);
+               truth != kTruthColumns.end()) {
+      roles.push_back({Role::Truth, static_cast<std::size_t>(truth - kTruthColumns.begin())});
+    } else {
+      roles.push_back({Role::Axis, rec.axis_names.size()});
+      rec.axis_names.emplace_back(name);
+    }
+  }
+  if (rec.axis_names.empty()) fail(path, line_no, "no gyro column: the header needs at least one of gx,gy,gz");
+  rec.axes.resize(rec.axis_names.size());
+  return roles;
+}
+
 }  // namespace
 
 std::optional<std::size_t> axisOfColumn(std::string_view column) {
@@ -174,8 +209,7 @@ Recording readRecordingCsv(const std::string& path, const ReadOptions& options) 
   }
   if (isSkippable(first)) fail(path, 0, "empty file: no header and no samples");
 
-  enum class Role { T, Axis, Temp, Truth };
-  std::vector<std::pair<Role, std::size_t>> roles;  // per column: what it feeds, axis index
+  std::vector<ColumnRole> roles;  // per column: what it feeds, axis index
   bool bare_numbers = false;
   std::size_t header_line = line_no;
   if (parseNumber(first)) {
@@ -184,34 +218,11 @@ Recording readRecordingCsv(const std::string& path, const ReadOptions& options) 
     rec.axes.resize(1);
     roles = {{Role::Axis, 0}};
   } else {
-    const auto names = splitFields(first);
-    if (names.size() == 1 && first.find(',') == std::string_view::npos &&
-        std::find(kKnownColumns.begin(), kKnownColumns.end(), names[0]) == kKnownColumns.end())
-      fail(path, line_no,
-           formats::quotedValue(names[0]) + " is neither a number nor a header of columns t,gx,gy,gz,temp");
-    for (auto name : names) {
-      if (std::find(kKnownColumns.begin(), kKnownColumns.end(), name) == kKnownColumns.end())
-        fail(path, line_no,
-             "unknown column " + formats::quotedValue(name) + " (expected any of t,gx,gy,gz,temp,wx,wy,wz)");
-      for (std::size_t j = 0; j < roles.size(); ++j)
-        if (names[j] == name) fail(path, line_no, "column '" + std::string(name) + "' appears twice");
-      if (name == "t") {
-        roles.push_back({Role::T, 0});
-      } else if (name == "temp") {
-        roles.push_back({Role::Temp, 0});
-      } else if (const auto truth = std::find(kTruthColumns.begin(), kTruthColumns.end(), name);
-                 truth != kTruthColumns.end()) {
-        roles.push_back({Role::Truth, static_cast<std::size_t>(truth - kTruthColumns.begin())});
-      } else {
-        roles.push_back({Role::Axis, rec.axis_names.size()});
-        rec.axis_names.emplace_back(name);
-      }
-    }
-    if (rec.axis_names.empty()) fail(path, line_no, "no gyro column: the header needs at least one of gx,gy,gz");
-    rec.axes.resize(rec.axis_names.size());
+    roles = headerRoles(path, line_no, first, rec);
   }
   // Where each field's value goes, resolved once; the column's name only for a message.
   std::vector<std::vector<double>*> targets;
+  targets.reserve(roles.size());
   for (const auto& [role, index] : roles) {
     targets.push_back(role == Role::T      ? &rec.t
                       : role == Role::Temp ? &rec.temp
