@@ -321,6 +321,13 @@ void calibrateAxisInto(recording::SensorModel& sensor, std::size_t slot, const s
 int runAnalyze(const AnalyzeOptions& opt) {
   // A target that cannot be written fails now, not after the analysis.
   if (!opt.write_model.empty()) formats::checkOutputTarget(opt.write_model, {opt.file});
+  // A progress line left on the terminal would run into an error message: cleared on any exit.
+  struct ClearProgressLine {
+    bool active;
+    ~ClearProgressLine() {
+      if (active) std::fputs("\r\033[K", stderr);
+    }
+  } const clear_progress{stderrIsTerminal()};
   recording::ReadOptions read;
   read.line_numbers = false;  // the line runs name any sample's line: 8 bytes a sample saved
   read.progress = readingProgress(opt.file);
