@@ -4,10 +4,15 @@
 #include <array>
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <cstring>
-#include <fstream>
+#include <memory>
+#include <span>
 #include <sstream>
 #include <string_view>
+
+#include <sys/stat.h>
 
 #include "formats/csv_fields.hpp"
 #include "formats/quoted_value.hpp"
@@ -27,6 +32,122 @@ constexpr std::array<std::string_view, 8> kKnownColumns = {"t", "gx", "gy", "gz"
 
 bool isSkippable(std::string_view line) { return line.empty() || line.front() == '#'; }
 
+// Lines of at most `max_bytes` bytes (the '\n' not counted) from a std::FILE, read in large
+// chunks: one copy of the text, no allocation per line, the same results as
+// BoundedLineReader (a line past the limit stops the reading).
+class ChunkedLineReader {
+ public:
+  enum class Result { Line, End, TooLong };
+  static constexpr std::size_t kChunkBytes = std::size_t{1} << 20;
+
+  ChunkedLineReader(std::FILE* file, std::size_t max_bytes)
+      : file_(file), max_bytes_(max_bytes), buffer_(kChunkBytes + max_bytes + 2) {}
+
+  Result next() {
+    while (true) {
+      const char* begin = buffer_.data() + pos_;
+      const std::size_t available = end_ - pos_;
+      if (const void* nl = std::memchr(begin, '\n', available)) {
+        const auto length = static_cast<std::size_t>(static_cast<const char*>(nl) - begin);
+        line_ = {begin, length};
+        pos_ += length + 1;
+        consumed_ += length + 1;
+        return length > max_bytes_ ? Result::TooLong : Result::Line;
+      }
+      if (available > max_bytes_) return Result::TooLong;
+      if (eof_) {
+        if (available == 0) return Result::End;
+        line_ = {begin, available};
+        pos_ = end_;
+        consumed_ += available;
+        return Result::Line;
+      }
+      // Keep the partial line (at most max_bytes_) and fill the rest of the buffer.
+      std::memmove(buffer_.data(), begin, available);
+      pos_ = 0;
+      end_ = available;
+      const std::size_t got = std::fread(buffer_.data() + end_, 1, buffer_.size() - end_, file_);
+      end_ += got;
+      if (got == 0) eof_ = true;
+    }
+  }
+  std::string_view line() const { return line_; }
+  std::size_t maxBytes() const { return max_bytes_; }
+  std::uint64_t bytesConsumed() const { return consumed_; }
+
+ private:
+  std::FILE* file_;
+  std::size_t max_bytes_;
+  std::vector<char> buffer_;
+  std::size_t pos_ = 0, end_ = 0;
+  std::uint64_t consumed_ = 0;
+  bool eof_ = false;
+  std::string_view line_;
+};
+
+struct FileCloser {
+  void operator()(std::FILE* f) const { std::fclose(f); }
+};
+
+// Splits `line` into at most fields.size() trimmed fields; returns the number of fields the
+// line has (which may be more than were stored).
+std::size_t splitInto(std::string_view line, std::span<std::string_view> fields) {
+  std::size_t count = 0;
+  std::size_t start = 0;
+  while (true) {
+    const auto comma = line.find(',', start);
+    if (count < fields.size())
+      fields[count] =
+          trimField(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
+    ++count;
+    if (comma == std::string_view::npos) return count;
+    start = comma + 1;
+  }
+}
+
+// A generous guess of the number of lines from the file's size and one line's length, so
+// that the columns are allocated once (capacity never touched costs no memory).
+std::size_t expectedLines(std::FILE* file, std::size_t line_bytes) {
+  struct stat st {};
+  if (::fstat(::fileno(file), &st) != 0 || !S_ISREG(st.st_mode) || st.st_size <= 0) return 0;
+  return static_cast<std::size_t>(st.st_size) / std::max<std::size_t>(line_bytes, 1) * 3 / 2 + 16;
+}
+
+enum class Role { T, Axis, Temp, Truth };
+using ColumnRole = std::pair<Role, std::size_t>;  // what a column feeds, and which axis
+
+// The columns of a header line; fills rec.axis_names and sizes rec.axes.
+std::vector<ColumnRole> headerRoles(const std::string& path, std::size_t line_no, std::string_view first,
+                                    Recording& rec) {
+  std::vector<ColumnRole> roles;
+  const auto names = splitFields(first);
+  if (names.size() == 1 && first.find(',') == std::string_view::npos &&
+      std::find(kKnownColumns.begin(), kKnownColumns.end(), names[0]) == kKnownColumns.end())
+    fail(path, line_no,
+         formats::quotedValue(names[0]) + " is neither a number nor a header of columns t,gx,gy,gz,temp");
+  for (auto name : names) {
+    if (std::find(kKnownColumns.begin(), kKnownColumns.end(), name) == kKnownColumns.end())
+      fail(path, line_no,
+           "unknown column " + formats::quotedValue(name) + " (expected any of t,gx,gy,gz,temp,wx,wy,wz)");
+    for (std::size_t j = 0; j < roles.size(); ++j)
+      if (names[j] == name) fail(path, line_no, "column '" + std::string(name) + "' appears twice");
+    if (name == "t") {
+      roles.push_back({Role::T, 0});
+    } else if (name == "temp") {
+      roles.push_back({Role::Temp, 0});
+    } else if (const auto truth = std::find(kTruthColumns.begin(), kTruthColumns.end(), name);
+               truth != kTruthColumns.end()) {
+      roles.push_back({Role::Truth, static_cast<std::size_t>(truth - kTruthColumns.begin())});
+    } else {
+      roles.push_back({Role::Axis, rec.axis_names.size()});
+      rec.axis_names.emplace_back(name);
+    }
+  }
+  if (rec.axis_names.empty()) fail(path, line_no, "no gyro column: the header needs at least one of gx,gy,gz");
+  rec.axes.resize(rec.axis_names.size());
+  return roles;
+}
+
 }  // namespace
 
 std::optional<std::size_t> axisOfColumn(std::string_view column) {
@@ -42,20 +163,31 @@ const std::vector<double>* Recording::axis(const std::string& name) const {
   return nullptr;
 }
 
-Recording readRecordingCsv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) fail(path, 0, std::string("cannot open: ") + std::strerror(errno));
+std::size_t Recording::lineOfSample(std::size_t sample) const {
+  if (sample < line_numbers.size()) return line_numbers[sample];
+  // The last run starting at or before `sample`: its lines follow one another.
+  const auto after = std::upper_bound(line_runs.begin(), line_runs.end(), sample,
+                                      [](std::size_t s, const LineRun& run) { return s < run.first_sample; });
+  if (after == line_runs.begin()) return sample + 1;
+  const LineRun& run = *(after - 1);
+  return run.first_line + (sample - run.first_sample);
+}
+
+Recording readRecordingCsv(const std::string& path, const ReadOptions& options) {
+  const std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
+  if (!file) fail(path, 0, std::string("cannot open: ") + std::strerror(errno));
 
   Recording rec;
   rec.path = path;
-  BoundedLineReader reader(in);
+  ChunkedLineReader reader(file.get(), kMaxLineBytes);
   std::size_t line_no = 0;
   // The next line, trimmed; nullopt at the end. A line past the limit stops the reading.
   const auto nextLine = [&]() -> std::optional<std::string_view> {
     const auto result = reader.next();
-    if (result == BoundedLineReader::Result::End) return std::nullopt;
+    if (result == ChunkedLineReader::Result::End) return std::nullopt;
     ++line_no;
-    if (result == BoundedLineReader::Result::TooLong) fail(path, line_no, lineTooLongCause(reader.maxBytes()));
+    if (result == ChunkedLineReader::Result::TooLong) fail(path, line_no, lineTooLongCause(reader.maxBytes()));
+    if (options.progress && (line_no & (kProgressLines - 1)) == 0) options.progress(line_no, reader.bytesConsumed());
     return trimField(reader.line());
   };
 
@@ -76,11 +208,10 @@ Recording readRecordingCsv(const std::string& path) {
     if (!skippable(first)) break;
   }
   // A directory opens but cannot be read (EISDIR): that is not an empty file.
-  if (in.bad()) fail(path, line_no, std::string("read error: ") + std::strerror(errno));
+  if (std::ferror(file.get())) fail(path, line_no, std::string("read error: ") + std::strerror(errno));
   if (isSkippable(first)) fail(path, 0, "empty file: no header and no samples");
 
-  enum class Role { T, Axis, Temp, Truth };
-  std::vector<std::pair<Role, std::size_t>> roles;  // per column: what it feeds, axis index
+  std::vector<ColumnRole> roles;  // per column: what it feeds, axis index
   bool bare_numbers = false;
   std::size_t header_line = line_no;
   if (parseNumber(first)) {
@@ -89,63 +220,53 @@ Recording readRecordingCsv(const std::string& path) {
     rec.axes.resize(1);
     roles = {{Role::Axis, 0}};
   } else {
-    const auto names = splitFields(first);
-    if (names.size() == 1 && first.find(',') == std::string_view::npos &&
-        std::find(kKnownColumns.begin(), kKnownColumns.end(), names[0]) == kKnownColumns.end())
-      fail(path, line_no,
-           formats::quotedValue(names[0]) + " is neither a number nor a header of columns t,gx,gy,gz,temp");
-    bool have_t = false, have_temp = false;
-    for (auto name : names) {
-      if (std::find(kKnownColumns.begin(), kKnownColumns.end(), name) == kKnownColumns.end())
-        fail(path, line_no,
-             "unknown column " + formats::quotedValue(name) + " (expected any of t,gx,gy,gz,temp,wx,wy,wz)");
-      for (std::size_t j = 0; j < roles.size(); ++j)
-        if (names[j] == name) fail(path, line_no, "column '" + std::string(name) + "' appears twice");
-      if (name == "t") {
-        roles.push_back({Role::T, 0});
-        have_t = true;
-      } else if (name == "temp") {
-        roles.push_back({Role::Temp, 0});
-        have_temp = true;
-      } else if (const auto truth = std::find(kTruthColumns.begin(), kTruthColumns.end(), name);
-                 truth != kTruthColumns.end()) {
-        roles.push_back({Role::Truth, static_cast<std::size_t>(truth - kTruthColumns.begin())});
-      } else {
-        roles.push_back({Role::Axis, rec.axis_names.size()});
-        rec.axis_names.emplace_back(name);
-      }
-    }
-    if (rec.axis_names.empty()) fail(path, line_no, "no gyro column: the header needs at least one of gx,gy,gz");
-    rec.axes.resize(rec.axis_names.size());
-    (void)have_t;
-    (void)have_temp;
+    roles = headerRoles(path, line_no, first, rec);
   }
+  // Where each field's value goes, resolved once; the column's name only for a message.
+  std::vector<std::vector<double>*> targets;
+  targets.reserve(roles.size());
+  for (const auto& [role, index] : roles) {
+    targets.push_back(role == Role::T      ? &rec.t
+                      : role == Role::Temp ? &rec.temp
+                      : role == Role::Axis ? &rec.axes[index]
+                                           : &rec.true_rate[index]);
+  }
+  const auto columnName = [&](std::size_t c) {
+    const auto [role, index] = roles[c];
+    return bare_numbers          ? std::string("value")
+           : role == Role::T     ? std::string("t")
+           : role == Role::Temp  ? std::string("temp")
+           : role == Role::Truth ? std::string(kTruthColumns[index])
+                                 : rec.axis_names[index];
+  };
 
+  bool reserved = false;
+  std::array<std::string_view, kKnownColumns.size()> fields;
   auto consume = [&](std::string_view line) {
-    const auto fields = splitFields(line);
-    if (fields.size() != roles.size()) {
+    if (!reserved) {
+      reserved = true;
+      const std::size_t lines = expectedLines(file.get(), line.size() + 1);
+      for (auto* target : targets) target->reserve(lines);
+      if (options.line_numbers) rec.line_numbers.reserve(lines);
+    }
+    const std::size_t count = splitInto(line, fields);
+    if (count != roles.size()) {
       std::ostringstream s;
-      s << "expected " << roles.size() << " field" << (roles.size() == 1 ? "" : "s") << ", found " << fields.size();
+      s << "expected " << roles.size() << " field" << (roles.size() == 1 ? "" : "s") << ", found " << count;
       fail(path, line_no, s.str());
     }
-    rec.line_numbers.push_back(line_no);
-    for (std::size_t c = 0; c < fields.size(); ++c) {
-      const std::string column = bare_numbers                    ? std::string("value")
-                                 : roles[c].first == Role::T     ? std::string("t")
-                                 : roles[c].first == Role::Temp  ? std::string("temp")
-                                 : roles[c].first == Role::Truth ? std::string(kTruthColumns[roles[c].second])
-                                                                 : rec.axis_names[roles[c].second];
+    const std::size_t sample = rec.size();
+    if (options.line_numbers) rec.line_numbers.push_back(line_no);
+    if (rec.line_runs.empty() ||
+        rec.line_runs.back().first_line + (sample - rec.line_runs.back().first_sample) != line_no)
+      rec.line_runs.push_back({sample, line_no});
+    for (std::size_t c = 0; c < count; ++c) {
       const auto value = parseNumber(fields[c]);
       if (!value)
-        fail(path, line_no, "column '" + column + "': " + formats::quotedValue(fields[c]) + " is not a number");
+        fail(path, line_no, "column '" + columnName(c) + "': " + formats::quotedValue(fields[c]) + " is not a number");
       if (!std::isfinite(*value))
-        fail(path, line_no, "column '" + column + "': non-finite value " + formats::quotedValue(fields[c]));
-      switch (roles[c].first) {
-        case Role::T: rec.t.push_back(*value); break;
-        case Role::Temp: rec.temp.push_back(*value); break;
-        case Role::Axis: rec.axes[roles[c].second].push_back(*value); break;
-        case Role::Truth: rec.true_rate[roles[c].second].push_back(*value); break;
-      }
+        fail(path, line_no, "column '" + columnName(c) + "': non-finite value " + formats::quotedValue(fields[c]));
+      targets[c]->push_back(*value);
     }
   };
 
@@ -157,7 +278,7 @@ Recording readRecordingCsv(const std::string& path) {
       fail(path, line_no, "more than one column in a file of bare numbers (add a header t,gx,gy,gz,temp)");
     consume(line);
   }
-  if (in.bad()) fail(path, line_no, std::string("read error: ") + std::strerror(errno));
+  if (std::ferror(file.get())) fail(path, line_no, std::string("read error: ") + std::strerror(errno));
   if (rec.size() == 0) fail(path, header_line, "no samples after the header");
   return rec;
 }
@@ -170,8 +291,8 @@ double sampleRateFromTimes(const Recording& r) {
     if (!(dt[i - 1] > 0.0)) {
       std::ostringstream s;
       s.precision(17);
-      s << r.path << ':' << (i < r.line_numbers.size() ? r.line_numbers[i] : i + 1)
-        << ": column 't' is not strictly increasing (t = " << r.t[i] << " after " << r.t[i - 1] << ")";
+      s << r.path << ':' << r.lineOfSample(i) << ": column 't' is not strictly increasing (t = " << r.t[i] << " after "
+        << r.t[i - 1] << ")";
       throw RecordingError(s.str());
     }
   }

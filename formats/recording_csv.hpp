@@ -6,6 +6,8 @@
 // (recording_format.hpp) are returned as LostSamples records, and a line that only looks
 // like one (say "# GAP at 12 s") stays an ordinary comment, as every '#' line always was.
 #include <array>
+#include <cstdint>
+#include <functional>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -31,10 +33,19 @@ struct Recording {
   // The truth wx, wy, wz of a simulated recording with motion, per axis; empty when absent
   // (gyrod's recordings never have it: the chip cannot know it).
   std::array<std::vector<double>, 3> true_rate;
-  std::vector<std::size_t> line_numbers;  // file line of each sample, for error messages
-  std::vector<LostSamples> lost;          // the GAP and DROPPED lines, in file order
+  std::vector<std::size_t> line_numbers;  // file line of each sample (empty without ReadOptions::line_numbers)
+  // The same lines, compactly: a run starts wherever a sample's line does not follow the
+  // previous sample's (after the header, a comment, an empty line).
+  struct LineRun {
+    std::size_t first_sample = 0;
+    std::size_t first_line = 0;
+  };
+  std::vector<LineRun> line_runs;
+  std::vector<LostSamples> lost;  // the GAP and DROPPED lines, in file order
   std::size_t size() const { return axes.empty() ? 0 : axes.front().size(); }
   const std::vector<double>* axis(const std::string& name) const;
+  // The file line of sample i, for messages (from line_numbers when kept, else line_runs).
+  std::size_t lineOfSample(std::size_t i) const;
 };
 
 // The gyro columns in axis order: gx is the x axis (0), gy the y axis (1), gz the z axis (2).
@@ -47,8 +58,19 @@ inline constexpr std::string_view kBareNumbersColumn = "x";
 // of a file of bare numbers, which stands for x. nullopt for any other name.
 std::optional<std::size_t> axisOfColumn(std::string_view column);
 
-// Reads and validates the whole file. Throws RecordingError naming file, line and cause.
-Recording readRecordingCsv(const std::string& path);
+// Lines between two calls of ReadOptions::progress.
+inline constexpr std::size_t kProgressLines = std::size_t{1} << 20;
+
+struct ReadOptions {
+  // Fill Recording::line_numbers (8 bytes a sample); lineOfSample() answers without it.
+  bool line_numbers = true;
+  // Called every kProgressLines lines with the lines and bytes read so far.
+  std::function<void(std::size_t lines, std::uint64_t bytes)> progress;
+};
+
+// Reads and validates the whole file in one pass (numbers by std::from_chars, no allocation
+// per line). Throws RecordingError naming file, line and cause.
+Recording readRecordingCsv(const std::string& path, const ReadOptions& options = {});
 
 // Sample rate implied by t: 1 / median spacing. Throws RecordingError if t is not
 // strictly increasing (naming file and line).

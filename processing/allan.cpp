@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <iomanip>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 
 #include "processing/distributions.hpp"
+#include "processing/parallel_share.hpp"
 
 namespace gyrod::processing {
 namespace {
@@ -61,15 +64,32 @@ class SumOfSquares {
 
 constexpr std::size_t kSumBlock = 4096;
 
+// Two doubles added and multiplied lane by lane (one SSE2 or NEON register): each lane is
+// IEEE arithmetic in the written order, the same as two scalar chains.
+using Lanes = double __attribute__((vector_size(2 * sizeof(double))));
+Lanes loadLanes(const double* p) {
+  Lanes v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+Lanes widenLanes(const float* p) { return Lanes{p[0], p[1]}; }
+
 // The phase (integrated rate, NIST SP 1065 x_k with x₀ = 0 and τ0 = 1 sample) of the
-// mean-removed series, held as an unevaluated double-double sum hi[k] + lo[k]. Removing
-// the mean keeps |x| small (Allan variance is blind to a constant rate); the double-double
-// running sum keeps the integration error at ~ε² of |x| even when x grows quadratically
-// (a rate ramp), so second differences keep full double accuracy.
+// mean-removed series, held as an unevaluated sum hi[k] + lo[k]. Removing the mean keeps
+// |x| small (Allan variance is blind to a constant rate); the running sum is double-double,
+// so its integration error stays at ~ε² of |x| even when x grows quadratically (a rate
+// ramp). lo is stored as a float (12 bytes a point instead of 16): |lo| ≤ ulp(hi)/2, so
+// rounding it costs at most 2⁻²⁴·ulp(hi)/2 ≈ 2⁻⁷⁷·|x|, and a second difference is off by
+// at most 4·2⁻⁷⁷·max|x| (plus its own rounding): for the 10⁷-sample random walk of the
+// tests, max|x| ≈ 10¹⁰·σ gives ≤ 3·10⁻¹³·σ against differences of order σ. (A float lo
+// flushes to zero below ~10⁻⁴⁵, far below any rate a gyro reports.)
 class IntegratedPhase {
  public:
   explicit IntegratedPhase(std::span<const double> rate, const char* where)
-      : rate_count_(rate.size()), mean_(compensatedMean(rate, where)), hi_(rate.size() + 1), lo_(rate.size() + 1) {
+      : rate_count_(rate.size()),
+        mean_(compensatedMean(rate, where)),
+        hi_(std::make_unique_for_overwrite<double[]>(rate.size() + 1)),
+        lo_(std::make_unique_for_overwrite<float[]>(rate.size() + 1)) {
     const double mean = mean_;
     double s_hi = 0.0;
     double s_lo = 0.0;
@@ -86,7 +106,7 @@ class IntegratedPhase {
       s_hi = h + l;
       s_lo = l - (s_hi - h);
       hi_[i + 1] = s_hi;
-      lo_[i + 1] = s_lo;
+      lo_[i + 1] = static_cast<float>(s_lo);
     }
   }
 
@@ -97,9 +117,10 @@ class IntegratedPhase {
   // parts are differenced first (each difference is a window sum, small), then the lo
   // corrections are added.
   double secondDifference(std::size_t i, std::size_t m) const {
-    const double* h = hi_.data();
-    const double* l = lo_.data();
-    return ((h[i + 2 * m] - h[i + m]) - (h[i + m] - h[i])) + ((l[i + 2 * m] - l[i + m]) - (l[i + m] - l[i]));
+    const double* h = hi_.get();
+    const float* l = lo_.get();
+    const double la = l[i], lb = l[i + m], lc = l[i + 2 * m];
+    return ((h[i + 2 * m] - h[i + m]) - (h[i + m] - h[i])) + ((lc - lb) - (lb - la));
   }
 
   // Σ over `count` second differences starting at 0, 0+stride, ... of their squares.
@@ -108,25 +129,92 @@ class IntegratedPhase {
     std::size_t k = 0;
     while (k < count) {
       const std::size_t block_end = std::min(count, k + kSumBlock);
-      double p0 = 0.0, p1 = 0.0, p2 = 0.0, p3 = 0.0;
-      for (; k + 4 <= block_end; k += 4) {
-        const double d0 = secondDifference((k + 0) * stride, m);
-        const double d1 = secondDifference((k + 1) * stride, m);
-        const double d2 = secondDifference((k + 2) * stride, m);
-        const double d3 = secondDifference((k + 3) * stride, m);
-        p0 += d0 * d0;
-        p1 += d1 * d1;
-        p2 += d2 * d2;
-        p3 += d3 * d3;
-      }
-      for (; k < block_end; ++k) {
-        const double d = secondDifference(k * stride, m);
-        p0 += d * d;
-      }
-      total.add((p0 + p1) + (p2 + p3));
+      total.add(stride == 1 ? overlappingBlockTotal(m, k, block_end) : stridedBlockTotal(m, stride, k, block_end));
+      k = block_end;
     }
     return total.total();
   }
+
+  // One block of the overlapping sum, terms [k, block_end): lane j of the four-lane
+  // accumulator takes the terms k + 4q + j, the tail goes to lane 0, and the lanes are
+  // added as (0 + 1) + (2 + 3). Every lane rounds exactly as the scalar expression of
+  // secondDifference() would, so the result does not depend on the vector width.
+  double overlappingBlockTotal(std::size_t m, std::size_t k, std::size_t block_end) const {
+    const double* h = hi_.get();
+    const float* l = lo_.get();
+    Lanes acc01 = {0.0, 0.0};
+    Lanes acc23 = {0.0, 0.0};
+    const auto lanePair = [&](std::size_t i) {
+      const Lanes ha = loadLanes(h + i), hb = loadLanes(h + i + m), hc = loadLanes(h + i + 2 * m);
+      const Lanes la = widenLanes(l + i), lb = widenLanes(l + i + m), lc = widenLanes(l + i + 2 * m);
+      const Lanes d = ((hc - hb) - (hb - ha)) + ((lc - lb) - (lb - la));
+      return d * d;
+    };
+    for (; k + 4 <= block_end; k += 4) {
+      acc01 += lanePair(k);
+      acc23 += lanePair(k + 2);
+    }
+    double p0 = acc01[0];
+    for (; k < block_end; ++k) {
+      const double d = secondDifference(k, m);
+      p0 += d * d;
+    }
+    return (p0 + acc01[1]) + (acc23[0] + acc23[1]);
+  }
+
+  double stridedBlockTotal(std::size_t m, std::size_t stride, std::size_t k, std::size_t block_end) const {
+    double p0 = 0.0, p1 = 0.0, p2 = 0.0, p3 = 0.0;
+    for (; k + 4 <= block_end; k += 4) {
+      const double d0 = secondDifference((k + 0) * stride, m);
+      const double d1 = secondDifference((k + 1) * stride, m);
+      const double d2 = secondDifference((k + 2) * stride, m);
+      const double d3 = secondDifference((k + 3) * stride, m);
+      p0 += d0 * d0;
+      p1 += d1 * d1;
+      p2 += d2 * d2;
+      p3 += d3 * d3;
+    }
+    for (; k < block_end; ++k) {
+      const double d = secondDifference(k * stride, m);
+      p0 += d * d;
+    }
+    return (p0 + p1) + (p2 + p3);
+  }
+
+  // The overlapping variances at every m of `ms` in one cache-blocked sweep: for each block
+  // of kSumBlock start indices, every m reads the phase at the block, m and 2m further on.
+  // For octave m the offsets coincide (2·m_k = m_{k+1}), so the block and the nearer
+  // offsets are still in cache when the next m needs them. The blocks are shared among
+  // threads; each block's total is kept and the totals are added in block order, so the
+  // result is the same bits as the one-m-at-a-time sum, for any number of threads.
+  std::vector<double> overlappingAllanVariances(std::span<const std::size_t> ms) const {
+    const std::size_t block_count = (rate_count_ + kSumBlock - 1) / kSumBlock;
+    std::vector<double> block_totals(ms.size() * block_count, 0.0);
+    const auto sweep = [&](std::size_t first_block, std::size_t end_block) {
+      for (std::size_t b = first_block; b < end_block; ++b) {
+        const std::size_t k = b * kSumBlock;
+        for (std::size_t j = 0; j < ms.size(); ++j) {
+          const std::size_t terms = overlappingTerms(ms[j]);
+          if (k < terms)
+            block_totals[j * block_count + b] = overlappingBlockTotal(ms[j], k, std::min(terms, k + kSumBlock));
+        }
+      }
+    };
+    forEachShare(block_count, sweep);
+    std::vector<double> variances(ms.size(), kNaN);
+    for (std::size_t j = 0; j < ms.size(); ++j) {
+      const std::size_t terms = overlappingTerms(ms[j]);
+      if (terms == 0) continue;
+      SumOfSquares total;
+      for (std::size_t b = 0; b * kSumBlock < terms; ++b) total.add(block_totals[j * block_count + b]);
+      const double md = static_cast<double>(ms[j]);
+      variances[j] = total.total() / (2.0 * md * md * static_cast<double>(terms));
+    }
+    return variances;
+  }
+
+  // M − 2m + 1, or 0 when 2m > M.
+  std::size_t overlappingTerms(std::size_t m) const { return 2 * m > rate_count_ ? 0 : rate_count_ - 2 * m + 1; }
 
   // Non-overlapping: K = ⌊M/m⌋ cluster means, K − 1 differences (paper eq. 2).
   double allanVariance(std::size_t m) const {
@@ -148,8 +236,10 @@ class IntegratedPhase {
  private:
   std::size_t rate_count_;
   double mean_;
-  std::vector<double> hi_;
-  std::vector<double> lo_;
+  // Written once in full by the constructor: not zero-filled first (one pass less over
+  // 12 bytes a point).
+  std::unique_ptr<double[]> hi_;
+  std::unique_ptr<float[]> lo_;
 };
 
 // Lag-1 autocorrelation r1 = Σ (z_i − z̄)(z_{i+1} − z̄) / Σ (z_i − z̄)² and the spread
@@ -182,14 +272,40 @@ int clampAlpha(double alpha) { return static_cast<int>(std::clamp(std::round(alp
 // A level that is numerically constant (spread ≤ 1e-10 of the undifferenced spread:
 // rounding only, e.g. the first difference of a pure ramp) has no correlation to measure;
 // it is taken as ρ = 0, i.e. the series is a polynomial of degree d − 1, α = −2d (clamped).
+int lag1NoiseIdOfAverages(std::vector<double> z);
+
 int lag1NoiseId(std::span<const double> rate, std::size_t m, double mean) {
   const std::size_t n = rate.size() / m;
   std::vector<double> z(n);
-  for (std::size_t k = 0; k < n; ++k) {
+  // Four clusters at a time: four independent addition chains instead of one, each summing
+  // its cluster in the same order as a cluster-by-cluster loop.
+  const double md = static_cast<double>(m);
+  std::size_t k = 0;
+  for (; k + 4 <= n; k += 4) {
+    const double* c = rate.data() + k * m;
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+    for (std::size_t i = 0; i < m; ++i) {
+      s0 += c[i] - mean;
+      s1 += c[i + m] - mean;
+      s2 += c[i + 2 * m] - mean;
+      s3 += c[i + 3 * m] - mean;
+    }
+    z[k] = s0 / md;
+    z[k + 1] = s1 / md;
+    z[k + 2] = s2 / md;
+    z[k + 3] = s3 / md;
+  }
+  for (; k < n; ++k) {
     double s = 0.0;
     for (std::size_t i = k * m; i < (k + 1) * m; ++i) s += rate[i] - mean;
-    z[k] = s / static_cast<double>(m);
+    z[k] = s / md;
   }
+  return lag1NoiseIdOfAverages(std::move(z));
+}
+
+// The lag-1 decision on the averaged series z (consumed: it is differenced in place).
+int lag1NoiseIdOfAverages(std::vector<double> z) {
+  const std::size_t n = z.size();
   constexpr int kMaxDifferences = 2;
   std::size_t len = n;
   double level0_spread = -1.0;
@@ -228,6 +344,70 @@ int identifyWithMean(std::span<const double> rate, std::size_t m, double mean, c
   if (!(va > 0.0 && vb > 0.0)) return 0;  // constant series: σ² = 0, nothing to identify
   const double mu = std::log(vb / va) / std::log(static_cast<double>(m_b) / static_cast<double>(m_a));
   return static_cast<int>(std::clamp(std::round(-mu - 1.0), -2.0, 1.0));
+}
+
+// The lag-1 noise type at every m of a table, each distinct averaging computed once (every
+// m too long for 30 averaged points uses the same one). The cluster sums of power-of-two
+// averagings are formed pairwise from the level below, a different rounding from the
+// one-by-one sum of lag1NoiseId (both within a few ε of the exact sum): the decision
+// differs only for a ρ within ~10⁻¹⁵ of a rounding boundary of α. Empty for a series shorter than kMinAveragedPointsForNoiseId, whose fallback
+// needs the phase. Throws on a non-finite sample.
+std::vector<int> noiseTypesForTable(std::span<const double> rate, std::span<const std::size_t> ms, const char* where) {
+  const double mean = compensatedMean(rate, where);
+  const std::size_t count = rate.size();
+  if (count < kMinAveragedPointsForNoiseId) return {};
+  const auto averaging = [&](std::size_t m) {
+    return count / m >= kMinAveragedPointsForNoiseId ? m : count / kMinAveragedPointsForNoiseId;
+  };
+  std::vector<std::size_t> distinct;
+  for (std::size_t m : ms) distinct.push_back(averaging(m));
+  std::sort(distinct.begin(), distinct.end());
+  distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+  std::vector<int> distinct_alpha(distinct.size());
+  // Powers of two: cluster sums by pairwise addition, level by level (2·count samples read
+  // in all instead of count per averaging); the others averaged directly, on another core.
+  const auto isPowerOfTwo = [](std::size_t m) { return (m & (m - 1)) == 0; };
+  const auto octaveChain = [&] {
+    const std::size_t top = distinct.empty() ? 0 : distinct.back();
+    // The next level is formed before this one is handed to the decision, so that at most
+    // one and a half series' worth of sums is held.
+    std::vector<double> sums(count);
+    for (std::size_t i = 0; i < count; ++i) sums[i] = rate[i] - mean;
+    for (std::size_t m = 1; m <= top; m *= 2) {
+      std::vector<double> next(count / (2 * m));
+      for (std::size_t k = 0; k < next.size(); ++k) next[k] = sums[2 * k] + sums[2 * k + 1];
+      const auto at = std::lower_bound(distinct.begin(), distinct.end(), m);
+      if (at != distinct.end() && *at == m) {
+        const double md = static_cast<double>(m);
+        for (double& v : sums) v /= md;
+        distinct_alpha[static_cast<std::size_t>(at - distinct.begin())] = lag1NoiseIdOfAverages(std::move(sums));
+      }
+      sums = std::move(next);
+    }
+  };
+  std::vector<std::size_t> others;  // indices into distinct
+  for (std::size_t i = 0; i < distinct.size(); ++i)
+    if (!isPowerOfTwo(distinct[i])) others.push_back(i);
+  forEachShare(
+      others.size() + 1,
+      [&](std::size_t first, std::size_t end) {
+        for (std::size_t task = first; task < end; ++task) {
+          if (task == 0) {
+            octaveChain();
+          } else {
+            const std::size_t i = others[task - 1];
+            distinct_alpha[i] = lag1NoiseId(rate, distinct[i], mean);
+          }
+        }
+      },
+      1);
+  std::vector<int> alphas;
+  alphas.reserve(ms.size());
+  for (std::size_t m : ms) {
+    const auto at = std::lower_bound(distinct.begin(), distinct.end(), averaging(m));
+    alphas.push_back(distinct_alpha[static_cast<std::size_t>(at - distinct.begin())]);
+  }
+  return alphas;
 }
 
 }  // namespace
@@ -306,10 +486,7 @@ double overlappingAllanVariance(std::span<const double> rate, std::size_t m) {
 std::vector<double> overlappingAllanVariances(std::span<const double> rate, std::span<const std::size_t> ms) {
   for (std::size_t m : ms) requireClusterSize(m, "overlappingAllanVariances");
   const IntegratedPhase phase(rate, "overlappingAllanVariances");
-  std::vector<double> variances;
-  variances.reserve(ms.size());
-  for (std::size_t m : ms) variances.push_back(phase.overlappingAllanVariance(m));
-  return variances;
+  return phase.overlappingAllanVariances(ms);
 }
 
 int identifyPowerLawNoise(std::span<const double> rate, std::size_t m) {
@@ -383,20 +560,25 @@ std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double
   }
   for (std::size_t m : ms) requireClusterSize(m, "allanDeviationTable");
 
-  const IntegratedPhase phase(rate, "allanDeviationTable");
   const std::size_t count = rate.size();
+  // The noise types first, while only the rate is held (the lag-1 method averages the rate
+  // itself); the phase, twice the rate's size, comes after.
+  const std::vector<int> alphas = noiseTypesForTable(rate, ms, "allanDeviationTable");
+  const IntegratedPhase phase(rate, "allanDeviationTable");
+  const std::vector<double> overlapping = phase.overlappingAllanVariances(ms);
 
   std::vector<AllanPoint> table;
   table.reserve(ms.size());
-  for (std::size_t m : ms) {
+  for (std::size_t j = 0; j < ms.size(); ++j) {
+    const std::size_t m = ms[j];
     AllanPoint p;
     p.m = m;
     p.tau_s = static_cast<double>(m) * tau0_s;
     p.adev = std::sqrt(phase.allanVariance(m));
     p.adev_terms = count / m >= 1 ? count / m - 1 : 0;
-    p.oadev = std::sqrt(phase.overlappingAllanVariance(m));
-    p.oadev_terms = 2 * m <= count ? count - 2 * m + 1 : 0;
-    p.noise_alpha = identifyWithMean(rate, m, phase.mean(), &phase);
+    p.oadev = std::sqrt(overlapping[j]);
+    p.oadev_terms = phase.overlappingTerms(m);
+    p.noise_alpha = alphas.empty() ? identifyWithMean(rate, m, phase.mean(), &phase) : alphas[j];
     if (p.oadev_terms >= 1) {
       p.edf = overlappingAllanEdf(p.noise_alpha, count + 1, m);
       const DeviationInterval interval = allanDeviationConfidenceInterval(p.oadev, p.edf, options.confidence);

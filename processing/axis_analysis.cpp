@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "processing/parallel_share.hpp"
+
 namespace gyrod::processing {
 
 double varianceAboutMean(std::span<const double> x) {
@@ -26,7 +28,37 @@ double peakDeviationFromMean(std::span<const double> x) {
   return peak;
 }
 
+namespace {
+
+// GrossErrorMeanFilter's output over x, in contiguous shares on the cores. Its output is a
+// function of the window's samples in time order only, so a share starting at i0 first feeds
+// its own filter the L − 1 samples before i0 (or all from 0 while the window is filling) and
+// then gives the same bits as one filter run from the start. x is finite (the tests on the
+// raw series have checked it), so no share throws.
+std::vector<double> meanFiltered(std::span<const double> x, std::size_t window, double threshold) {
+  std::vector<double> out(x.size());
+  const GrossErrorMeanFilter validated(window, threshold);  // throws for bad parameters here, not in a thread
+  forEachShare(
+      x.size(),
+      [&](std::size_t first, std::size_t end) {
+        GrossErrorMeanFilter mean(window, threshold);
+        for (std::size_t i = first >= window - 1 ? first - (window - 1) : 0; i < first; ++i) mean.update(x[i]);
+        for (std::size_t i = first; i < end; ++i) out[i] = mean.update(x[i]);
+      },
+      std::size_t{1} << 16);
+  return out;
+}
+
+}  // namespace
+
 AxisAnalysis analyzeAxis(std::span<const double> rate_dps, const AnalysisOptions& options) {
+  return analyzeAxis(std::vector<double>(rate_dps.begin(), rate_dps.end()), options);
+}
+
+// The steps hold at most three series' worth of doubles at once (the series and the
+// Allan phase, twice its size; later the mean-filter output in place of the series):
+// 24 bytes a sample.
+AxisAnalysis analyzeAxis(std::vector<double>&& rate_dps, const AnalysisOptions& options) {
   if (!(options.rate_hz > 0.0) || !std::isfinite(options.rate_hz))
     throw std::invalid_argument("analyzeAxis: rate must be a positive number of Hz");
   const double tau0 = 1.0 / options.rate_hz;
@@ -38,8 +70,8 @@ AxisAnalysis analyzeAxis(std::span<const double> rate_dps, const AnalysisOptions
   a.reverse_arrangements = reverseArrangementsTest(rate_dps, options.reverse_arrangements_segments);
   a.normality = chiSquareNormalityTest(rate_dps);
 
-  // 2. Preprocessing (§3.2.2).
-  std::vector<double> x(rate_dps.begin(), rate_dps.end());
+  // 2. Preprocessing (§3.2.2), in place: the raw series is not needed again.
+  std::vector<double> x = std::move(rate_dps);
   if (options.detrend) a.trend_removed = removeLinearTrend(x, tau0);
 
   // 3. Allan deviation and noise terms (§3.2.3, Table 2).
@@ -48,22 +80,26 @@ AxisAnalysis analyzeAxis(std::span<const double> rate_dps, const AnalysisOptions
   a.noise = fitNoiseTerms(a.allan);
   a.noise_from_slopes = readNoiseTermsFromSlopes(a.allan);
 
-  // 4–6. Mean filter, AR models of its output, Kalman on AR(1) (§4–5).
-  a.filter = identifyFilterChain(x, options.mean_window, options.mean_threshold_dps, options.kalman_overrides);
-  AxisFilterChain chain(a.filter);
-  std::vector<double> mean_filtered(x.size()), kalman_filtered(x.size());
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    const FilteredRate f = chain.update(x[i]);
-    mean_filtered[i] = f.mean_dps;
-    kalman_filtered[i] = f.kalman_dps;
-  }
-  a.ar = yuleWalker(mean_filtered, options.max_ar_order);
+  // 4–6. Mean filter, AR models of its output, Kalman on AR(1) (§4–5). The mean filter runs
+  // once: its output identifies the Kalman and then feeds it, exactly as AxisFilterChain
+  // (mean filter, then Kalman) would on the same series.
+  std::vector<double> filtered = meanFiltered(x, options.mean_window, options.mean_threshold_dps);
+  a.filter = identifyFilterChainFromMeanFiltered(x, filtered, options.mean_window, options.mean_threshold_dps,
+                                                 options.kalman_overrides);
+  a.ar = yuleWalker(filtered, options.max_ar_order);
   a.ar_order_aic = orderByAic(a.ar);
   a.ar_order_bic = orderByBic(a.ar);
   a.steady_state_gain = steadyStateGain(a.filter.kalman.a, a.filter.kalman.q, a.filter.kalman.r);
 
-  a.variance = {varianceAboutMean(x), varianceAboutMean(mean_filtered), varianceAboutMean(kalman_filtered)};
+  a.variance.raw = varianceAboutMean(x);
+  a.variance.mean = varianceAboutMean(filtered);
   const double peak_raw = peakDeviationFromMean(x);
+  x = std::vector<double>();  // the Kalman output takes the mean-filter output's place
+
+  ScalarKalmanFilter kalman(a.filter.kalman);
+  for (double& v : filtered) v = kalman.update(v);
+  const std::vector<double>& kalman_filtered = filtered;
+  a.variance.kalman = varianceAboutMean(kalman_filtered);
   a.peak_ratio = peak_raw > 0.0 ? peakDeviationFromMean(kalman_filtered) / peak_raw : 0.0;
 
   // Table 4: the same Allan analysis on the Kalman output.

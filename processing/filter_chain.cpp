@@ -22,21 +22,26 @@ void AxisFilterChain::reset() {
 FilterChainParameters identifyFilterChain(std::span<const double> rate_dps, std::size_t mean_window,
                                           double mean_threshold_dps, const KalmanOverrides& overrides) {
   GrossErrorMeanFilter mean(mean_window, mean_threshold_dps);
-  if (overrides.a && overrides.q && overrides.r) {  // nothing to identify
-    FilterChainParameters given;
-    given.mean_window = mean_window;
-    given.mean_threshold_dps = mean_threshold_dps;
-    given.kalman = {*overrides.a, *overrides.q, *overrides.r, 0.0, {}};
-    ScalarKalmanFilter validate(given.kalman);
-    return given;
-  }
+  if (overrides.a && overrides.q && overrides.r)
+    return identifyFilterChainFromMeanFiltered({}, {}, mean_window, mean_threshold_dps, overrides);
   std::vector<double> filtered(rate_dps.size());
   for (std::size_t i = 0; i < rate_dps.size(); ++i) filtered[i] = mean.update(rate_dps[i]);
+  return identifyFilterChainFromMeanFiltered(rate_dps, filtered, mean_window, mean_threshold_dps, overrides);
+}
 
+FilterChainParameters identifyFilterChainFromMeanFiltered(std::span<const double> rate_dps,
+                                                          std::span<const double> mean_filtered,
+                                                          std::size_t mean_window, double mean_threshold_dps,
+                                                          const KalmanOverrides& overrides) {
   FilterChainParameters p;
   p.mean_window = mean_window;
   p.mean_threshold_dps = mean_threshold_dps;
-  p.kalman = identifyKalmanParameters(rate_dps, filtered).params;
+  if (overrides.a && overrides.q && overrides.r) {  // nothing to identify
+    p.kalman = {*overrides.a, *overrides.q, *overrides.r, 0.0, {}};
+    ScalarKalmanFilter validate(p.kalman);
+    return p;
+  }
+  p.kalman = identifyKalmanParameters(rate_dps, mean_filtered).params;
   if (overrides.a) p.kalman.a = *overrides.a;
   if (overrides.q) p.kalman.q = *overrides.q;
   if (overrides.r) p.kalman.r = *overrides.r;

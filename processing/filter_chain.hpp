@@ -48,5 +48,11 @@ struct KalmanOverrides {
 // may be anything). Throws std::invalid_argument when the series is too short.
 FilterChainParameters identifyFilterChain(std::span<const double> rate_dps, std::size_t mean_window,
                                           double mean_threshold_dps, const KalmanOverrides& overrides = {});
+// The same from a series and its mean-filter output (GrossErrorMeanFilter(mean_window,
+// mean_threshold_dps) run over it), for a caller that keeps that output anyway.
+FilterChainParameters identifyFilterChainFromMeanFiltered(std::span<const double> rate_dps,
+                                                          std::span<const double> mean_filtered,
+                                                          std::size_t mean_window, double mean_threshold_dps,
+                                                          const KalmanOverrides& overrides = {});
 
 }  // namespace gyrod::processing

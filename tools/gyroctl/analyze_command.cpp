@@ -31,13 +31,25 @@ using nlohmann::json;
 // Fewer samples than this cannot carry the tests (100 reverse-arrangement segments
 // need ≥ 10 samples each to mean anything) nor a useful Allan curve.
 constexpr std::size_t kMinimumSamples = 100;
-AxisAnalysis analyzeColumn(const recording::Recording& rec, std::size_t axis_index, const AnalysisOptions& options) {
+// Consumes the column unless `keep` (the model's calibration reads it again): the analysis
+// then works in the column's own memory.
+AxisAnalysis analyzeColumn(recording::Recording& rec, std::size_t axis_index, const AnalysisOptions& options,
+                           bool keep) {
   try {
-    return analyzeAxis(rec.axes[axis_index], options);
+    if (keep) return analyzeAxis(std::span<const double>(rec.axes[axis_index]), options);
+    return analyzeAxis(std::move(rec.axes[axis_index]), options);
   } catch (const std::invalid_argument& e) {
     throw recording::RecordingError(rec.path + ": column '" + rec.axis_names[axis_index] +
                                     "': " + withoutFunctionName(e.what()));
   }
+}
+
+// Without --write-model the analysis needs only the gyro columns: the others are freed
+// before it starts, so that the peak memory is the analysis's own.
+void releaseColumnsNotAnalysed(recording::Recording& rec) {
+  rec.t = std::vector<double>();
+  rec.temp = std::vector<double>();
+  for (auto& truth : rec.true_rate) truth = std::vector<double>();
 }
 
 struct AnalyzeOptions {
@@ -280,8 +292,19 @@ void calibrateAxisInto(recording::SensorModel& sensor, std::size_t slot, const s
 int runAnalyze(const AnalyzeOptions& opt) {
   // A target that cannot be written fails now, not after the analysis.
   if (!opt.write_model.empty()) formats::checkOutputTarget(opt.write_model, {opt.file});
-  LoadedInput in = loadInput(opt.file, opt.rate_hz, opt.axis);
-  const auto& rec = in.recording;
+  // A progress line left on the terminal would run into an error message: cleared on any exit.
+  struct ClearProgressLine {
+    bool active;
+    ~ClearProgressLine() {
+      if (active) std::fputs("\r\033[K", stderr);
+    }
+  } const clear_progress{stderrIsTerminal()};
+  recording::ReadOptions read;
+  read.line_numbers = false;  // the line runs name any sample's line: 8 bytes a sample saved
+  read.progress = readingProgress(opt.file);
+  LoadedInput in = loadInput(opt.file, opt.rate_hz, opt.axis, read);
+  auto& rec = in.recording;
+  const std::size_t samples = rec.size();
   if (rec.size() < kMinimumSamples) {
     std::ostringstream s;
     s << opt.file << ": " << rec.size() << " samples are too few to analyse (need at least " << kMinimumSamples << ")";
@@ -297,26 +320,37 @@ int runAnalyze(const AnalyzeOptions& opt) {
   for (std::size_t idx : in.axis_indices) requireAnalysableValues(rec, idx);
   const TimingSummary timing = checkTiming(rec, opt.rate_hz);
   reportTiming(opt.file, timing, opt.strict_timing);
+  const bool writes_model = !opt.write_model.empty();
+  if (!writes_model) releaseColumnsNotAnalysed(rec);
   std::vector<AxisAnalysis> analyses;
   analyses.reserve(in.axis_indices.size());
-  for (std::size_t idx : in.axis_indices) analyses.push_back(analyzeColumn(rec, idx, options));
+  const bool show_progress = samples >= kProgressSamples && stderrIsTerminal();
+  for (std::size_t k = 0; k < in.axis_indices.size(); ++k) {
+    const std::size_t idx = in.axis_indices[k];
+    if (show_progress)
+      std::fprintf(stderr, "\ranalysing %s (%zu of %zu)...\033[K", rec.axis_names[idx].c_str(), k + 1,
+                   in.axis_indices.size());
+    analyses.push_back(analyzeColumn(rec, idx, options, writes_model));
+  }
+  if (show_progress) std::fprintf(stderr, "\r\033[K");
 
   json doc;
   doc["file"] = opt.file;
   doc["rate_hz"] = in.rate_hz;
-  doc["samples"] = rec.size();
+  doc["samples"] = samples;
   doc["detrended"] = options.detrend;
   doc["timing"] = timingJson(timing);
   doc["axes"] = json::object();
   if (!opt.json) {
-    std::printf("gyroctl analyze %s: %zu samples at %g Hz (%s), %.1f s%s\n", opt.file.c_str(), rec.size(), in.rate_hz,
-                in.rate_source.c_str(), rec.size() / in.rate_hz,
+    std::printf("gyroctl analyze %s: %zu samples at %g Hz (%s), %.1f s%s\n", opt.file.c_str(), samples, in.rate_hz,
+                in.rate_source.c_str(), samples / in.rate_hz,
                 options.detrend ? ", constant and linear trend removed" : ", no detrending");
   }
   recording::SensorModel sensor;
   SimulationModel& model = sensor.simulation;
   model.rate_hz = in.rate_hz;
-  const std::vector<double> secs = recording::secondsFromStart(rec, in.rate_hz);
+  // Only the model needs the times and the temperature (released otherwise).
+  const std::vector<double> secs = writes_model ? recording::secondsFromStart(rec, in.rate_hz) : std::vector<double>();
   if (!rec.temp.empty()) model.temperature = fitExponentialWarmUp(secs, rec.temp);
   sensor.filter = recording::FilterModel{};
   sensor.filter->mean_window = opt.mean_window;

@@ -1,6 +1,7 @@
 #include "tools/gyroctl/input.hpp"
 
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cmath>
@@ -11,7 +12,8 @@
 
 namespace gyrod::gyroctl {
 
-LoadedInput loadInput(const std::string& path, std::optional<double> rate_hz, const std::string& axis) {
+LoadedInput loadInput(const std::string& path, std::optional<double> rate_hz, const std::string& axis,
+                      const recording::ReadOptions& read) {
   LoadedInput in;
   if (rate_hz && !(std::isfinite(*rate_hz) && *rate_hz > 0.0)) {
     std::ostringstream s;
@@ -19,7 +21,7 @@ LoadedInput loadInput(const std::string& path, std::optional<double> rate_hz, co
     throw std::invalid_argument(s.str());
   }
   requireNotADirectory(path);
-  in.recording = recording::readRecordingCsv(path);
+  in.recording = recording::readRecordingCsv(path, read);
   const auto& rec = in.recording;
   if (!rec.t.empty()) {
     const double from_t = recording::sampleRateFromTimes(rec);
@@ -55,6 +57,21 @@ LoadedInput loadInput(const std::string& path, std::optional<double> rate_hz, co
     }
   }
   return in;
+}
+
+bool stderrIsTerminal() { return ::isatty(STDERR_FILENO) == 1; }
+
+std::function<void(std::size_t, std::uint64_t)> readingProgress(const std::string& path) {
+  if (!stderrIsTerminal()) return {};
+  struct stat st {};
+  const std::uint64_t total = ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode) ? st.st_size : 0;
+  return [path, total](std::size_t lines, std::uint64_t bytes) {
+    if (total > 0)
+      std::fprintf(stderr, "\rreading %s: %.0f %% (%.1f M lines)\033[K", path.c_str(),
+                   100.0 * static_cast<double>(bytes) / static_cast<double>(total), static_cast<double>(lines) / 1e6);
+    else
+      std::fprintf(stderr, "\rreading %s: %.1f M lines\033[K", path.c_str(), static_cast<double>(lines) / 1e6);
+  };
 }
 
 void requireNotADirectory(const std::string& path) {

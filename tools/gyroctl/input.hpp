@@ -1,5 +1,7 @@
 #pragma once
 // Loading a recording for an offline command: read, pick axes, settle the sample rate.
+#include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -17,7 +19,17 @@ struct LoadedInput {
 
 // rate: from --rate when given; must agree with the t column (1 % tolerance) if present.
 // axis: "all" or a column name. Throws RecordingError naming the file and the problem.
-LoadedInput loadInput(const std::string& path, std::optional<double> rate_hz, const std::string& axis);
+// `read` passes on to readRecordingCsv (line numbers kept or not, progress).
+LoadedInput loadInput(const std::string& path, std::optional<double> rate_hz, const std::string& axis,
+                      const recording::ReadOptions& read = {});
+
+// Progress on stderr for long inputs, only when stderr is a terminal (a log or a pipe gets
+// nothing): from kProgressSamples samples on, as the reading and the analysis go.
+inline constexpr std::size_t kProgressSamples = std::size_t{1} << 20;
+bool stderrIsTerminal();
+// "reading FILE: 37 % (4.2 M lines)" as readRecordingCsv reports; empty when stderr is not
+// a terminal.
+std::function<void(std::size_t, std::uint64_t)> readingProgress(const std::string& path);
 
 // Refuses a directory as an input file, saying so (reading one would look like an empty
 // file). FIFOs and devices stay readable: `analyze /dev/stdin` works.

@@ -8,10 +8,6 @@
 namespace gyrod::gyroctl {
 namespace {
 
-std::size_t lineOfSample(const recording::Recording& rec, std::size_t i) {
-  return i < rec.line_numbers.size() ? rec.line_numbers[i] : i + 1;
-}
-
 const char* lostKindName(recording::LostSamples::Kind kind) {
   return kind == recording::LostSamples::Kind::Gap ? "GAP" : "DROPPED";
 }
@@ -55,7 +51,7 @@ void requireAnalysableValues(const recording::Recording& rec, std::size_t axis_i
   for (std::size_t i = 0; i < values.size(); ++i) {
     if (std::abs(values[i]) <= kLargestAnalysableRateDps) continue;
     std::ostringstream s;
-    s << rec.path << ':' << lineOfSample(rec, i) << ": column '" << rec.axis_names[axis_index] << "': " << values[i]
+    s << rec.path << ':' << rec.lineOfSample(i) << ": column '" << rec.axis_names[axis_index] << "': " << values[i]
       << " deg/s is beyond " << kLargestAnalysableRateDps
       << " deg/s, more than any gyro measures (the statistics would overflow)";
     throw recording::RecordingError(s.str());
@@ -75,7 +71,7 @@ std::string withoutFunctionName(const std::string& message) {
 TimingSummary checkTiming(const recording::Recording& rec, std::optional<double> rate_hz) {
   if (rec.t.empty()) return summarizeTiming(std::nullopt, rec.lost);
   processing::SampleTimingCheck check(rate_hz ? std::optional<double>(1.0 / *rate_hz) : std::nullopt);
-  for (std::size_t i = 0; i < rec.t.size(); ++i) check.add(rec.t[i], lineOfSample(rec, i));
+  for (std::size_t i = 0; i < rec.t.size(); ++i) check.add(rec.t[i], rec.lineOfSample(i));
   return summarizeTiming(check.report(), rec.lost);
 }
 

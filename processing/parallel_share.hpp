@@ -1,0 +1,36 @@
+#pragma once
+// Splitting a loop over [0, count) into contiguous shares run on the machine's cores.
+// Callers write each share's results to their own slots and combine them in index order
+// afterwards, so a result never depends on the number of threads.
+#include <algorithm>
+#include <cstddef>
+#include <thread>
+#include <vector>
+
+namespace gyrod::processing {
+
+// Threads worth starting: the cores, at most kMaxShareThreads (the loops it serves are
+// memory-bound beyond a few cores).
+inline constexpr std::size_t kMaxShareThreads = 4;
+inline std::size_t shareThreadCount() {
+  return std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, kMaxShareThreads);
+}
+
+// Calls body(first, end) for contiguous shares covering [0, count), one per thread, the last
+// share on the calling thread; below `min_per_thread` items per thread it stays on one.
+template <typename Body>
+void forEachShare(std::size_t count, Body&& body, std::size_t min_per_thread = 16) {
+  const std::size_t threads = std::min(shareThreadCount(), std::max<std::size_t>(1, count / min_per_thread));
+  if (threads <= 1) {
+    body(std::size_t{0}, count);
+    return;
+  }
+  std::vector<std::thread> workers;
+  workers.reserve(threads - 1);
+  const auto boundary = [&](std::size_t t) { return count * t / threads; };
+  for (std::size_t t = 0; t + 1 < threads; ++t) workers.emplace_back([&, t] { body(boundary(t), boundary(t + 1)); });
+  body(boundary(threads - 1), count);
+  for (auto& w : workers) w.join();
+}
+
+}  // namespace gyrod::processing
