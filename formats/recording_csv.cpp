@@ -45,7 +45,10 @@ const std::vector<double>* Recording::axis(const std::string& name) const {
 Recording readRecordingCsv(const std::string& path) {
   std::ifstream in(path);
   if (!in) fail(path, 0, std::string("cannot open: ") + std::strerror(errno));
+  return parseRecordingCsv(in, path);
+}
 
+Recording parseRecordingCsv(std::istream& in, const std::string& path) {
   Recording rec;
   rec.path = path;
   BoundedLineReader reader(in);

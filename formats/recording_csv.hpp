@@ -6,6 +6,7 @@
 // (recording_format.hpp) are returned as LostSamples records, and a line that only looks
 // like one (say "# GAP at 12 s") stays an ordinary comment, as every '#' line always was.
 #include <array>
+#include <iosfwd>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -49,6 +50,8 @@ std::optional<std::size_t> axisOfColumn(std::string_view column);
 
 // Reads and validates the whole file. Throws RecordingError naming file, line and cause.
 Recording readRecordingCsv(const std::string& path);
+// The same from a stream already open; `path` names it in messages and in Recording::path.
+Recording parseRecordingCsv(std::istream& in, const std::string& path);
 
 // Sample rate implied by t: 1 / median spacing. Throws RecordingError if t is not
 // strictly increasing (naming file and line).
