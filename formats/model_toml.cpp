@@ -270,6 +270,9 @@ class ModelReader {
         fail(key.source(), "unknown key '" + name + "' in [" + axis + ".kalman] (expected a, q, r)");
       }
     }
+    // A filter without one of them is no filter (R = 0 is refused by the Kalman filter itself).
+    for (const char* needed : {"a", "q", "r"})
+      if (!t.contains(needed)) fail(t.source(), "[" + axis + ".kalman] needs a, q and r (" + needed + " is missing)");
     return k;
   }
 
