@@ -110,7 +110,12 @@ ImucalConversion convertImucal(std::istream& in, const std::string& path, int fs
       s << "expected " << columns.size() << " fields, found " << f.size();
       fail(path, line_no, s.str());
     }
-    std::snprintf(buf, sizeof buf, "%.17g", static_cast<double>(samples) / fs);
+    const double t = static_cast<double>(samples) / fs;
+    if (!std::isfinite(t))  // a rate of 1e-320 Hz reads as positive, but its times overflow
+      fail(path, line_no,
+           "sample rate " + formats::quotedValue(first[1]) + " is too small: t = " + std::to_string(samples) +
+               " / Fs is not a finite number");
+    std::snprintf(buf, sizeof buf, "%.17g", t);
     out += buf;
     for (int a : present) {
       long counts = 0;

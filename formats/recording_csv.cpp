@@ -178,6 +178,12 @@ double sampleRateFromTimes(const Recording& r) {
   }
   auto mid = dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2);
   std::nth_element(dt.begin(), mid, dt.end());
+  if (!std::isfinite(1.0 / *mid)) {  // steps of 1e-320 s are positive, but no rate
+    std::ostringstream s;
+    s.precision(17);
+    s << r.path << ": column 't' steps by " << *mid << " s, too small for a sample rate";
+    throw RecordingError(s.str());
+  }
   return 1.0 / *mid;
 }
 

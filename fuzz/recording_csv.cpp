@@ -43,7 +43,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     checkAccepted(rec);
     if (rec.t.size() >= 2) {
       const double rate_hz = gyrod::recording::sampleRateFromTimes(rec);
-      fuzzCheck(rate_hz > 0.0, "a rate from strictly increasing t is positive");
+      fuzzCheck(rate_hz > 0.0 && std::isfinite(rate_hz), "a rate from strictly increasing t is positive and finite");
     }
   } catch (const gyrod::recording::RecordingError&) {}
   return 0;
