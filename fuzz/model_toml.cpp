@@ -15,7 +15,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string written = gyrod::recording::sensorModelToToml(model);
   try {
     const auto again = gyrod::recording::parseSensorModelToml(written, "written.toml");
-    fuzzCheck(gyrod::recording::sensorModelToToml(again) == written, "a written model reads back the same");
+    const std::string rewritten = gyrod::recording::sensorModelToToml(again);
+    if (rewritten != written)
+      std::fprintf(stderr, "written:\n%s\nread back and written:\n%s\n", written.c_str(), rewritten.c_str());
+    fuzzCheck(rewritten == written, "a written model reads back the same");
   } catch (const gyrod::recording::RecordingError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     fuzzCheck(false, "the model reader accepts what the model writer writes");
