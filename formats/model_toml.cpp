@@ -270,6 +270,9 @@ class ModelReader {
         fail(key.source(), "unknown key '" + name + "' in [" + axis + ".kalman] (expected a, q, r)");
       }
     }
+    // A filter without one of them is no filter (R = 0 is refused by the Kalman filter itself).
+    for (const char* needed : {"a", "q", "r"})
+      if (!t.contains(needed)) fail(t.source(), "[" + axis + ".kalman] needs a, q and r (" + needed + " is missing)");
     return k;
   }
 
@@ -338,6 +341,10 @@ class ModelReader {
  private:
   const formats::TomlDocument& doc_;
 };
+
+// In arrays values are written as %.17g, where -0.0 would be "-0", which TOML reads as the
+// integer 0: write 0 so that the file reads back to what it says (found by fuzz_model_toml).
+double unsignedZero(double v) { return v == 0.0 ? 0.0 : v; }
 
 void appendKeyValue(std::string& out, const std::string& key, double v) {
   char buf[64];
@@ -447,7 +454,7 @@ std::string modelText(const processing::SimulationModel& model, const SensorMode
       out += std::string("\n[") + names[a] + ".ar]\nphi = [";
       for (std::size_t i = 0; i < axis.ar.phi.size(); ++i) {
         char buf[64];
-        std::snprintf(buf, sizeof buf, "%s%.17g", i ? ", " : "", axis.ar.phi[i]);
+        std::snprintf(buf, sizeof buf, "%s%.17g", i ? ", " : "", unsignedZero(axis.ar.phi[i]));
         out += buf;
       }
       out += "]\n";
@@ -466,13 +473,14 @@ std::string modelText(const processing::SimulationModel& model, const SensorMode
       out += "sinusoids = [";
       for (std::size_t i = 0; i < e.sinusoids.size(); ++i) {
         std::snprintf(buf, sizeof buf, "%s{freq_hz = %.17g, amp_dps = %.17g, phase_rad = %.17g}", i ? ", " : "",
-                      e.sinusoids[i].freq_hz, e.sinusoids[i].amp_dps, e.sinusoids[i].phase_rad);
+                      unsignedZero(e.sinusoids[i].freq_hz), unsignedZero(e.sinusoids[i].amp_dps),
+                      unsignedZero(e.sinusoids[i].phase_rad));
         out += buf;
       }
       out += "]\nbias_steps = [";
       for (std::size_t i = 0; i < e.bias_steps.size(); ++i) {
-        std::snprintf(buf, sizeof buf, "%s{time_s = %.17g, size_dps = %.17g}", i ? ", " : "", e.bias_steps[i].time_s,
-                      e.bias_steps[i].size_dps);
+        std::snprintf(buf, sizeof buf, "%s{time_s = %.17g, size_dps = %.17g}", i ? ", " : "",
+                      unsignedZero(e.bias_steps[i].time_s), unsignedZero(e.bias_steps[i].size_dps));
         out += buf;
       }
       out += "]\n";

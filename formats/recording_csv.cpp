@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <istream>
+#include <iterator>
 #include <memory>
 #include <span>
 #include <sstream>
@@ -173,13 +175,13 @@ std::size_t Recording::lineOfSample(std::size_t sample) const {
   return run.first_line + (sample - run.first_sample);
 }
 
-Recording readRecordingCsv(const std::string& path, const ReadOptions& options) {
-  const std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
-  if (!file) fail(path, 0, std::string("cannot open: ") + std::strerror(errno));
+namespace {
 
+// The one reading pass, over an open file (a real file, or a string through fmemopen).
+Recording parseRecordingFile(std::FILE* file, const std::string& path, const ReadOptions& options) {
   Recording rec;
   rec.path = path;
-  ChunkedLineReader reader(file.get(), kMaxLineBytes);
+  ChunkedLineReader reader(file, kMaxLineBytes);
   std::size_t line_no = 0;
   // The next line, trimmed; nullopt at the end. A line past the limit stops the reading.
   const auto nextLine = [&]() -> std::optional<std::string_view> {
@@ -208,7 +210,7 @@ Recording readRecordingCsv(const std::string& path, const ReadOptions& options) 
     if (!skippable(first)) break;
   }
   // A directory opens but cannot be read (EISDIR): that is not an empty file.
-  if (std::ferror(file.get())) fail(path, line_no, std::string("read error: ") + std::strerror(errno));
+  if (std::ferror(file)) fail(path, line_no, std::string("read error: ") + std::strerror(errno));
   if (isSkippable(first)) fail(path, 0, "empty file: no header and no samples");
 
   std::vector<ColumnRole> roles;  // per column: what it feeds, axis index
@@ -245,7 +247,7 @@ Recording readRecordingCsv(const std::string& path, const ReadOptions& options) 
   auto consume = [&](std::string_view line) {
     if (!reserved) {
       reserved = true;
-      const std::size_t lines = expectedLines(file.get(), line.size() + 1);
+      const std::size_t lines = expectedLines(file, line.size() + 1);
       for (auto* target : targets) target->reserve(lines);
       if (options.line_numbers) rec.line_numbers.reserve(lines);
     }
@@ -278,9 +280,26 @@ Recording readRecordingCsv(const std::string& path, const ReadOptions& options) 
       fail(path, line_no, "more than one column in a file of bare numbers (add a header t,gx,gy,gz,temp)");
     consume(line);
   }
-  if (std::ferror(file.get())) fail(path, line_no, std::string("read error: ") + std::strerror(errno));
+  if (std::ferror(file)) fail(path, line_no, std::string("read error: ") + std::strerror(errno));
   if (rec.size() == 0) fail(path, header_line, "no samples after the header");
   return rec;
+}
+
+}  // namespace
+
+Recording readRecordingCsv(const std::string& path, const ReadOptions& options) {
+  const std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
+  if (!file) fail(path, 0, std::string("cannot open: ") + std::strerror(errno));
+  return parseRecordingFile(file.get(), path, options);
+}
+
+Recording parseRecordingCsv(std::istream& in, const std::string& path) {
+  // The stream's bytes through fmemopen: the same reading pass as a file, line limits included.
+  std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  if (text.empty()) fail(path, 0, "empty file: no header and no samples");
+  const std::unique_ptr<std::FILE, FileCloser> file(::fmemopen(text.data(), text.size(), "rb"));
+  if (!file) fail(path, 0, std::string("cannot read: ") + std::strerror(errno));
+  return parseRecordingFile(file.get(), path, ReadOptions{});
 }
 
 double sampleRateFromTimes(const Recording& r) {
@@ -298,6 +317,12 @@ double sampleRateFromTimes(const Recording& r) {
   }
   auto mid = dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2);
   std::nth_element(dt.begin(), mid, dt.end());
+  if (!std::isfinite(1.0 / *mid)) {  // steps of 1e-320 s are positive, but no rate
+    std::ostringstream s;
+    s.precision(17);
+    s << r.path << ": column 't' steps by " << *mid << " s, too small for a sample rate";
+    throw RecordingError(s.str());
+  }
   return 1.0 / *mid;
 }
 

@@ -8,6 +8,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <iosfwd>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -71,6 +72,8 @@ struct ReadOptions {
 // Reads and validates the whole file in one pass (numbers by std::from_chars, no allocation
 // per line). Throws RecordingError naming file, line and cause.
 Recording readRecordingCsv(const std::string& path, const ReadOptions& options = {});
+// The same from a stream already open; `path` names it in messages and in Recording::path.
+Recording parseRecordingCsv(std::istream& in, const std::string& path);
 
 // Sample rate implied by t: 1 / median spacing. Throws RecordingError if t is not
 // strictly increasing (naming file and line).
