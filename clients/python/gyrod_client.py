@@ -3,12 +3,14 @@
     import gyrod_client
     with gyrod_client.Client() as gyro:          # or Client("/tmp/gyrod.sock")
         print(gyro.status()["device_state"])
-        for sample in gyro.watch(decimate=50):
-            print(sample.seq, sample.rate)
+        for item in gyro.watch(decimate=50):
+            if isinstance(item, gyrod_client.Rate):
+                print(item.seq, item.t, item.rate)
 
 `watch()` yields `Rate` and `Gap` objects; `status()` and `allan()` return the reply as a dict.
-Fields and classes this module does not know are ignored, as the protocol asks of clients
-(a minor version may add them); a field gyrod left out (it never sends null) is None here.
+Fields this module does not name are kept in `.fields` and classes it does not know are
+skipped, as the protocol asks of clients (a minor version may add them); a field gyrod left
+out (it never sends null) is None here.
 """
 
 import json

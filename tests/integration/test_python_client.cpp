@@ -1,6 +1,6 @@
 // The Python client module (clients/python/gyrod_client.py) against the real gyrod on the mock:
 // tests/python/check_gyrod_client.py does the checks, run by Debian's /usr/bin/python3 with the
-// module's folder on PYTHONPATH, as installed it is on sys.path.
+// module's folder on PYTHONPATH, as installed it is on sys.path (-B: no __pycache__ in the source tree).
 #include <gtest/gtest.h>
 
 #include <sstream>
@@ -39,8 +39,8 @@ TEST(PythonClient, WatchesStatusAndAllanAgainstGyrodOnTheMock) {
   }
   const auto out = d.path() / "python.out";
   const std::string cmd = "PYTHONPATH='" + (kSourceDir / "clients/python").string() + "' " + python.string() +
-                          " -s -X dev '" + (kSourceDir / "tests/python/check_gyrod_client.py").string() + "' '" + sock +
-                          "' >'" + out.string() + "' 2>&1";
+                          " -B -s -X dev '" + (kSourceDir / "tests/python/check_gyrod_client.py").string() + "' '" +
+                          sock + "' >'" + out.string() + "' 2>&1";
   const int status = std::system(cmd.c_str());
   const std::string output = readWholeFile(out);
   ASSERT_TRUE(WIFEXITED(status)) << output;
