@@ -7,7 +7,7 @@ packages=(
   libeigen3-dev libboost-math-dev nlohmann-json3-dev libcli11-dev libtomlplusplus-dev
   libspdlog-dev libi2c-dev libgpiod-dev libsystemd-dev
   libgtest-dev libbenchmark-dev
-  gnuplot-nox systemd
+  gnuplot-nox systemd python3
   clang-format clang-tidy
 )
 missing=()

@@ -1,15 +1,71 @@
 // gyroctl: offline analysis of gyro recordings and the gyrod client.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <exception>
 #include <iostream>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include "formats/recording_csv.hpp"
 #include "tools/gyroctl/commands.hpp"
 
+#ifndef GYROD_VERSION
+#define GYROD_VERSION "unknown"
+#endif
+
+namespace {
+
+using namespace gyrod::gyroctl;
+
+// Levenshtein distance: how many single-character edits turn `a` into `b`.
+std::size_t editDistance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t substituted = diagonal + (a[i - 1] == b[j - 1] ? 0 : 1);
+      diagonal = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, substituted});
+    }
+  }
+  return row[b.size()];
+}
+
+// The first word that is not an option must name a subcommand (gyroctl has no global option
+// taking a value). CLI11 would only say the argument was "not expected"; this names the word
+// and the nearest command. Returns the message for an unknown command, nullopt otherwise.
+std::optional<std::string> unknownCommandMessage(CLI::App& app, int argc, char** argv) {
+  std::vector<std::string> names;
+  for (const CLI::App* sub : app.get_subcommands({})) names.push_back(sub->get_name());
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view word = argv[i];
+    if (word.empty() || word.front() == '-') continue;
+    if (std::find(names.begin(), names.end(), word) != names.end()) return std::nullopt;
+    std::string message = "gyroctl: unknown command '" + std::string(word) + "'";
+    const auto nearest = std::min_element(names.begin(), names.end(), [&](const auto& x, const auto& y) {
+      return editDistance(word, x) < editDistance(word, y);
+    });
+    // Only a near miss is a suggestion: at most a third of the word's letters differ.
+    if (nearest != names.end() && editDistance(word, *nearest) <= std::max<std::size_t>(2, word.size() / 3))
+      message += "; did you mean '" + *nearest + "'?";
+    std::string all;
+    for (const auto& n : names) all += (all.empty() ? "" : ", ") + n;
+    return message + " (commands: " + all + ")";
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
-  using namespace gyrod::gyroctl;
-  CLI::App app{"gyroctl: analyse MPU6050 gyro recordings and talk to gyrod"};
+  // The name is given, so help and errors say "gyroctl" whatever path it was started by.
+  CLI::App app{"gyroctl: analyse MPU6050 gyro recordings and talk to gyrod", "gyroctl"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("gyroctl ") + GYROD_VERSION);
   CommandRunner run;
   addAnalyzeCommand(app, run);
   addFilterCommand(app, run);
@@ -17,6 +73,10 @@ int main(int argc, char** argv) {
   addSimulateCommand(app, run);
   addClientCommands(app, run);
   addModelCheckCommand(app, run);
+  if (const auto message = unknownCommandMessage(app, argc, argv)) {
+    std::cerr << *message << '\n';
+    return kExitUsage;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
