@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "formats/csv_fields.hpp"
+#include "formats/quoted_value.hpp"
 #include "formats/recording_csv.hpp"
 
 namespace gyrod::recording {
@@ -97,7 +98,7 @@ std::size_t parseAxis(std::string_view kind, std::string_view value) {
   if (value == "x") return 0;
   if (value == "y") return 1;
   if (value == "z") return 2;
-  failText(std::string(kind), "axis must be x, y or z, got '" + std::string(value) + "'");
+  failText(std::string(kind), "axis must be x, y or z, got " + formats::quotedValue(value));
 }
 
 // The factory's message with its parameter names replaced by the keys the user wrote.
@@ -137,7 +138,7 @@ MotionProfile parseProfile(std::string_view term) {
   const std::string_view kind = trimField(term.substr(0, colon));
   const auto rule = std::find_if(kKinds.begin(), kKinds.end(), [&](const KindRule& k) { return k.kind == kind; });
   if (colon == std::string_view::npos || rule == kKinds.end())
-    failText("", "unknown profile '" + std::string(kind) + "' (profiles: " + kindNames() + ")");
+    failText("", "unknown profile " + formats::quotedValue(kind) + " (profiles: " + kindNames() + ")");
   const std::string where(kind);
   std::optional<std::size_t> axis;
   std::vector<std::pair<std::string_view, double>> values;
@@ -146,12 +147,12 @@ MotionProfile parseProfile(std::string_view term) {
     const auto equals = field.find('=');
     const std::string_view key = trimField(field.substr(0, equals));
     if (equals == std::string_view::npos)
-      failText(where, "'" + std::string(field) + "' is not key=value (keys: " + keyNames(*rule) + ")");
+      failText(where, formats::quotedValue(field) + " is not key=value (keys: " + keyNames(*rule) + ")");
     const std::string_view text = trimField(field.substr(equals + 1));
     if (std::none_of(rule->keys.begin(), rule->keys.end(), [&](const KeyRule& k) { return k.key == key; }))
-      failText(where, "unknown key '" + std::string(key) + "' (keys: " + keyNames(*rule) + ")");
+      failText(where, "unknown key " + formats::quotedValue(key) + " (keys: " + keyNames(*rule) + ")");
     if (std::find(seen.begin(), seen.end(), key) != seen.end())
-      failText(where, "key '" + std::string(key) + "' given twice");
+      failText(where, "key " + formats::quotedValue(key) + " given twice");
     seen.push_back(key);
     if (key == "axis") {
       axis = parseAxis(kind, text);
@@ -159,12 +160,12 @@ MotionProfile parseProfile(std::string_view term) {
     }
     const auto number = parseNumber(text);
     if (!number || !std::isfinite(*number))
-      failText(where, std::string(key) + " must be a finite number, got '" + std::string(text) + "'");
+      failText(where, std::string(key) + " must be a finite number, got " + formats::quotedValue(text));
     values.emplace_back(key, *number);
   }
   for (const KeyRule& k : rule->keys)
     if (k.required && std::find(seen.begin(), seen.end(), k.key) == seen.end())
-      failText(where, "missing key '" + std::string(k.key) + "' (keys: " + keyNames(*rule) + ")");
+      failText(where, "missing key " + formats::quotedValue(k.key) + " (keys: " + keyNames(*rule) + ")");
   return buildProfile(*rule, *axis, values);
 }
 
@@ -186,10 +187,10 @@ std::vector<std::size_t> readHeader(const std::string& path, std::size_t line_no
   for (const std::string_view name : splitFields(header)) {
     const auto known = std::find(kMotionColumns.begin(), kMotionColumns.end(), name);
     if (known == kMotionColumns.end())
-      failFile(path, line_no, "unknown column '" + std::string(name) + "' (expected t and any of wx,wy,wz)");
+      failFile(path, line_no, "unknown column " + formats::quotedValue(name) + " (expected t and any of wx,wy,wz)");
     const auto index = static_cast<std::size_t>(known - kMotionColumns.begin());
     if (std::find(columns.begin(), columns.end(), index) != columns.end())
-      failFile(path, line_no, "column '" + std::string(name) + "' appears twice");
+      failFile(path, line_no, "column " + formats::quotedValue(name) + " appears twice");
     columns.push_back(index);
   }
   if (std::find(columns.begin(), columns.end(), 0) == columns.end())
@@ -208,9 +209,10 @@ MotionPoint readRow(const std::string& path, std::size_t line_no, std::string_vi
   for (std::size_t c = 0; c < fields.size(); ++c) {
     const std::string column(kMotionColumns[columns[c]]);
     const auto value = parseNumber(fields[c]);
-    if (!value) failFile(path, line_no, "column '" + column + "': '" + std::string(fields[c]) + "' is not a number");
+    if (!value)
+      failFile(path, line_no, "column '" + column + "': " + formats::quotedValue(fields[c]) + " is not a number");
     if (!std::isfinite(*value))
-      failFile(path, line_no, "column '" + column + "': non-finite value '" + std::string(fields[c]) + "'");
+      failFile(path, line_no, "column '" + column + "': non-finite value " + formats::quotedValue(fields[c]));
     if (columns[c] == 0)
       point.t_s = *value;
     else
@@ -279,8 +281,8 @@ std::vector<double> finiteNumbers(std::string_view text, std::string_view what) 
   for (std::string_view field : splitFields(text)) {
     const auto number = parseNumber(field);
     if (!number || !std::isfinite(*number))
-      throw std::invalid_argument(std::string(what) + ": '" + std::string(field) + "' is not a finite number (in '" +
-                                  std::string(text) + "')");
+      throw std::invalid_argument(std::string(what) + ": " + formats::quotedValue(field) +
+                                  " is not a finite number (in " + formats::quotedValue(text) + ")");
     out.push_back(*number);
   }
   return out;
@@ -290,9 +292,9 @@ std::vector<double> finiteNumbers(std::string_view text, std::string_view what) 
 processing::WarmUp parseWarmUpSpec(std::string_view text) {
   const std::vector<double> v = finiteNumbers(text, "warm-up");
   if (v.size() != 2)
-    throw std::invalid_argument("warm-up: expected DELTA_C,TAU_S (e.g. 15,300), got '" + std::string(text) + "'");
+    throw std::invalid_argument("warm-up: expected DELTA_C,TAU_S (e.g. 15,300), got " + formats::quotedValue(text));
   if (!(v[1] > 0.0))
-    throw std::invalid_argument("warm-up: the time constant TAU_S must be > 0 s, got '" + std::string(text) + "'");
+    throw std::invalid_argument("warm-up: the time constant TAU_S must be > 0 s, got " + formats::quotedValue(text));
   return {v[0], v[1]};
 }
 
@@ -300,8 +302,8 @@ std::array<double, processing::kSimulatedAxes> parseAxisValues(std::string_view 
   const std::vector<double> v = finiteNumbers(text, what);
   if (v.size() == 1) return {v[0], v[0], v[0]};
   if (v.size() == 3) return {v[0], v[1], v[2]};
-  throw std::invalid_argument(std::string(what) + ": expected one value for all axes or three (x,y,z), got '" +
-                              std::string(text) + "'");
+  throw std::invalid_argument(std::string(what) + ": expected one value for all axes or three (x,y,z), got " +
+                              formats::quotedValue(text));
 }
 
 }  // namespace gyrod::recording

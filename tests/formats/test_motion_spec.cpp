@@ -92,6 +92,15 @@ TEST(MotionSpecText, TellsProfilesFromPaths) {
   EXPECT_FALSE(isMotionProfileText("./step:1.csv"));
 }
 
+TEST(MotionSpecText, ErrorsEscapeAndBoundWhatTheyEcho) {
+  // A value from a hostile config or command line reaches the terminal escaped and cut.
+  EXPECT_EQ(textError("step:axis=z,at=5,rate=\x1b[2J"), "motion: step: rate must be a finite number, got '\\x1B[2J'");
+  const std::string long_value(5000, '7');
+  const std::string e = textError("step:axis=z,at=5,rate=" + long_value + "x");
+  EXPECT_LT(e.size(), 200u) << e;
+  EXPECT_NE(e.find("(5001 bytes)"), std::string::npos) << e;
+}
+
 TEST(MotionSpecText, ErrorsNameTheProfileKeyAndValue) {
   EXPECT_EQ(textError("stpe:axis=z,at=5,rate=10"),
             "motion: unknown profile 'stpe' (profiles: step, sine, constant, turns)");
