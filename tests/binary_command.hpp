@@ -2,7 +2,8 @@
 // How a test starts one of the project's binaries (gyrod, gyroctl). A cross build runs its tests
 // under qemu-user and cannot count on binfmt_misc, so the binary must be started through the same
 // emulator: GYROD_TEST_LAUNCHER is CMake's CMAKE_CROSSCOMPILING_EMULATOR (tests/CMakeLists.txt),
-// its words separated by spaces, and empty in a native build.
+// its words separated by spaces (its first an absolute path: execv does not search PATH), and
+// empty in a native build.
 #include <cstdlib>
 #include <sstream>
 #include <string>

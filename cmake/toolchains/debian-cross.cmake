@@ -46,4 +46,9 @@ set(CMAKE_SHARED_LINKER_FLAGS_INIT "${_gyrod_rpath_link}")
 # Test executables run under qemu-user with the sysroot as their root (its ld.so, libc and
 # libraries); gtest_discover_tests and ctest use this, and tests/ hands it to the tests that
 # start gyrod or gyroctl themselves (binfmt_misc is not assumed).
-set(CMAKE_CROSSCOMPILING_EMULATOR ${GYROD_QEMU} -L ${GYROD_SYSROOT})
+# An absolute path: the tests exec it with execv/posix_spawn, which do not search PATH.
+find_program(GYROD_QEMU_PATH ${GYROD_QEMU} NO_CMAKE_FIND_ROOT_PATH)
+if(NOT GYROD_QEMU_PATH)
+  message(FATAL_ERROR "${GYROD_QEMU} not found: apt-get install qemu-user-static")
+endif()
+set(CMAKE_CROSSCOMPILING_EMULATOR ${GYROD_QEMU_PATH} -L ${GYROD_SYSROOT})
