@@ -32,9 +32,7 @@ std::int64_t steadyNowNs() {
 }
 
 std::string utcStamp(std::int64_t unix_seconds, const char* format) {
-  const std::time_t t = static_cast<std::time_t>(unix_seconds);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
+  const std::tm tm = recording::utcCalendarTime(unix_seconds);
   char buf[32];
   const auto n = std::strftime(buf, sizeof buf, format, &tm);
   return std::string(buf, n);

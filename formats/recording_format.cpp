@@ -1,6 +1,7 @@
 #include "formats/recording_format.hpp"
 
 #include <charconv>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <ctime>
@@ -76,11 +77,27 @@ bool isReasonToken(std::string_view s) {
 
 }  // namespace
 
+std::tm utcCalendarTime(std::int64_t unix_seconds) {
+  using namespace std::chrono;
+  const sys_seconds t{seconds{unix_seconds}};
+  const sys_days day = floor<days>(t);
+  const year_month_day date{day};
+  const hh_mm_ss<seconds> time{t - day};
+  std::tm tm{};
+  tm.tm_year = static_cast<int>(date.year()) - 1900;
+  tm.tm_mon = static_cast<int>(static_cast<unsigned>(date.month())) - 1;
+  tm.tm_mday = static_cast<int>(static_cast<unsigned>(date.day()));
+  tm.tm_hour = static_cast<int>(time.hours().count());
+  tm.tm_min = static_cast<int>(time.minutes().count());
+  tm.tm_sec = static_cast<int>(time.seconds().count());
+  tm.tm_wday = static_cast<int>(weekday{day}.c_encoding());
+  tm.tm_yday = static_cast<int>((day - sys_days{date.year() / January / 1}).count());
+  return tm;
+}
+
 std::string recordingHeaderComments(std::int64_t opened_unix_seconds, std::string_view previous_file,
                                     const std::vector<std::string>& comments) {
-  const std::time_t t = static_cast<std::time_t>(opened_unix_seconds);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
+  const std::tm tm = utcCalendarTime(opened_unix_seconds);
   char stamp[32];
   const auto n = std::strftime(stamp, sizeof stamp, "%Y-%m-%dT%H:%M:%SZ", &tm);
   std::string header = "# gyrod recording, opened " + std::string(stamp, n) + "\n";

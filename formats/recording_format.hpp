@@ -16,6 +16,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <ctime>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -25,6 +26,11 @@ namespace gyrod::recording {
 
 // The column line of every file gyrod writes.
 inline constexpr std::string_view kColumnsLine = "t,gx,gy,gz,temp\n";
+
+// The UTC calendar time of `unix_seconds`, as gmtime_r gives it but without time_t, which is
+// 32 bits on 32-bit Debian (armhf, bookworm): there gmtime_r cannot name a time after
+// 2038-01-19T03:14:07Z. For strftime's date and time fields.
+std::tm utcCalendarTime(std::int64_t unix_seconds);
 
 // The comment lines that start a file, up to (not including) kColumnsLine. `previous_file`
 // is the name of the file this one continues after a rotation; empty for none.

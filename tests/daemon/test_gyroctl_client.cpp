@@ -49,8 +49,8 @@ class GyroctlTest : public ServerFixture {
     const auto err_path = dir_.path() / "err.txt";
     const protocol::Fd out(::open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666));
     const protocol::Fd err(::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666));
-    const std::string exe = std::string(GYROD_BIN_DIR) + "/gyroctl";
-    std::vector<std::string> argv_s{exe};
+    std::vector<std::string> argv_s = binaryArgv("gyroctl");
+    const std::string exe = argv_s.front();
     argv_s.insert(argv_s.end(), args.begin(), args.end());
     std::vector<std::string> env_s;
     for (char** e = environ; *e != nullptr; ++e) {

@@ -310,6 +310,11 @@ TEST(Recorder, RotatesByTime) {
   EXPECT_EQ(readRecordingCsv(files[1]).t, std::vector<double>{1.0});
 }
 
+// A 32-bit time_t (armhf, bookworm) cannot hold 2^31 s; the name must not wrap to 1901.
+TEST(Recorder, FileNamesAfter2038OnEveryTarget) {
+  EXPECT_EQ(recordingFileName("gyro", ".csv", std::int64_t{1} << 31, 3), "gyro-20380119T031408Z-000003.csv");
+}
+
 TEST(Recorder, FileNames) {
   // 2025-01-02 03:04:05 UTC = 1735787045 s since the epoch.
   EXPECT_EQ(recordingFileName("gyro", ".csv", 1735787045, 7), "gyro-20250102T030405Z-000007.csv");

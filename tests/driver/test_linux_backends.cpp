@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <string>
 
+#include "binary_command.hpp"
 #include "driver/clock.hpp"
 #include "driver/gpio_data_ready.hpp"
 #include "driver/i2c_messages.hpp"
@@ -53,13 +54,20 @@ TEST(LinuxI2cBus, ANonAdapterIsRefusedBecauseI2cFuncsFails) {
   const int fd = mkstemp(path);
   ASSERT_GE(fd, 0);
   ::close(fd);
+  // qemu-user does not pass I2C_FUNCS to the kernel: it answers ENOSYS itself, where the
+  // kernel answers ENOTTY. That the file is refused, and named, is still checked there.
+  const bool emulated = test::underEmulator();
   for (const std::string& p : {std::string("/dev/null"), std::string(path)}) {
     const I2cBusError e = catchError<I2cBusError>([&] { LinuxI2cBus bus(p); });
-    EXPECT_EQ(e.error(), ENOTTY) << p;
-    EXPECT_TRUE(contains(e.what(), "is not an I2C adapter")) << e.what();
+    EXPECT_EQ(e.error(), emulated ? ENOSYS : ENOTTY) << p;
+    EXPECT_TRUE(contains(e.what(), emulated ? "cannot query the functions of" : "is not an I2C adapter")) << e.what();
     EXPECT_TRUE(contains(e.what(), p)) << e.what();
   }
   ::unlink(path);
+  if (test::underEmulator()) {
+    GTEST_SKIP() << "emulator gap: qemu-user answers I2C_FUNCS with ENOSYS, not the kernel's ENOTTY; "
+                    "the ENOTTY case is checked only on a native run";
+  }
 }
 
 TEST(LinuxI2cBus, PermissionDeniedNamesTheI2cGroup) {

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "formats/recording_csv.hpp"
 #include "formats/recording_format.hpp"
@@ -74,6 +75,21 @@ TEST(RecordingFormat, LinesAreWrittenByteForByte) {
   EXPECT_EQ(reasonCharacter('a'), 'a');
   EXPECT_EQ(reasonCharacter(' '), '_');
   EXPECT_EQ(reasonCharacter(','), '_');
+}
+
+// 32-bit Debian (armhf, bookworm) has a 32-bit time_t: through gmtime_r a date after
+// 2038-01-19T03:14:07Z came out as 1901. The header and the recorder's file names use
+// utcCalendarTime, which takes the int64 seconds as they are.
+TEST(RecordingFormat, DatesAfter2038AreWrittenOnEveryTarget) {
+  EXPECT_EQ(recordingHeaderComments(std::int64_t{1} << 31, "", {}), "# gyrod recording, opened 2038-01-19T03:14:08Z\n");
+  EXPECT_EQ(recordingHeaderComments(4102531199, "", {}), "# gyrod recording, opened 2100-01-01T23:59:59Z\n");
+  const std::tm leap = utcCalendarTime(951782400);  // 2000-02-29, a Tuesday
+  EXPECT_EQ(std::vector<int>({leap.tm_year, leap.tm_mon, leap.tm_mday, leap.tm_hour, leap.tm_wday, leap.tm_yday}),
+            std::vector<int>({100, 1, 29, 0, 2, 59}));
+  const std::tm before_epoch = utcCalendarTime(-1);  // 1969-12-31T23:59:59, a Wednesday
+  EXPECT_EQ(std::vector<int>({before_epoch.tm_year, before_epoch.tm_mon, before_epoch.tm_mday, before_epoch.tm_hour,
+                              before_epoch.tm_min, before_epoch.tm_sec, before_epoch.tm_wday, before_epoch.tm_yday}),
+            std::vector<int>({69, 11, 31, 23, 59, 59, 3, 364}));
 }
 
 TEST(RecordingFormat, TheLongestLinesFit) {

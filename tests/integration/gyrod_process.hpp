@@ -15,6 +15,8 @@
 #include <thread>
 #include <vector>
 
+#include "binary_command.hpp"
+
 namespace gyrod::test {
 
 class GyrodProcess {
@@ -29,7 +31,7 @@ class GyrodProcess {
       ::dup2(fd, 1);
       ::dup2(fd, 2);
       if (in_child) in_child();
-      std::vector<std::string> all = {std::string(GYROD_BIN_DIR) + "/gyrod"};
+      std::vector<std::string> all = binaryArgv("gyrod");
       all.insert(all.end(), args.begin(), args.end());
       std::vector<char*> argv;
       for (auto& a : all) argv.push_back(a.data());

@@ -3,8 +3,10 @@
 // directly from IEEE 952 Table 1 (not through noise_terms.cpp).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <stdexcept>
@@ -18,6 +20,11 @@ using namespace gyrod::processing;
 namespace {
 
 constexpr double kTau0 = 0.02;  // 50 Hz, as in the paper
+
+// The term count of every exact-curve point: 2^40 where size_t holds it, 2^31 on a 32-bit
+// target (std::size_t{1} << 40 is undefined there and made every point unusable).
+constexpr std::size_t kManyTerms = std::size_t{1} << std::min(40, std::numeric_limits<std::size_t>::digits - 1);
+constexpr std::size_t kLargestExactM = std::size_t{1} << 22;
 
 // σ(τ) in °/s of each Table 1 term, τ in s, values in the paper's units.
 double sigmaQuantization(double q_urad, double tau) {
@@ -40,12 +47,12 @@ double exactVariance(const NoiseTerms& t, double tau) {
 // that the fit's cap of edf at the frequency-noise value never binds.
 std::vector<AllanPoint> exactCurve(const NoiseTerms& terms, double edf = 100.0) {
   std::vector<AllanPoint> curve;
-  for (std::size_t m = 1; m <= (std::size_t{1} << 22); m *= 2) {
+  for (std::size_t m = 1; m <= kLargestExactM; m *= 2) {
     AllanPoint p;
     p.m = m;
     p.tau_s = static_cast<double>(m) * kTau0;
     p.oadev = std::sqrt(exactVariance(terms, p.tau_s));
-    p.oadev_terms = std::size_t{1} << 40;
+    p.oadev_terms = kManyTerms;
     p.edf = edf;
     curve.push_back(p);
   }
@@ -163,9 +170,24 @@ TEST(NoiseFit, UncertaintyShrinksAsOneOverRootEdf) {
   }
 }
 
+// The helper's promise, on every target: each point is usable and its edf (up to 400 in these
+// tests) stays below the fit's frequency-noise cap, so the cap never changes a weight. On
+// armhf the old 2^40 term count did not fit in size_t, and this test failed with the fits.
+TEST(NoiseFit, ExactCurvePointsAreUsableAndBelowTheEdfCapOnEveryTarget) {
+  const auto curve = exactCurve(visibleTerms(), 400.0);
+  ASSERT_EQ(curve.size(), 23u);
+  for (const AllanPoint& p : curve) {
+    ASSERT_GE(p.oadev_terms, kLargestExactM) << "m = " << p.m;
+    double cap = 0.0;
+    for (int alpha : {0, -1, -2}) cap = std::max(cap, overlappingAllanEdf(alpha, p.oadev_terms + 2 * p.m, p.m));
+    EXPECT_GT(cap, 400.0) << "m = " << p.m;
+  }
+  EXPECT_NO_THROW(fitNoiseTerms(curve, kManyTerms));
+}
+
 TEST(NoiseFit, BadCurvesThrow) {
   auto curve = exactCurve(visibleTerms());
-  EXPECT_THROW(fitNoiseTerms(curve, (std::size_t{1} << 40) + 1),
+  EXPECT_THROW(fitNoiseTerms(curve, kManyTerms + 1),
                std::invalid_argument);  // no point has that many terms
   curve[3].edf = std::nan("");
   EXPECT_THROW(fitNoiseTerms(curve), std::invalid_argument);

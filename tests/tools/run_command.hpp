@@ -10,6 +10,8 @@
 #include <sstream>
 #include <string>
 
+#include "binary_command.hpp"
+
 namespace gyrod::test {
 
 struct CommandResult {
@@ -29,8 +31,8 @@ inline std::string readWholeFile(const std::filesystem::path& p) {
 inline CommandResult runGyroctl(const std::string& args, const std::filesystem::path& scratch) {
   const auto out_path = scratch / "stdout.txt";
   const auto err_path = scratch / "stderr.txt";
-  const std::string cmd = std::string(GYROD_BIN_DIR) + "/gyroctl " + args + " >" + out_path.string() + " 2>" +
-                          err_path.string() + " </dev/null";
+  const std::string cmd =
+      binaryShellCommand("gyroctl") + " " + args + " >" + out_path.string() + " 2>" + err_path.string() + " </dev/null";
   const int status = std::system(cmd.c_str());
   CommandResult r;
   r.exit_status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);

@@ -26,6 +26,7 @@
 extern char** environ;
 
 namespace fs = std::filesystem;
+using gyrod::test::binaryArgv;
 using gyrod::test::readWholeFile;
 using gyrod::test::runGyroctl;
 using gyrod::test::ScratchDir;
@@ -210,7 +211,7 @@ TEST(GyroctlOutputFiles, AnExistingFileKeepsItsModeAndANewOneIs0644LessTheUmask)
 namespace {
 
 pid_t spawnGyroctl(const std::vector<std::string>& args, const fs::path& log) {
-  std::vector<std::string> argv_text = {std::string(GYROD_BIN_DIR) + "/gyroctl"};
+  std::vector<std::string> argv_text = binaryArgv("gyroctl");
   argv_text.insert(argv_text.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (auto& a : argv_text) argv.push_back(a.data());
