@@ -118,8 +118,9 @@ fi
 systemctl stop gyrod.service
 if timeout 30 systemctl start gyrod.socket && [ "$(systemctl is-active gyrod.service)" = inactive ]; then
   t=$(uptime_s)
+  # The journal may get gyrod's line after the client its reply: waited for, not raced.
   if status=$(timeout 120 gyroctl status --socket $sock --json) && [ "$(systemctl is-active gyrod.service)" = active ] &&
-    journal gyrod.service | grep -q "using the socket passed by systemd"; then
+    wait_for 30 sh -c 'journalctl -b -o cat --no-pager -u gyrod.service | grep -q "using the socket passed by systemd"'; then
     pass socket-activation "gyroctl status started gyrod in $(since "$t") s: $(journal gyrod.service | grep 'socket passed by systemd' | tail -n1 | cut -c1-120); $(stat -c '%U:%G %a' $sock)"
   else
     fail socket-activation "gyroctl status: ${status:0:200}; gyrod.service $(systemctl is-active gyrod.service)"
