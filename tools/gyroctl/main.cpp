@@ -8,6 +8,7 @@
 #include <string_view>
 #include <vector>
 
+#include "formats/edit_distance.hpp"
 #include "formats/recording_csv.hpp"
 #include "tools/gyroctl/commands.hpp"
 
@@ -18,22 +19,7 @@
 namespace {
 
 using namespace gyrod::gyroctl;
-
-// Levenshtein distance: how many single-character edits turn `a` into `b`.
-std::size_t editDistance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t substituted = diagonal + (a[i - 1] == b[j - 1] ? 0 : 1);
-      diagonal = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, substituted});
-    }
-  }
-  return row[b.size()];
-}
+using gyrod::formats::editDistance;
 
 // The first word that is not an option must name a subcommand (gyroctl has no global option
 // taking a value). CLI11 would only say the argument was "not expected"; this names the word
