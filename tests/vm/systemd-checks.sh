@@ -118,8 +118,11 @@ fi
 systemctl stop gyrod.service
 if timeout 30 systemctl start gyrod.socket && [ "$(systemctl is-active gyrod.service)" = inactive ]; then
   t=$(uptime_s)
-  # The journal may get gyrod's line after the client its reply: waited for, not raced.
-  if status=$(timeout 120 gyroctl status --socket $sock --json) && [ "$(systemctl is-active gyrod.service)" = active ] &&
+  # gyrod answers the client that started it before it reports READY=1 (the unit is still
+  # "activating"), and the journal may get its line after the client its reply: both waited
+  # for, not raced.
+  if status=$(timeout 120 gyroctl status --socket $sock --json) &&
+    wait_for 30 sh -c '[ "$(systemctl is-active gyrod.service)" = active ]' &&
     wait_for 30 sh -c 'journalctl -b -o cat --no-pager -u gyrod.service | grep -q "using the socket passed by systemd"'; then
     pass socket-activation "gyroctl status started gyrod in $(since "$t") s: $(journal gyrod.service | grep 'socket passed by systemd' | tail -n1 | cut -c1-120); $(stat -c '%U:%G %a' $sock)"
   else
