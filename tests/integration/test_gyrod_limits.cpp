@@ -190,7 +190,10 @@ TEST(GyrodLimits, TheRecorderKeepsUpWithTheMockAtFiftyTimesRealTime) {
   std::this_thread::sleep_for(4000ms);  // ~10000 samples
   const json status = statusOf(c);
   gyrod.signal(SIGTERM);
-  EXPECT_EQ(gyrod.waitExit(3000ms), std::optional<int>(0));
+  // What is tested is the recorder's accounting, not how fast gyrod stops (Gyrod.StreamFilterAndAllan… asks for 1 s):
+  // the wait is generous, as gyrod did not exit within 3 s once on a host loaded by a parallel
+  // build and QEMU (not seen again in repeated runs; the shutdown line was never logged).
+  EXPECT_EQ(gyrod.waitExit(10000ms), std::optional<int>(0));
   ASSERT_TRUE(status.contains("recorder")) << status.dump();
   EXPECT_GT(status["samples"].get<std::uint64_t>(), 5000u);
   EXPECT_EQ(status["recorder"]["dropped"].get<std::uint64_t>(), 0u) << status.dump();
