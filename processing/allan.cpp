@@ -2,13 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <iomanip>
 #include <limits>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
 
+#include "processing/allan_kernels.hpp"
 #include "processing/distributions.hpp"
 #include "processing/parallel_share.hpp"
 
@@ -64,15 +64,18 @@ class SumOfSquares {
 
 constexpr std::size_t kSumBlock = 4096;
 
-// Two doubles added and multiplied lane by lane (one SSE2 or NEON register): each lane is
-// IEEE arithmetic in the written order, the same as two scalar chains.
-using Lanes = double __attribute__((vector_size(2 * sizeof(double))));
-Lanes loadLanes(const double* p) {
-  Lanes v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
+// Runs of the phase's running sum (IntegratedPhase::integrate): long enough that the
+// per-run work is negligible, short enough for both cores on a 10⁵-sample series.
+constexpr std::size_t kPhaseRun = std::size_t{1} << 13;
+
+// a + b for double-double a, b (TwoSum of the high parts, the low parts added, renormalised).
+allan_kernels::PhaseState doubleDoubleSum(allan_kernels::PhaseState a, allan_kernels::PhaseState b) {
+  const double s = a.hi + b.hi;
+  const double bb = s - a.hi;
+  const double e = ((a.hi - (s - bb)) + (b.hi - bb)) + (a.lo + b.lo);
+  const double hi = s + e;
+  return {hi, e - (hi - s)};
 }
-Lanes widenLanes(const float* p) { return Lanes{p[0], p[1]}; }
 
 // The phase (integrated rate, NIST SP 1065 x_k with x₀ = 0 and τ0 = 1 sample) of the
 // mean-removed series, held as an unevaluated sum hi[k] + lo[k]. Removing the mean keeps
@@ -90,24 +93,9 @@ class IntegratedPhase {
         mean_(compensatedMean(rate, where)),
         hi_(std::make_unique_for_overwrite<double[]>(rate.size() + 1)),
         lo_(std::make_unique_for_overwrite<float[]>(rate.size() + 1)) {
-    const double mean = mean_;
-    double s_hi = 0.0;
-    double s_lo = 0.0;
     hi_[0] = 0.0;
     lo_[0] = 0.0;
-    for (std::size_t i = 0; i < rate.size(); ++i) {
-      const double v = rate[i] - mean;
-      // TwoSum(s_hi, v): exact h + e.
-      const double h = s_hi + v;
-      const double bv = h - s_hi;
-      const double e = (s_hi - (h - bv)) + (v - bv);
-      const double l = s_lo + e;
-      // FastTwoSum renormalisation (|h| ≥ |l|).
-      s_hi = h + l;
-      s_lo = l - (s_hi - h);
-      hi_[i + 1] = s_hi;
-      lo_[i + 1] = static_cast<float>(s_lo);
-    }
+    integrate(rate);
   }
 
   std::size_t rateCount() const { return rate_count_; }
@@ -135,31 +123,10 @@ class IntegratedPhase {
     return total.total();
   }
 
-  // One block of the overlapping sum, terms [k, block_end): lane j of the four-lane
-  // accumulator takes the terms k + 4q + j, the tail goes to lane 0, and the lanes are
-  // added as (0 + 1) + (2 + 3). Every lane rounds exactly as the scalar expression of
-  // secondDifference() would, so the result does not depend on the vector width.
+  // One block of the overlapping sum, terms [k, block_end) (allan_kernels: the same bits
+  // on every ISA).
   double overlappingBlockTotal(std::size_t m, std::size_t k, std::size_t block_end) const {
-    const double* h = hi_.get();
-    const float* l = lo_.get();
-    Lanes acc01 = {0.0, 0.0};
-    Lanes acc23 = {0.0, 0.0};
-    const auto lanePair = [&](std::size_t i) {
-      const Lanes ha = loadLanes(h + i), hb = loadLanes(h + i + m), hc = loadLanes(h + i + 2 * m);
-      const Lanes la = widenLanes(l + i), lb = widenLanes(l + i + m), lc = widenLanes(l + i + 2 * m);
-      const Lanes d = ((hc - hb) - (hb - ha)) + ((lc - lb) - (lb - la));
-      return d * d;
-    };
-    for (; k + 4 <= block_end; k += 4) {
-      acc01 += lanePair(k);
-      acc23 += lanePair(k + 2);
-    }
-    double p0 = acc01[0];
-    for (; k < block_end; ++k) {
-      const double d = secondDifference(k, m);
-      p0 += d * d;
-    }
-    return (p0 + acc01[1]) + (acc23[0] + acc23[1]);
+    return allan_kernels::overlappingBlockTotal(hi_.get(), lo_.get(), m, k, block_end);
   }
 
   double stridedBlockTotal(std::size_t m, std::size_t stride, std::size_t k, std::size_t block_end) const {
@@ -211,6 +178,50 @@ class IntegratedPhase {
       variances[j] = total.total() / (2.0 * md * md * static_cast<double>(terms));
     }
     return variances;
+  }
+
+  // The running sum in fixed runs of kPhaseRun samples: every run's double-double total
+  // (pass 1), the runs' starting sums by double-double addition of the totals before them
+  // (pass 2), then every run's running sum from its start (pass 3). Passes 1 and 3 take
+  // four runs at once, one per lane, and share the runs among threads. The run length is
+  // fixed, so the phase is the same bits for any number of threads and any ISA; it differs
+  // from one serial running sum only by the error of the double-double additions
+  // (~ε²·|x| each, far below the float lo's 2⁻⁷⁷·|x|).
+  void integrate(std::span<const double> rate) {
+    using allan_kernels::PhaseState;
+    const std::size_t count = rate.size();
+    const std::size_t runs = (count + kPhaseRun - 1) / kPhaseRun;
+    std::vector<PhaseState> totals(runs), starts(runs);
+    forEachRunGroup(rate, totals, false);
+    for (std::size_t r = 1; r < runs; ++r) starts[r] = doubleDoubleSum(starts[r - 1], totals[r - 1]);
+    forEachRunGroup(rate, starts, true);
+  }
+
+  // Runs r·kPhaseRun … of the rate from the states given (updated to the runs' ends),
+  // writing the phase when `store`: groups of four full runs through the four-lane kernel,
+  // the others (the last, shorter run among them) one by one.
+  void forEachRunGroup(std::span<const double> rate, std::vector<allan_kernels::PhaseState>& states, bool store) {
+    using allan_kernels::kPhaseLanes;
+    const std::size_t full_runs = rate.size() / kPhaseRun;
+    const std::size_t groups = full_runs / kPhaseLanes;
+    const std::size_t singles = states.size() - groups * kPhaseLanes;
+    forEachShare(
+        groups + singles,
+        [&](std::size_t first, std::size_t end) {
+          for (std::size_t task = first; task < end; ++task) {
+            const std::size_t run = task < groups ? task * kPhaseLanes : groups * kPhaseLanes + (task - groups);
+            const std::size_t begin = run * kPhaseRun;
+            double* hi = store ? hi_.get() + 1 + begin : nullptr;
+            float* lo = store ? lo_.get() + 1 + begin : nullptr;
+            if (task < groups) {
+              allan_kernels::integrateRuns(rate.data() + begin, mean_, kPhaseRun, kPhaseRun, &states[run], hi, lo);
+            } else {
+              const std::size_t length = std::min(kPhaseRun, rate.size() - begin);
+              allan_kernels::integrateRun(rate.data() + begin, mean_, length, states[run], hi, lo);
+            }
+          }
+        },
+        4);
   }
 
   // M − 2m + 1, or 0 when 2m > M.

@@ -1,0 +1,123 @@
+#include "processing/allan_kernels.hpp"
+
+#include <cstring>
+
+// One clone per ISA where the compiler can dispatch at load time (x86-64 ELF); elsewhere
+// (arm64, armhf, sanitizer builds that lack ifunc) the one portable build.
+#if defined(__x86_64__) && defined(__ELF__) && defined(__has_attribute) && !defined(GYROD_NO_TARGET_CLONES)
+#if __has_attribute(target_clones)
+#define GYROD_ISA_CLONES __attribute__((target_clones("avx2", "default")))
+#endif
+#endif
+#ifndef GYROD_ISA_CLONES
+#define GYROD_ISA_CLONES
+#endif
+
+// The four-lane helpers below are inlined into the clones; no vector crosses an ABI
+// boundary, so GCC's note that a 32-byte vector argument would change the ABI without AVX
+// does not apply.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
+
+namespace gyrod::processing::allan_kernels {
+namespace {
+
+// Four doubles (floats) operated on lane by lane: one AVX2 register, or two SSE2/NEON ones.
+// Each lane is IEEE arithmetic in the written order, the same as a scalar chain.
+using Doubles4 = double __attribute__((vector_size(4 * sizeof(double))));
+using Floats4 = float __attribute__((vector_size(4 * sizeof(float))));
+
+inline Doubles4 loadDoubles(const double* p) {
+  Doubles4 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline Doubles4 loadWidened(const float* p) {
+  Floats4 v;
+  std::memcpy(&v, p, sizeof v);
+  return __builtin_convertvector(v, Doubles4);
+}
+
+inline double secondDifference(const double* h, const float* l, std::size_t i, std::size_t m) {
+  const double la = l[i], lb = l[i + m], lc = l[i + 2 * m];
+  return ((h[i + 2 * m] - h[i + m]) - (h[i + m] - h[i])) + ((lc - lb) - (lb - la));
+}
+
+inline Doubles4 squaredSecondDifferences(const double* h, const float* l, std::size_t i, std::size_t m) {
+  const Doubles4 ha = loadDoubles(h + i), hb = loadDoubles(h + i + m), hc = loadDoubles(h + i + 2 * m);
+  const Doubles4 la = loadWidened(l + i), lb = loadWidened(l + i + m), lc = loadWidened(l + i + 2 * m);
+  const Doubles4 d = ((hc - hb) - (hb - ha)) + ((lc - lb) - (lb - la));
+  return d * d;
+}
+
+// One step of the double-double running sum: TwoSum(s_hi, v), then FastTwoSum renormalisation.
+template <typename T>
+inline void accumulate(T& s_hi, T& s_lo, T v) {
+  const T h = s_hi + v;
+  const T bv = h - s_hi;
+  const T e = (s_hi - (h - bv)) + (v - bv);
+  const T l = s_lo + e;
+  s_hi = h + l;
+  s_lo = l - (s_hi - h);
+}
+
+}  // namespace
+
+GYROD_ISA_CLONES
+double overlappingBlockTotal(const double* hi, const float* lo, std::size_t m, std::size_t k, std::size_t block_end) {
+  Doubles4 acc = {0.0, 0.0, 0.0, 0.0};
+  // Two groups of four per step: both are computed independently, then added in order.
+  for (; k + 8 <= block_end; k += 8) {
+    const Doubles4 first = squaredSecondDifferences(hi, lo, k, m);
+    const Doubles4 second = squaredSecondDifferences(hi, lo, k + 4, m);
+    acc += first;
+    acc += second;
+  }
+  for (; k + 4 <= block_end; k += 4) acc += squaredSecondDifferences(hi, lo, k, m);
+  double p0 = acc[0];
+  for (; k < block_end; ++k) {
+    const double d = secondDifference(hi, lo, k, m);
+    p0 += d * d;
+  }
+  return (p0 + acc[1]) + (acc[2] + acc[3]);
+}
+
+GYROD_ISA_CLONES
+void integrateRuns(const double* rate, double mean, std::size_t run_stride, std::size_t count, PhaseState* states,
+                   double* hi, float* lo) {
+  Doubles4 s_hi = {states[0].hi, states[1].hi, states[2].hi, states[3].hi};
+  Doubles4 s_lo = {states[0].lo, states[1].lo, states[2].lo, states[3].lo};
+  const Doubles4 mean4 = {mean, mean, mean, mean};
+  const std::size_t s1 = run_stride, s2 = 2 * run_stride, s3 = 3 * run_stride;
+  for (std::size_t i = 0; i < count; ++i) {
+    const Doubles4 y = {rate[i], rate[i + s1], rate[i + s2], rate[i + s3]};
+    accumulate(s_hi, s_lo, y - mean4);
+    if (hi != nullptr) {
+      const Floats4 low = __builtin_convertvector(s_lo, Floats4);
+      hi[i] = s_hi[0];
+      hi[i + s1] = s_hi[1];
+      hi[i + s2] = s_hi[2];
+      hi[i + s3] = s_hi[3];
+      lo[i] = low[0];
+      lo[i + s1] = low[1];
+      lo[i + s2] = low[2];
+      lo[i + s3] = low[3];
+    }
+  }
+  for (std::size_t q = 0; q < kPhaseLanes; ++q) states[q] = {s_hi[q], s_lo[q]};
+}
+
+void integrateRun(const double* rate, double mean, std::size_t count, PhaseState& state, double* hi, float* lo) {
+  double s_hi = state.hi, s_lo = state.lo;
+  for (std::size_t i = 0; i < count; ++i) {
+    accumulate(s_hi, s_lo, rate[i] - mean);
+    if (hi != nullptr) {
+      hi[i] = s_hi;
+      lo[i] = static_cast<float>(s_lo);
+    }
+  }
+  state = {s_hi, s_lo};
+}
+
+}  // namespace gyrod::processing::allan_kernels
