@@ -1,6 +1,7 @@
 #include "processing/allan.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <iomanip>
 #include <limits>
@@ -64,19 +65,6 @@ class SumOfSquares {
 
 constexpr std::size_t kSumBlock = 4096;
 
-// Runs of the phase's running sum (IntegratedPhase::integrate): long enough that the
-// per-run work is negligible, short enough for both cores on a 10⁵-sample series.
-constexpr std::size_t kPhaseRun = std::size_t{1} << 13;
-
-// a + b for double-double a, b (TwoSum of the high parts, the low parts added, renormalised).
-allan_kernels::PhaseState doubleDoubleSum(allan_kernels::PhaseState a, allan_kernels::PhaseState b) {
-  const double s = a.hi + b.hi;
-  const double bb = s - a.hi;
-  const double e = ((a.hi - (s - bb)) + (b.hi - bb)) + (a.lo + b.lo);
-  const double hi = s + e;
-  return {hi, e - (hi - s)};
-}
-
 // The phase (integrated rate, NIST SP 1065 x_k with x₀ = 0 and τ0 = 1 sample) of the
 // mean-removed series, held as an unevaluated sum hi[k] + lo[k]. Removing the mean keeps
 // |x| small (Allan variance is blind to a constant rate); the running sum is double-double,
@@ -93,9 +81,7 @@ class IntegratedPhase {
         mean_(compensatedMean(rate, where)),
         hi_(std::make_unique_for_overwrite<double[]>(rate.size() + 1)),
         lo_(std::make_unique_for_overwrite<float[]>(rate.size() + 1)) {
-    hi_[0] = 0.0;
-    lo_[0] = 0.0;
-    integrate(rate);
+    allan_kernels::integratePhase(rate.data(), rate.size(), mean_, hi_.get(), lo_.get());
   }
 
   std::size_t rateCount() const { return rate_count_; }
@@ -178,50 +164,6 @@ class IntegratedPhase {
       variances[j] = total.total() / (2.0 * md * md * static_cast<double>(terms));
     }
     return variances;
-  }
-
-  // The running sum in fixed runs of kPhaseRun samples: every run's double-double total
-  // (pass 1), the runs' starting sums by double-double addition of the totals before them
-  // (pass 2), then every run's running sum from its start (pass 3). Passes 1 and 3 take
-  // four runs at once, one per lane, and share the runs among threads. The run length is
-  // fixed, so the phase is the same bits for any number of threads and any ISA; it differs
-  // from one serial running sum only by the error of the double-double additions
-  // (~ε²·|x| each, far below the float lo's 2⁻⁷⁷·|x|).
-  void integrate(std::span<const double> rate) {
-    using allan_kernels::PhaseState;
-    const std::size_t count = rate.size();
-    const std::size_t runs = (count + kPhaseRun - 1) / kPhaseRun;
-    std::vector<PhaseState> totals(runs), starts(runs);
-    forEachRunGroup(rate, totals, false);
-    for (std::size_t r = 1; r < runs; ++r) starts[r] = doubleDoubleSum(starts[r - 1], totals[r - 1]);
-    forEachRunGroup(rate, starts, true);
-  }
-
-  // Runs r·kPhaseRun … of the rate from the states given (updated to the runs' ends),
-  // writing the phase when `store`: groups of four full runs through the four-lane kernel,
-  // the others (the last, shorter run among them) one by one.
-  void forEachRunGroup(std::span<const double> rate, std::vector<allan_kernels::PhaseState>& states, bool store) {
-    using allan_kernels::kPhaseLanes;
-    const std::size_t full_runs = rate.size() / kPhaseRun;
-    const std::size_t groups = full_runs / kPhaseLanes;
-    const std::size_t singles = states.size() - groups * kPhaseLanes;
-    forEachShare(
-        groups + singles,
-        [&](std::size_t first, std::size_t end) {
-          for (std::size_t task = first; task < end; ++task) {
-            const std::size_t run = task < groups ? task * kPhaseLanes : groups * kPhaseLanes + (task - groups);
-            const std::size_t begin = run * kPhaseRun;
-            double* hi = store ? hi_.get() + 1 + begin : nullptr;
-            float* lo = store ? lo_.get() + 1 + begin : nullptr;
-            if (task < groups) {
-              allan_kernels::integrateRuns(rate.data() + begin, mean_, kPhaseRun, kPhaseRun, &states[run], hi, lo);
-            } else {
-              const std::size_t length = std::min(kPhaseRun, rate.size() - begin);
-              allan_kernels::integrateRun(rate.data() + begin, mean_, length, states[run], hi, lo);
-            }
-          }
-        },
-        4);
   }
 
   // M − 2m + 1, or 0 when 2m > M.
@@ -421,6 +363,31 @@ std::vector<int> noiseTypesForTable(std::span<const double> rate, std::span<cons
   return alphas;
 }
 
+// The non-overlapping variances at every m of `ms`, on both cores for a long series. Each m's
+// sum is its own, so how the m are shared (greedily by their cost, M/m terms) changes only
+// the time.
+std::vector<double> nonOverlappingVariances(const IntegratedPhase& phase, std::span<const std::size_t> ms) {
+  std::vector<double> variances(ms.size());
+  std::array<std::vector<std::size_t>, 2> shares;
+  std::array<double, 2> costs = {0.0, 0.0};
+  for (std::size_t j = 0; j < ms.size(); ++j) {
+    const std::size_t lighter = costs[0] <= costs[1] ? 0 : 1;
+    shares[lighter].push_back(j);
+    costs[lighter] += 1.0 / static_cast<double>(ms[j]);
+  }
+  const auto run = [&](const std::vector<std::size_t>& share) {
+    for (std::size_t j : share) variances[j] = phase.allanVariance(ms[j]);
+  };
+  constexpr std::size_t kParallelSamples = std::size_t{1} << 16;
+  if (phase.rateCount() < kParallelSamples) {
+    run(shares[0]);
+    run(shares[1]);
+  } else {
+    runBoth([&] { run(shares[1]); }, [&] { run(shares[0]); });
+  }
+  return variances;
+}
+
 }  // namespace
 
 // ---- cluster sizes -----------------------------------------------------------------
@@ -577,6 +544,7 @@ std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double
   const std::vector<int> alphas = noiseTypesForTable(rate, ms, "allanDeviationTable");
   const IntegratedPhase phase(rate, "allanDeviationTable");
   const std::vector<double> overlapping = phase.overlappingAllanVariances(ms);
+  const std::vector<double> non_overlapping = nonOverlappingVariances(phase, ms);
 
   std::vector<AllanPoint> table;
   table.reserve(ms.size());
@@ -585,7 +553,7 @@ std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double
     AllanPoint p;
     p.m = m;
     p.tau_s = static_cast<double>(m) * tau0_s;
-    p.adev = std::sqrt(phase.allanVariance(m));
+    p.adev = std::sqrt(non_overlapping[j]);
     p.adev_terms = count / m >= 1 ? count / m - 1 : 0;
     p.oadev = std::sqrt(overlapping[j]);
     p.oadev_terms = phase.overlappingTerms(m);

@@ -1,6 +1,10 @@
 #include "processing/allan_kernels.hpp"
 
+#include <algorithm>
 #include <cstring>
+#include <vector>
+
+#include "processing/parallel_share.hpp"
 
 // One clone per ISA where the compiler can dispatch at load time (x86-64 ELF); elsewhere
 // (arm64, armhf, sanitizer builds that lack ifunc) the one portable build.
@@ -83,6 +87,17 @@ double overlappingBlockTotal(const double* hi, const float* lo, std::size_t m, s
   return (p0 + acc[1]) + (acc[2] + acc[3]);
 }
 
+namespace {
+
+struct PhaseState {
+  double hi = 0.0;
+  double lo = 0.0;
+};
+constexpr std::size_t kPhaseLanes = 4;
+
+// The double-double running sum of (rate[i] − mean) over `count` samples of kPhaseLanes
+// runs `run_stride` apart, one per lane, each from its state in `states` (updated to the
+// run's end); writes hi[i] and lo[i] (rounded to float) after each sample when hi is given.
 GYROD_ISA_CLONES
 void integrateRuns(const double* rate, double mean, std::size_t run_stride, std::size_t count, PhaseState* states,
                    double* hi, float* lo) {
@@ -108,6 +123,7 @@ void integrateRuns(const double* rate, double mean, std::size_t run_stride, std:
   for (std::size_t q = 0; q < kPhaseLanes; ++q) states[q] = {s_hi[q], s_lo[q]};
 }
 
+// The same for one run (the same operations as one lane).
 void integrateRun(const double* rate, double mean, std::size_t count, PhaseState& state, double* hi, float* lo) {
   double s_hi = state.hi, s_lo = state.lo;
   for (std::size_t i = 0; i < count; ++i) {
@@ -118,6 +134,51 @@ void integrateRun(const double* rate, double mean, std::size_t count, PhaseState
     }
   }
   state = {s_hi, s_lo};
+}
+
+// a + b for double-double a, b (TwoSum of the high parts, the low parts added, renormalised).
+PhaseState doubleDoubleSum(PhaseState a, PhaseState b) {
+  const double s = a.hi + b.hi;
+  const double bb = s - a.hi;
+  const double e = ((a.hi - (s - bb)) + (b.hi - bb)) + (a.lo + b.lo);
+  const double hi = s + e;
+  return {hi, e - (hi - s)};
+}
+
+// Runs r·kPhaseRun … of the rate from the states given (updated to the runs' ends), writing
+// the phase when hi is given: groups of four full runs through the four-lane kernel, the
+// others (the last, shorter run among them) one by one.
+void forEachRunGroup(const double* rate, std::size_t count, double mean, std::vector<PhaseState>& states, double* hi,
+                     float* lo) {
+  const std::size_t groups = count / kPhaseRun / kPhaseLanes;
+  const std::size_t singles = states.size() - groups * kPhaseLanes;
+  forEachShare(
+      groups + singles,
+      [&](std::size_t first, std::size_t end) {
+        for (std::size_t task = first; task < end; ++task) {
+          const std::size_t run = task < groups ? task * kPhaseLanes : groups * kPhaseLanes + (task - groups);
+          const std::size_t begin = run * kPhaseRun;
+          double* run_hi = hi != nullptr ? hi + begin : nullptr;
+          float* run_lo = hi != nullptr ? lo + begin : nullptr;
+          if (task < groups)
+            integrateRuns(rate + begin, mean, kPhaseRun, kPhaseRun, &states[run], run_hi, run_lo);
+          else
+            integrateRun(rate + begin, mean, std::min(kPhaseRun, count - begin), states[run], run_hi, run_lo);
+        }
+      },
+      4);
+}
+
+}  // namespace
+
+void integratePhase(const double* rate, std::size_t count, double mean, double* hi, float* lo) {
+  hi[0] = 0.0;
+  lo[0] = 0.0;
+  const std::size_t runs = (count + kPhaseRun - 1) / kPhaseRun;
+  std::vector<PhaseState> totals(runs), starts(runs);
+  forEachRunGroup(rate, count, mean, totals, nullptr, nullptr);
+  for (std::size_t r = 1; r < runs; ++r) starts[r] = doubleDoubleSum(starts[r - 1], totals[r - 1]);
+  forEachRunGroup(rate, count, mean, starts, hi + 1, lo + 1);
 }
 
 }  // namespace gyrod::processing::allan_kernels

@@ -17,19 +17,16 @@ namespace gyrod::processing::allan_kernels {
 // the total is (lane0 + lane1) + (lane2 + lane3).
 double overlappingBlockTotal(const double* hi, const float* lo, std::size_t m, std::size_t k, std::size_t block_end);
 
-// The double-double running sum of (rate[i] − mean) over `count` samples, starting from the
-// state (s_hi, s_lo): writes hi[i] and lo[i] (rounded to float) after each sample i, and
-// returns the final state. The running sums of kPhaseLanes runs, each `count` long and
-// `run_stride` apart, are formed together, one per lane (independent chains: the latency of
-// one is hidden by the others).
-inline constexpr std::size_t kPhaseLanes = 4;
-struct PhaseState {
-  double hi = 0.0;
-  double lo = 0.0;
-};
-void integrateRuns(const double* rate, double mean, std::size_t run_stride, std::size_t count, PhaseState* states,
-                   double* hi, float* lo);
-// The same for one run (the same operations as one lane).
-void integrateRun(const double* rate, double mean, std::size_t count, PhaseState& state, double* hi, float* lo);
+// The phase of the mean-removed rate as the unevaluated sum hi[k] + lo[k], k = 0 … count
+// (hi[0] = lo[0] = 0): the double-double running sum of (rate[i] − mean), lo rounded to
+// float. Formed in fixed runs of kPhaseRun samples: every run's double-double total (pass 1),
+// the runs' starting sums by double-double addition of the totals before them (pass 2), then
+// every run's running sum from its start (pass 3). Passes 1 and 3 take four runs at once, one
+// per lane (independent chains: the latency of one hides behind the others), and share the
+// runs among threads. The run length is fixed, so the phase is the same bits for any number
+// of threads and any ISA; it differs from one serial running sum only by the errors of the
+// double-double additions (~ε²·|x| each, far below the float lo's 2⁻⁷⁷·|x|).
+inline constexpr std::size_t kPhaseRun = std::size_t{1} << 13;
+void integratePhase(const double* rate, std::size_t count, double mean, double* hi, float* lo);
 
 }  // namespace gyrod::processing::allan_kernels
