@@ -332,7 +332,8 @@ std::vector<int> noiseTypesForTable(std::span<const double> rate, std::span<cons
       const auto at = std::lower_bound(distinct.begin(), distinct.end(), m);
       if (at != distinct.end() && *at == m) {
         const double md = static_cast<double>(m);
-        for (double& v : sums) v /= md;
+        if (m > 1)  // v / 1.0 is v: no pass needed
+          for (double& v : sums) v /= md;
         distinct_alpha[static_cast<std::size_t>(at - distinct.begin())] = lag1NoiseIdOfAverages(std::move(sums));
       }
       sums = std::move(next);
