@@ -77,8 +77,11 @@ constexpr std::size_t kSumBlock = 4096;
 class IntegratedPhase {
  public:
   explicit IntegratedPhase(std::span<const double> rate, const char* where)
+      : IntegratedPhase(rate, compensatedMean(rate, where)) {}
+  // With the mean already formed (by compensatedMean, which has checked every sample).
+  IntegratedPhase(std::span<const double> rate, double mean)
       : rate_count_(rate.size()),
-        mean_(compensatedMean(rate, where)),
+        mean_(mean),
         hi_(std::make_unique_for_overwrite<double[]>(rate.size() + 1)),
         lo_(std::make_unique_for_overwrite<float[]>(rate.size() + 1)) {
     allan_kernels::integratePhase(rate.data(), rate.size(), mean_, hi_.get(), lo_.get());
@@ -304,9 +307,8 @@ int identifyWithMean(std::span<const double> rate, std::size_t m, double mean, c
 // averagings are formed pairwise from the level below, a different rounding from the
 // one-by-one sum of lag1NoiseId (both within a few ε of the exact sum): the decision
 // differs only for a ρ within ~10⁻¹⁵ of a rounding boundary of α. Empty for a series shorter than kMinAveragedPointsForNoiseId, whose fallback
-// needs the phase. Throws on a non-finite sample.
-std::vector<int> noiseTypesForTable(std::span<const double> rate, std::span<const std::size_t> ms, const char* where) {
-  const double mean = compensatedMean(rate, where);
+// needs the phase. `mean` is compensatedMean's, which has rejected any non-finite sample.
+std::vector<int> noiseTypesForTable(std::span<const double> rate, std::span<const std::size_t> ms, double mean) {
   const std::size_t count = rate.size();
   if (count < kMinAveragedPointsForNoiseId) return {};
   const auto averaging = [&](std::size_t m) {
@@ -542,8 +544,9 @@ std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double
   const std::size_t count = rate.size();
   // The noise types first, while only the rate is held (the lag-1 method averages the rate
   // itself); the phase, twice the rate's size, comes after.
-  const std::vector<int> alphas = noiseTypesForTable(rate, ms, "allanDeviationTable");
-  const IntegratedPhase phase(rate, "allanDeviationTable");
+  const double mean = compensatedMean(rate, "allanDeviationTable");  // one pass for both
+  const std::vector<int> alphas = noiseTypesForTable(rate, ms, mean);
+  const IntegratedPhase phase(rate, mean);
   const std::vector<double> overlapping = phase.overlappingAllanVariances(ms);
   const std::vector<double> non_overlapping = nonOverlappingVariances(phase, ms);
 

@@ -17,9 +17,9 @@
 #define GYROD_ISA_CLONES
 #endif
 
-// The four-lane helpers below are inlined into the clones; no vector crosses an ABI
-// boundary, so GCC's note that a 32-byte vector argument would change the ABI without AVX
-// does not apply.
+// The four-lane helpers below take and give vectors by reference only, so no vector crosses
+// an ABI boundary and GCC's note that a 32-byte vector would change the ABI without AVX does
+// not apply.
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wpsabi"
 #endif
@@ -32,15 +32,13 @@ namespace {
 using Doubles4 = double __attribute__((vector_size(4 * sizeof(double))));
 using Floats4 = float __attribute__((vector_size(4 * sizeof(float))));
 
-inline Doubles4 loadDoubles(const double* p) {
-  Doubles4 v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-inline Doubles4 loadWidened(const float* p) {
-  Floats4 v;
-  std::memcpy(&v, p, sizeof v);
-  return __builtin_convertvector(v, Doubles4);
+// Vectors leave the helpers by reference only: a 32-byte vector passed or returned by value
+// would have a different ABI in the AVX2 clone and the baseline (Clang refuses it).
+inline void loadDoubles(const double* p, Doubles4& v) { std::memcpy(&v, p, sizeof v); }
+inline void loadWidened(const float* p, Doubles4& v) {
+  Floats4 f;
+  std::memcpy(&f, p, sizeof f);
+  v = __builtin_convertvector(f, Doubles4);
 }
 
 inline double secondDifference(const double* h, const float* l, std::size_t i, std::size_t m) {
@@ -48,16 +46,21 @@ inline double secondDifference(const double* h, const float* l, std::size_t i, s
   return ((h[i + 2 * m] - h[i + m]) - (h[i + m] - h[i])) + ((lc - lb) - (lb - la));
 }
 
-inline Doubles4 squaredSecondDifferences(const double* h, const float* l, std::size_t i, std::size_t m) {
-  const Doubles4 ha = loadDoubles(h + i), hb = loadDoubles(h + i + m), hc = loadDoubles(h + i + 2 * m);
-  const Doubles4 la = loadWidened(l + i), lb = loadWidened(l + i + m), lc = loadWidened(l + i + 2 * m);
+inline void squaredSecondDifferences(const double* h, const float* l, std::size_t i, std::size_t m, Doubles4& out) {
+  Doubles4 ha, hb, hc, la, lb, lc;
+  loadDoubles(h + i, ha);
+  loadDoubles(h + i + m, hb);
+  loadDoubles(h + i + 2 * m, hc);
+  loadWidened(l + i, la);
+  loadWidened(l + i + m, lb);
+  loadWidened(l + i + 2 * m, lc);
   const Doubles4 d = ((hc - hb) - (hb - ha)) + ((lc - lb) - (lb - la));
-  return d * d;
+  out = d * d;
 }
 
 // One step of the double-double running sum: TwoSum(s_hi, v), then FastTwoSum renormalisation.
 template <typename T>
-inline void accumulate(T& s_hi, T& s_lo, T v) {
+inline void accumulate(T& s_hi, T& s_lo, const T& v) {
   const T h = s_hi + v;
   const T bv = h - s_hi;
   const T e = (s_hi - (h - bv)) + (v - bv);
@@ -68,23 +71,38 @@ inline void accumulate(T& s_hi, T& s_lo, T v) {
 
 }  // namespace
 
+namespace {
+
+// The clones are internal functions behind the declared one (Clang multiversions only a
+// function whose every declaration carries the attribute).
 GYROD_ISA_CLONES
-double overlappingBlockTotal(const double* hi, const float* lo, std::size_t m, std::size_t k, std::size_t block_end) {
+double blockTotalLanes(const double* hi, const float* lo, std::size_t m, std::size_t k, std::size_t block_end) {
   Doubles4 acc = {0.0, 0.0, 0.0, 0.0};
   // Two groups of four per step: both are computed independently, then added in order.
   for (; k + 8 <= block_end; k += 8) {
-    const Doubles4 first = squaredSecondDifferences(hi, lo, k, m);
-    const Doubles4 second = squaredSecondDifferences(hi, lo, k + 4, m);
+    Doubles4 first, second;
+    squaredSecondDifferences(hi, lo, k, m, first);
+    squaredSecondDifferences(hi, lo, k + 4, m, second);
     acc += first;
     acc += second;
   }
-  for (; k + 4 <= block_end; k += 4) acc += squaredSecondDifferences(hi, lo, k, m);
+  for (; k + 4 <= block_end; k += 4) {
+    Doubles4 terms;
+    squaredSecondDifferences(hi, lo, k, m, terms);
+    acc += terms;
+  }
   double p0 = acc[0];
   for (; k < block_end; ++k) {
     const double d = secondDifference(hi, lo, k, m);
     p0 += d * d;
   }
   return (p0 + acc[1]) + (acc[2] + acc[3]);
+}
+
+}  // namespace
+
+double overlappingBlockTotal(const double* hi, const float* lo, std::size_t m, std::size_t k, std::size_t block_end) {
+  return blockTotalLanes(hi, lo, m, k, block_end);
 }
 
 namespace {
@@ -107,7 +125,8 @@ void integrateRuns(const double* rate, double mean, std::size_t run_stride, std:
   const std::size_t s1 = run_stride, s2 = 2 * run_stride, s3 = 3 * run_stride;
   for (std::size_t i = 0; i < count; ++i) {
     const Doubles4 y = {rate[i], rate[i + s1], rate[i + s2], rate[i + s3]};
-    accumulate(s_hi, s_lo, y - mean4);
+    const Doubles4 v = y - mean4;
+    accumulate(s_hi, s_lo, v);
     if (hi != nullptr) {
       const Floats4 low = __builtin_convertvector(s_lo, Floats4);
       hi[i] = s_hi[0];
