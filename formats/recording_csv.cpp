@@ -274,6 +274,25 @@ std::pair<std::string_view, std::string_view> splitAtLineNearMiddle(std::string_
   return {text.substr(0, nl + 1), text.substr(nl + 1)};
 }
 
+// A slice's samples, records and line runs appended to `rec`, its lines numbered after line_no.
+void appendSlice(const SliceResult& slice, std::size_t line_no, Recording& rec,
+                 const std::vector<std::vector<double>*>& targets) {
+  const std::size_t first_sample = rec.size();
+  for (LostSamples lost : slice.lost) {
+    lost.line += line_no;
+    lost.before_sample += first_sample;
+    rec.lost.push_back(std::move(lost));
+  }
+  for (const auto& run : slice.line_runs) {
+    const std::size_t sample = first_sample + run.first_sample, line = line_no + run.first_line;
+    if (rec.line_runs.empty() || rec.line_runs.back().first_line + (sample - rec.line_runs.back().first_sample) != line)
+      rec.line_runs.push_back({sample, line});
+  }
+  for (std::size_t line : slice.sample_lines) rec.line_numbers.push_back(line_no + line);
+  for (std::size_t c = 0; c < targets.size(); ++c)
+    targets[c]->insert(targets[c]->end(), slice.columns[c].begin(), slice.columns[c].end());
+}
+
 // ReadOptions::progress at every multiple of kProgressLines among the `lines` lines of
 // `text` (which starts at byte `text_start`, after line `line_no`), with the bytes read up to
 // the end of that line.
@@ -399,21 +418,7 @@ Recording parseRecordingFile(std::FILE* file, const std::string& path, const Rea
       for (auto* target : targets) target->reserve(lines);
       if (options.line_numbers) rec.line_numbers.reserve(lines);
     }
-    const std::size_t first_sample = rec.size();
-    for (LostSamples lost : slice.lost) {
-      lost.line += line_no;
-      lost.before_sample += first_sample;
-      rec.lost.push_back(std::move(lost));
-    }
-    for (const auto& run : slice.line_runs) {
-      const std::size_t sample = first_sample + run.first_sample, line = line_no + run.first_line;
-      if (rec.line_runs.empty() ||
-          rec.line_runs.back().first_line + (sample - rec.line_runs.back().first_sample) != line)
-        rec.line_runs.push_back({sample, line});
-    }
-    for (std::size_t line : slice.sample_lines) rec.line_numbers.push_back(line_no + line);
-    for (std::size_t c = 0; c < targets.size(); ++c)
-      targets[c]->insert(targets[c]->end(), slice.columns[c].begin(), slice.columns[c].end());
+    appendSlice(slice, line_no, rec, targets);
     reportProgress(options, text, text_start, line_no, slice.lines);
     line_no += slice.lines;
   };
