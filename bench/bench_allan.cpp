@@ -7,8 +7,10 @@
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
+#include <ctime>
 #include <numeric>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "processing/allan.hpp"
@@ -57,18 +59,48 @@ void BM_AllanTableOctaves(benchmark::State& state) {  // + ADEV, noise id, edf, 
   }
 }
 
-// Median of a few plain wall-clock runs, for the printed ratio.
+double processCpuNs() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e9 + static_cast<double>(ts.tv_nsec);
+}
+
+// Medians of a few plain runs, for the printed ratios: wall time, and the CPU time of the
+// process (all threads), which a machine loaded by other work inflates much less.
+struct Timing {
+  double wall_ns = 0.0;
+  double cpu_ns = 0.0;
+};
 template <typename F>
-double medianNs(F&& f, int runs) {
-  std::vector<double> t;
+Timing medianNs(F&& f, int runs) {
+  std::vector<double> wall, cpu;
   for (int i = 0; i < runs; ++i) {
     const auto a = std::chrono::steady_clock::now();
+    const double c = processCpuNs();
     f();
+    cpu.push_back(processCpuNs() - c);
     const auto b = std::chrono::steady_clock::now();
-    t.push_back(std::chrono::duration<double, std::nano>(b - a).count());
+    wall.push_back(std::chrono::duration<double, std::nano>(b - a).count());
   }
-  std::nth_element(t.begin(), t.begin() + runs / 2, t.end());
-  return t[static_cast<std::size_t>(runs / 2)];
+  const auto median = [runs](std::vector<double>& t) {
+    std::nth_element(t.begin(), t.begin() + runs / 2, t.end());
+    return t[static_cast<std::size_t>(runs / 2)];
+  };
+  return {median(wall), median(cpu)};
+}
+
+std::string loadAverage() {
+  std::FILE* f = std::fopen("/proc/loadavg", "r");
+  if (f == nullptr) return "unknown";
+  char buf[64] = {};
+  const bool read = std::fgets(buf, sizeof buf, f) != nullptr;
+  std::fclose(f);
+  if (!read) return "unknown";
+  std::string s(buf);
+  // The 1, 5 and 15 minute averages: the first three fields.
+  std::size_t end = 0;
+  for (int field = 0; field < 3 && end != std::string::npos; ++field) end = s.find(' ', end + (field > 0 ? 1 : 0));
+  return s.substr(0, end);
 }
 
 }  // namespace
@@ -85,19 +117,22 @@ int main(int argc, char** argv) {
 
   const auto& y = samples();
   const auto ms = gyrod::processing::octaveClusterSizes(y.size());
-  const double g_stream_ns = medianNs(
+  const Timing stream = medianNs(
       [&] {
         double s = std::accumulate(y.begin(), y.end(), 0.0);
         benchmark::DoNotOptimize(s);
       },
       15);
-  const double g_allan_ns = medianNs(
+  const Timing allan = medianNs(
       [&] {
         auto v = gyrod::processing::overlappingAllanVariances(y, ms);
         benchmark::DoNotOptimize(v.data());
       },
       5);
-  std::printf("overlapping ADEV at %zu octave taus on %zu samples: %.1f ms; one streaming sum: %.2f ms; ratio %.1f\n",
-              ms.size(), y.size(), g_allan_ns / 1e6, g_stream_ns / 1e6, g_allan_ns / g_stream_ns);
+  std::printf(
+      "overlapping ADEV at %zu octave taus on %zu samples: %.1f ms wall, %.1f ms CPU; one streaming sum: %.2f ms wall, "
+      "%.2f ms CPU; ratio %.1f wall, %.1f CPU (load %s)\n",
+      ms.size(), y.size(), allan.wall_ns / 1e6, allan.cpu_ns / 1e6, stream.wall_ns / 1e6, stream.cpu_ns / 1e6,
+      allan.wall_ns / stream.wall_ns, allan.cpu_ns / stream.cpu_ns, loadAverage().c_str());
   return 0;
 }

@@ -18,6 +18,7 @@
 
 #include "formats/csv_fields.hpp"
 #include "formats/quoted_value.hpp"
+#include "processing/parallel_share.hpp"
 
 namespace gyrod::recording {
 namespace {
@@ -64,13 +65,32 @@ class ChunkedLineReader {
         consumed_ += available;
         return Result::Line;
       }
-      // Keep the partial line (at most max_bytes_) and fill the rest of the buffer.
-      std::memmove(buffer_.data(), begin, available);
-      pos_ = 0;
-      end_ = available;
-      const std::size_t got = std::fread(buffer_.data() + end_, 1, buffer_.size() - end_, file_);
-      end_ += got;
-      if (got == 0) eof_ = true;
+      refill(begin, available);
+    }
+  }
+  // Every complete line now in the buffer, with their '\n' (refilling first when there is
+  // none), or the last line of the file without one. Lines longer than the limit are left
+  // to the caller to find; TooLong when no line ends within the limit.
+  Result nextLines() {
+    while (true) {
+      const char* begin = buffer_.data() + pos_;
+      const std::size_t available = end_ - pos_;
+      if (const void* nl = available > 0 ? ::memrchr(begin, '\n', available) : nullptr) {
+        const auto length = static_cast<std::size_t>(static_cast<const char*>(nl) - begin) + 1;
+        line_ = {begin, length};
+        pos_ += length;
+        consumed_ += length;
+        return Result::Line;
+      }
+      if (available > max_bytes_) return Result::TooLong;
+      if (eof_) {
+        if (available == 0) return Result::End;
+        line_ = {begin, available};
+        pos_ = end_;
+        consumed_ += available;
+        return Result::Line;
+      }
+      refill(begin, available);
     }
   }
   std::string_view line() const { return line_; }
@@ -78,6 +98,16 @@ class ChunkedLineReader {
   std::uint64_t bytesConsumed() const { return consumed_; }
 
  private:
+  // Keeps the partial line (at most max_bytes_) and fills the rest of the buffer.
+  void refill(const char* begin, std::size_t available) {
+    std::memmove(buffer_.data(), begin, available);
+    pos_ = 0;
+    end_ = available;
+    const std::size_t got = std::fread(buffer_.data() + end_, 1, buffer_.size() - end_, file_);
+    end_ += got;
+    if (got == 0) eof_ = true;
+  }
+
   std::FILE* file_;
   std::size_t max_bytes_;
   std::vector<char> buffer_;
@@ -148,6 +178,137 @@ std::vector<ColumnRole> headerRoles(const std::string& path, std::size_t line_no
   if (rec.axis_names.empty()) fail(path, line_no, "no gyro column: the header needs at least one of gx,gy,gz");
   rec.axes.resize(rec.axis_names.size());
   return roles;
+}
+
+// What a slice of the sample lines yields, numbered from the slice: its first line is 1 and
+// its first sample 0. Slices are parsed apart (on both cores) and appended in file order.
+struct SliceResult {
+  std::vector<std::vector<double>> columns;   // one per field of the header
+  std::vector<Recording::LineRun> line_runs;  // runs within the slice
+  std::vector<std::size_t> sample_lines;      // each sample's line (only with ReadOptions::line_numbers)
+  std::vector<LostSamples> lost;              // GAP and DROPPED lines
+  std::size_t lines = 0;                      // lines read (up to and including an error's)
+  std::size_t samples = 0;
+  std::string error;  // the cause of the first bad line (the slice's last), empty when none
+};
+
+// The sample lines' rules, the same for every slice: field count, numbers, comments and
+// GAP/DROPPED records, the line length limit, one column for bare numbers.
+struct SliceParser {
+  std::vector<std::string> column_names;  // for messages ("value" for bare numbers)
+  bool bare_numbers = false;
+  bool line_numbers = false;
+  std::size_t max_bytes = kMaxLineBytes;
+
+  // Parses the lines of `text` (each ending in '\n' but maybe the last) into `out`,
+  // stopping at the first bad line.
+  void parse(std::string_view text, SliceResult& out) const {
+    out.columns.resize(column_names.size());
+    std::array<std::string_view, kKnownColumns.size()> fields;
+    std::size_t start = 0;
+    while (start < text.size()) {
+      const auto nl = text.find('\n', start);
+      const std::size_t end = nl == std::string_view::npos ? text.size() : nl;
+      const std::string_view raw = text.substr(start, end - start);
+      start = end + 1;
+      ++out.lines;
+      if (raw.size() > max_bytes) {
+        out.error = lineTooLongCause(max_bytes);
+        return;
+      }
+      const std::string_view line = trimField(raw);
+      if (isSkippable(line)) {
+        if (auto lost = parseLostSamplesLine(line)) {
+          lost->line = out.lines;
+          lost->before_sample = out.samples;
+          out.lost.push_back(std::move(*lost));
+        }
+        continue;
+      }
+      if (bare_numbers && line.find(',') != std::string_view::npos) {
+        out.error = "more than one column in a file of bare numbers (add a header t,gx,gy,gz,temp)";
+        return;
+      }
+      if (!consume(line, fields, out)) return;
+    }
+  }
+
+  bool consume(std::string_view line, std::span<std::string_view> fields, SliceResult& out) const {
+    const std::size_t count = splitInto(line, fields);
+    if (count != column_names.size()) {
+      std::ostringstream s;
+      s << "expected " << column_names.size() << " field" << (column_names.size() == 1 ? "" : "s") << ", found "
+        << count;
+      out.error = s.str();
+      return false;
+    }
+    for (std::size_t c = 0; c < count; ++c) {
+      const auto value = parseNumber(fields[c]);
+      if (!value) {
+        out.error = "column '" + column_names[c] + "': " + formats::quotedValue(fields[c]) + " is not a number";
+        return false;
+      }
+      if (!std::isfinite(*value)) {
+        out.error = "column '" + column_names[c] + "': non-finite value " + formats::quotedValue(fields[c]);
+        return false;
+      }
+      out.columns[c].push_back(*value);
+    }
+    if (line_numbers) out.sample_lines.push_back(out.lines);
+    if (out.line_runs.empty() ||
+        out.line_runs.back().first_line + (out.samples - out.line_runs.back().first_sample) != out.lines)
+      out.line_runs.push_back({out.samples, out.lines});
+    ++out.samples;
+    return true;
+  }
+};
+
+// Below this many bytes a batch of lines is parsed on the calling thread alone.
+constexpr std::size_t kParallelSliceBytes = std::size_t{1} << 17;
+
+// `text` cut at a line end near its middle (the whole of it in the first part when short).
+std::pair<std::string_view, std::string_view> splitAtLineNearMiddle(std::string_view text) {
+  if (text.size() < kParallelSliceBytes) return {text, {}};
+  const auto nl = text.find('\n', text.size() / 2);
+  if (nl == std::string_view::npos || nl + 1 >= text.size()) return {text, {}};
+  return {text.substr(0, nl + 1), text.substr(nl + 1)};
+}
+
+// A slice's samples, records and line runs appended to `rec`, its lines numbered after line_no.
+void appendSlice(const SliceResult& slice, std::size_t line_no, Recording& rec,
+                 const std::vector<std::vector<double>*>& targets) {
+  const std::size_t first_sample = rec.size();
+  for (LostSamples lost : slice.lost) {
+    lost.line += line_no;
+    lost.before_sample += first_sample;
+    rec.lost.push_back(std::move(lost));
+  }
+  for (const auto& run : slice.line_runs) {
+    const std::size_t sample = first_sample + run.first_sample, line = line_no + run.first_line;
+    if (rec.line_runs.empty() || rec.line_runs.back().first_line + (sample - rec.line_runs.back().first_sample) != line)
+      rec.line_runs.push_back({sample, line});
+  }
+  for (std::size_t line : slice.sample_lines) rec.line_numbers.push_back(line_no + line);
+  for (std::size_t c = 0; c < targets.size(); ++c)
+    targets[c]->insert(targets[c]->end(), slice.columns[c].begin(), slice.columns[c].end());
+}
+
+// ReadOptions::progress at every multiple of kProgressLines among the `lines` lines of
+// `text` (which starts at byte `text_start`, after line `line_no`), with the bytes read up to
+// the end of that line.
+void reportProgress(const ReadOptions& options, std::string_view text, std::uint64_t text_start, std::size_t line_no,
+                    std::size_t lines) {
+  if (!options.progress) return;
+  std::size_t mark = (line_no / kProgressLines + 1) * kProgressLines;
+  std::size_t scanned = 0;  // lines of text passed
+  std::size_t pos = 0;      // bytes of text passed
+  for (; mark <= line_no + lines; mark += kProgressLines) {
+    for (; scanned < mark - line_no; ++scanned) {
+      const auto nl = text.find('\n', pos);
+      pos = nl == std::string_view::npos ? text.size() : nl + 1;
+    }
+    options.progress(mark, text_start + pos);
+  }
 }
 
 }  // namespace
@@ -242,43 +403,49 @@ Recording parseRecordingFile(std::FILE* file, const std::string& path, const Rea
                                  : rec.axis_names[index];
   };
 
+  SliceParser parser;
+  parser.bare_numbers = bare_numbers;
+  parser.line_numbers = options.line_numbers;
+  parser.max_bytes = reader.maxBytes();
+  for (std::size_t c = 0; c < roles.size(); ++c) parser.column_names.push_back(columnName(c));
   bool reserved = false;
-  std::array<std::string_view, kKnownColumns.size()> fields;
-  auto consume = [&](std::string_view line) {
-    if (!reserved) {
+  // Appends a parsed slice whose text starts at byte `text_start` of the file after line line_no.
+  const auto append = [&](std::string_view text, std::uint64_t text_start, const SliceResult& slice) {
+    if (!slice.error.empty()) fail(path, line_no + slice.lines, slice.error);
+    if (!reserved && slice.samples > 0) {
       reserved = true;
-      const std::size_t lines = expectedLines(file, line.size() + 1);
+      const std::size_t lines = expectedLines(file, text.size() / slice.lines);
       for (auto* target : targets) target->reserve(lines);
       if (options.line_numbers) rec.line_numbers.reserve(lines);
     }
-    const std::size_t count = splitInto(line, fields);
-    if (count != roles.size()) {
-      std::ostringstream s;
-      s << "expected " << roles.size() << " field" << (roles.size() == 1 ? "" : "s") << ", found " << count;
-      fail(path, line_no, s.str());
-    }
-    const std::size_t sample = rec.size();
-    if (options.line_numbers) rec.line_numbers.push_back(line_no);
-    if (rec.line_runs.empty() ||
-        rec.line_runs.back().first_line + (sample - rec.line_runs.back().first_sample) != line_no)
-      rec.line_runs.push_back({sample, line_no});
-    for (std::size_t c = 0; c < count; ++c) {
-      const auto value = parseNumber(fields[c]);
-      if (!value)
-        fail(path, line_no, "column '" + columnName(c) + "': " + formats::quotedValue(fields[c]) + " is not a number");
-      if (!std::isfinite(*value))
-        fail(path, line_no, "column '" + columnName(c) + "': non-finite value " + formats::quotedValue(fields[c]));
-      targets[c]->push_back(*value);
-    }
+    appendSlice(slice, line_no, rec, targets);
+    reportProgress(options, text, text_start, line_no, slice.lines);
+    line_no += slice.lines;
   };
 
-  if (bare_numbers) consume(first);
-  while (const auto next = nextLine()) {
-    const auto line = *next;
-    if (skippable(line)) continue;
-    if (bare_numbers && line.find(',') != std::string_view::npos)
-      fail(path, line_no, "more than one column in a file of bare numbers (add a header t,gx,gy,gz,temp)");
-    consume(line);
+  if (bare_numbers) {
+    SliceResult slice;
+    parser.parse(first, slice);
+    --line_no;  // `first` is line line_no: the slice's line 1
+    append(first, reader.bytesConsumed(), slice);
+  }
+  // The rest in batches of whole lines (about a chunk each), each cut in two slices that are
+  // parsed on both cores and appended in file order: the first bad line is still the one named.
+  while (true) {
+    const auto result = reader.nextLines();
+    if (result == ChunkedLineReader::Result::End) break;
+    if (result == ChunkedLineReader::Result::TooLong) fail(path, line_no + 1, lineTooLongCause(reader.maxBytes()));
+    const std::string_view text = reader.line();
+    const std::uint64_t text_start = reader.bytesConsumed() - text.size();
+    const auto [front, back] = splitAtLineNearMiddle(text);
+    SliceResult front_slice, back_slice;
+    if (back.empty())
+      parser.parse(front, front_slice);
+    else
+      processing::runBoth([&, front = front] { parser.parse(front, front_slice); },
+                          [&, back = back] { parser.parse(back, back_slice); });
+    append(front, text_start, front_slice);
+    if (!back.empty()) append(back, text_start + front.size(), back_slice);
   }
   if (std::ferror(file)) fail(path, line_no, std::string("read error: ") + std::strerror(errno));
   if (rec.size() == 0) fail(path, header_line, "no samples after the header");

@@ -1,14 +1,15 @@
 #include "processing/allan.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <cstring>
 #include <iomanip>
 #include <limits>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
 
+#include "processing/allan_kernels.hpp"
 #include "processing/distributions.hpp"
 #include "processing/parallel_share.hpp"
 
@@ -64,16 +65,6 @@ class SumOfSquares {
 
 constexpr std::size_t kSumBlock = 4096;
 
-// Two doubles added and multiplied lane by lane (one SSE2 or NEON register): each lane is
-// IEEE arithmetic in the written order, the same as two scalar chains.
-using Lanes = double __attribute__((vector_size(2 * sizeof(double))));
-Lanes loadLanes(const double* p) {
-  Lanes v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-Lanes widenLanes(const float* p) { return Lanes{p[0], p[1]}; }
-
 // The phase (integrated rate, NIST SP 1065 x_k with x₀ = 0 and τ0 = 1 sample) of the
 // mean-removed series, held as an unevaluated sum hi[k] + lo[k]. Removing the mean keeps
 // |x| small (Allan variance is blind to a constant rate); the running sum is double-double,
@@ -86,28 +77,14 @@ Lanes widenLanes(const float* p) { return Lanes{p[0], p[1]}; }
 class IntegratedPhase {
  public:
   explicit IntegratedPhase(std::span<const double> rate, const char* where)
+      : IntegratedPhase(rate, compensatedMean(rate, where)) {}
+  // With the mean already formed (by compensatedMean, which has checked every sample).
+  IntegratedPhase(std::span<const double> rate, double mean)
       : rate_count_(rate.size()),
-        mean_(compensatedMean(rate, where)),
+        mean_(mean),
         hi_(std::make_unique_for_overwrite<double[]>(rate.size() + 1)),
         lo_(std::make_unique_for_overwrite<float[]>(rate.size() + 1)) {
-    const double mean = mean_;
-    double s_hi = 0.0;
-    double s_lo = 0.0;
-    hi_[0] = 0.0;
-    lo_[0] = 0.0;
-    for (std::size_t i = 0; i < rate.size(); ++i) {
-      const double v = rate[i] - mean;
-      // TwoSum(s_hi, v): exact h + e.
-      const double h = s_hi + v;
-      const double bv = h - s_hi;
-      const double e = (s_hi - (h - bv)) + (v - bv);
-      const double l = s_lo + e;
-      // FastTwoSum renormalisation (|h| ≥ |l|).
-      s_hi = h + l;
-      s_lo = l - (s_hi - h);
-      hi_[i + 1] = s_hi;
-      lo_[i + 1] = static_cast<float>(s_lo);
-    }
+    allan_kernels::integratePhase(rate.data(), rate.size(), mean_, hi_.get(), lo_.get());
   }
 
   std::size_t rateCount() const { return rate_count_; }
@@ -135,31 +112,10 @@ class IntegratedPhase {
     return total.total();
   }
 
-  // One block of the overlapping sum, terms [k, block_end): lane j of the four-lane
-  // accumulator takes the terms k + 4q + j, the tail goes to lane 0, and the lanes are
-  // added as (0 + 1) + (2 + 3). Every lane rounds exactly as the scalar expression of
-  // secondDifference() would, so the result does not depend on the vector width.
+  // One block of the overlapping sum, terms [k, block_end) (allan_kernels: the same bits
+  // on every ISA).
   double overlappingBlockTotal(std::size_t m, std::size_t k, std::size_t block_end) const {
-    const double* h = hi_.get();
-    const float* l = lo_.get();
-    Lanes acc01 = {0.0, 0.0};
-    Lanes acc23 = {0.0, 0.0};
-    const auto lanePair = [&](std::size_t i) {
-      const Lanes ha = loadLanes(h + i), hb = loadLanes(h + i + m), hc = loadLanes(h + i + 2 * m);
-      const Lanes la = widenLanes(l + i), lb = widenLanes(l + i + m), lc = widenLanes(l + i + 2 * m);
-      const Lanes d = ((hc - hb) - (hb - ha)) + ((lc - lb) - (lb - la));
-      return d * d;
-    };
-    for (; k + 4 <= block_end; k += 4) {
-      acc01 += lanePair(k);
-      acc23 += lanePair(k + 2);
-    }
-    double p0 = acc01[0];
-    for (; k < block_end; ++k) {
-      const double d = secondDifference(k, m);
-      p0 += d * d;
-    }
-    return (p0 + acc01[1]) + (acc23[0] + acc23[1]);
+    return allan_kernels::overlappingBlockTotal(hi_.get(), lo_.get(), m, k, block_end);
   }
 
   double stridedBlockTotal(std::size_t m, std::size_t stride, std::size_t k, std::size_t block_end) const {
@@ -351,9 +307,8 @@ int identifyWithMean(std::span<const double> rate, std::size_t m, double mean, c
 // averagings are formed pairwise from the level below, a different rounding from the
 // one-by-one sum of lag1NoiseId (both within a few ε of the exact sum): the decision
 // differs only for a ρ within ~10⁻¹⁵ of a rounding boundary of α. Empty for a series shorter than kMinAveragedPointsForNoiseId, whose fallback
-// needs the phase. Throws on a non-finite sample.
-std::vector<int> noiseTypesForTable(std::span<const double> rate, std::span<const std::size_t> ms, const char* where) {
-  const double mean = compensatedMean(rate, where);
+// needs the phase. `mean` is compensatedMean's, which has rejected any non-finite sample.
+std::vector<int> noiseTypesForTable(std::span<const double> rate, std::span<const std::size_t> ms, double mean) {
   const std::size_t count = rate.size();
   if (count < kMinAveragedPointsForNoiseId) return {};
   const auto averaging = [&](std::size_t m) {
@@ -379,7 +334,8 @@ std::vector<int> noiseTypesForTable(std::span<const double> rate, std::span<cons
       const auto at = std::lower_bound(distinct.begin(), distinct.end(), m);
       if (at != distinct.end() && *at == m) {
         const double md = static_cast<double>(m);
-        for (double& v : sums) v /= md;
+        if (m > 1)  // v / 1.0 is v: no pass needed
+          for (double& v : sums) v /= md;
         distinct_alpha[static_cast<std::size_t>(at - distinct.begin())] = lag1NoiseIdOfAverages(std::move(sums));
       }
       sums = std::move(next);
@@ -408,6 +364,31 @@ std::vector<int> noiseTypesForTable(std::span<const double> rate, std::span<cons
     alphas.push_back(distinct_alpha[static_cast<std::size_t>(at - distinct.begin())]);
   }
   return alphas;
+}
+
+// The non-overlapping variances at every m of `ms`, on both cores for a long series. Each m's
+// sum is its own, so how the m are shared (greedily by their cost, M/m terms) changes only
+// the time.
+std::vector<double> nonOverlappingVariances(const IntegratedPhase& phase, std::span<const std::size_t> ms) {
+  std::vector<double> variances(ms.size());
+  std::array<std::vector<std::size_t>, 2> shares;
+  std::array<double, 2> costs = {0.0, 0.0};
+  for (std::size_t j = 0; j < ms.size(); ++j) {
+    const std::size_t lighter = costs[0] <= costs[1] ? 0 : 1;
+    shares[lighter].push_back(j);
+    costs[lighter] += 1.0 / static_cast<double>(ms[j]);
+  }
+  const auto run = [&](const std::vector<std::size_t>& share) {
+    for (std::size_t j : share) variances[j] = phase.allanVariance(ms[j]);
+  };
+  constexpr std::size_t kParallelSamples = std::size_t{1} << 16;
+  if (phase.rateCount() < kParallelSamples) {
+    run(shares[0]);
+    run(shares[1]);
+  } else {
+    runBoth([&] { run(shares[1]); }, [&] { run(shares[0]); });
+  }
+  return variances;
 }
 
 }  // namespace
@@ -563,9 +544,11 @@ std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double
   const std::size_t count = rate.size();
   // The noise types first, while only the rate is held (the lag-1 method averages the rate
   // itself); the phase, twice the rate's size, comes after.
-  const std::vector<int> alphas = noiseTypesForTable(rate, ms, "allanDeviationTable");
-  const IntegratedPhase phase(rate, "allanDeviationTable");
+  const double mean = compensatedMean(rate, "allanDeviationTable");  // one pass for both
+  const std::vector<int> alphas = noiseTypesForTable(rate, ms, mean);
+  const IntegratedPhase phase(rate, mean);
   const std::vector<double> overlapping = phase.overlappingAllanVariances(ms);
+  const std::vector<double> non_overlapping = nonOverlappingVariances(phase, ms);
 
   std::vector<AllanPoint> table;
   table.reserve(ms.size());
@@ -574,7 +557,7 @@ std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double
     AllanPoint p;
     p.m = m;
     p.tau_s = static_cast<double>(m) * tau0_s;
-    p.adev = std::sqrt(phase.allanVariance(m));
+    p.adev = std::sqrt(non_overlapping[j]);
     p.adev_terms = count / m >= 1 ? count / m - 1 : 0;
     p.oadev = std::sqrt(overlapping[j]);
     p.oadev_terms = phase.overlappingTerms(m);

@@ -8,24 +8,46 @@
 
 namespace gyrod::processing {
 
-double varianceAboutMean(std::span<const double> x) {
-  if (x.empty()) return 0.0;
+namespace {
+
+// The long double mean of varianceAboutMean and peakDeviationFromMean, formed once for both.
+long double longDoubleMean(std::span<const double> x) {
   long double mean = 0.0L;
   for (double v : x) mean += v;
-  mean /= static_cast<long double>(x.size());
+  return mean / static_cast<long double>(x.size());
+}
+double varianceAbout(std::span<const double> x, long double mean) {
   long double ss = 0.0L;
   for (double v : x) ss += (v - mean) * (v - mean);
   return static_cast<double>(ss / static_cast<long double>(x.size()));
 }
-
-double peakDeviationFromMean(std::span<const double> x) {
-  if (x.empty()) return 0.0;
-  long double mean = 0.0L;
-  for (double v : x) mean += v;
-  mean /= static_cast<long double>(x.size());
+double peakDeviationFrom(std::span<const double> x, long double mean) {
   double peak = 0.0;
   for (double v : x) peak = std::max(peak, std::abs(static_cast<double>(v - mean)));
   return peak;
+}
+
+struct Spread {
+  double variance = 0.0;
+  double peak = 0.0;
+};
+// varianceAboutMean(x) and peakDeviationFromMean(x), the same bits, with one mean pass.
+Spread spreadAboutMean(std::span<const double> x) {
+  if (x.empty()) return {};
+  const long double mean = longDoubleMean(x);
+  return {varianceAbout(x, mean), peakDeviationFrom(x, mean)};
+}
+
+}  // namespace
+
+double varianceAboutMean(std::span<const double> x) {
+  if (x.empty()) return 0.0;
+  return varianceAbout(x, longDoubleMean(x));
+}
+
+double peakDeviationFromMean(std::span<const double> x) {
+  if (x.empty()) return 0.0;
+  return peakDeviationFrom(x, longDoubleMean(x));
 }
 
 namespace {
@@ -65,10 +87,14 @@ AxisAnalysis analyzeAxis(std::vector<double>&& rate_dps, const AnalysisOptions& 
   AxisAnalysis a;
   a.samples = rate_dps.size();
 
-  // 1. Tests on the raw series, before any preprocessing (paper §3.2.1).
-  a.zero_mean = zeroMeanTest(rate_dps);
-  a.reverse_arrangements = reverseArrangementsTest(rate_dps, options.reverse_arrangements_segments);
-  a.normality = chiSquareNormalityTest(rate_dps);
+  // 1. Tests on the raw series, before any preprocessing (paper §3.2.1); they only read it,
+  // so two run beside the third.
+  runBoth(
+      [&] {
+        a.zero_mean = zeroMeanTest(rate_dps);
+        a.reverse_arrangements = reverseArrangementsTest(rate_dps, options.reverse_arrangements_segments);
+      },
+      [&] { a.normality = chiSquareNormalityTest(rate_dps); });
 
   // 2. Preprocessing (§3.2.2), in place: the raw series is not needed again.
   std::vector<double> x = std::move(rate_dps);
@@ -84,26 +110,36 @@ AxisAnalysis analyzeAxis(std::vector<double>&& rate_dps, const AnalysisOptions& 
   // once: its output identifies the Kalman and then feeds it, exactly as AxisFilterChain
   // (mean filter, then Kalman) would on the same series.
   std::vector<double> filtered = meanFiltered(x, options.mean_window, options.mean_threshold_dps);
-  a.filter = identifyFilterChainFromMeanFiltered(x, filtered, options.mean_window, options.mean_threshold_dps,
-                                                 options.kalman_overrides);
-  a.ar = yuleWalker(filtered, options.max_ar_order);
-  a.ar_order_aic = orderByAic(a.ar);
-  a.ar_order_bic = orderByBic(a.ar);
-  a.steady_state_gain = steadyStateGain(a.filter.kalman.a, a.filter.kalman.q, a.filter.kalman.r);
-
-  a.variance.raw = varianceAboutMean(x);
-  a.variance.mean = varianceAboutMean(filtered);
-  const double peak_raw = peakDeviationFromMean(x);
+  // The identification and the AR models beside the spreads: all only read x and filtered.
+  double peak_raw = 0.0;
+  runBoth(
+      [&] {
+        a.filter = identifyFilterChainFromMeanFiltered(x, filtered, options.mean_window, options.mean_threshold_dps,
+                                                       options.kalman_overrides);
+        a.ar = yuleWalker(filtered, options.max_ar_order);
+        a.ar_order_aic = orderByAic(a.ar);
+        a.ar_order_bic = orderByBic(a.ar);
+        a.steady_state_gain = steadyStateGain(a.filter.kalman.a, a.filter.kalman.q, a.filter.kalman.r);
+      },
+      [&] {
+        const Spread raw = spreadAboutMean(x);
+        a.variance.raw = raw.variance;
+        peak_raw = raw.peak;
+        a.variance.mean = varianceAboutMean(filtered);
+      });
   x = std::vector<double>();  // the Kalman output takes the mean-filter output's place
 
   ScalarKalmanFilter kalman(a.filter.kalman);
   for (double& v : filtered) v = kalman.update(v);
   const std::vector<double>& kalman_filtered = filtered;
-  a.variance.kalman = varianceAboutMean(kalman_filtered);
-  a.peak_ratio = peak_raw > 0.0 ? peakDeviationFromMean(kalman_filtered) / peak_raw : 0.0;
 
-  // Table 4: the same Allan analysis on the Kalman output.
-  a.allan_after_kalman = allanDeviationTable(kalman_filtered, tau0, ms);
+  // Table 4: the same Allan analysis on the Kalman output, beside its spread.
+  runBoth([&] { a.allan_after_kalman = allanDeviationTable(kalman_filtered, tau0, ms); },
+          [&] {
+            const Spread after = spreadAboutMean(kalman_filtered);
+            a.variance.kalman = after.variance;
+            a.peak_ratio = peak_raw > 0.0 ? after.peak / peak_raw : 0.0;
+          });
   a.noise_after_kalman = fitNoiseTerms(a.allan_after_kalman);
   return a;
 }

@@ -4,6 +4,7 @@
 // afterwards, so a result never depends on the number of threads.
 #include <algorithm>
 #include <cstddef>
+#include <exception>
 #include <thread>
 #include <vector>
 
@@ -31,6 +32,36 @@ void forEachShare(std::size_t count, Body&& body, std::size_t min_per_thread = 1
   for (std::size_t t = 0; t + 1 < threads; ++t) workers.emplace_back([&, t] { body(boundary(t), boundary(t + 1)); });
   body(boundary(threads - 1), count);
   for (auto& w : workers) w.join();
+}
+
+// Runs first() and second() at once (second on the calling thread) when there are two cores,
+// else one after the other. Each writes only its own results, so nothing depends on the
+// thread count. An exception from either is rethrown once both have ended, first()'s before
+// second()'s: the one the sequential order would have thrown.
+template <typename First, typename Second>
+void runBoth(First&& first, Second&& second) {
+  if (shareThreadCount() <= 1) {
+    first();
+    second();
+    return;
+  }
+  std::exception_ptr first_error;
+  std::exception_ptr second_error;
+  std::thread worker([&] {
+    try {
+      first();
+    } catch (...) {
+      first_error = std::current_exception();
+    }
+  });
+  try {
+    second();
+  } catch (...) {
+    second_error = std::current_exception();
+  }
+  worker.join();
+  if (first_error) std::rethrow_exception(first_error);
+  if (second_error) std::rethrow_exception(second_error);
 }
 
 }  // namespace gyrod::processing

@@ -13,6 +13,7 @@
 
 #include "formats/csv_fields.hpp"
 #include "formats/recording_csv.hpp"
+#include "formats/recording_format.hpp"
 
 using namespace gyrod::recording;
 namespace fs = std::filesystem;
@@ -87,6 +88,68 @@ TEST(RecordingReading, TheLineLimitHoldsAcrossAChunkBoundary) {
     EXPECT_EQ(std::string(e.what()), f.path() + ":" + std::to_string(lines_before + 1) +
                                          ": line longer than 65536 bytes (the limit for one line)");
   }
+}
+
+// The lines of each chunk are cut in two slices parsed on both cores: a bad value anywhere,
+// the first of two in one chunk included, is named by its own line.
+TEST(RecordingReading, TheFirstBadLineIsNamedWhereverItFalls) {
+  const Written w = longFile();
+  const auto lineStart = [&](std::size_t sample) {
+    std::size_t pos = 0;
+    for (std::size_t line = 1; line < w.lines[sample]; ++line) pos = w.text.find('\n', pos) + 1;
+    return pos;
+  };
+  const auto withBadSample = [&](std::string text, std::size_t sample) {
+    const std::size_t at = lineStart(sample);
+    text.replace(at, w.text.find('\n', at) - at, "0,1,x");
+    return text;
+  };
+  for (std::size_t sample : {std::size_t{0}, std::size_t{9'000}, std::size_t{11'000}, std::size_t{21'000},
+                             std::size_t{40'000}, std::size_t{59'999}}) {
+    TempFile f(withBadSample(w.text, sample));
+    try {
+      (void)readRecordingCsv(f.path());
+      FAIL() << "accepted a bad value at sample " << sample;
+    } catch (const RecordingError& e) {
+      EXPECT_EQ(std::string(e.what()),
+                f.path() + ":" + std::to_string(w.lines[sample]) + ": column 'gy': 'x' is not a number");
+    }
+  }
+  // Two bad lines a few kB apart (one chunk, most likely in both of its slices): the first.
+  TempFile two(withBadSample(withBadSample(w.text, 30'000), 25'000));
+  try {
+    (void)readRecordingCsv(two.path());
+    FAIL() << "accepted two bad values";
+  } catch (const RecordingError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              two.path() + ":" + std::to_string(w.lines[25'000]) + ": column 'gy': 'x' is not a number");
+  }
+}
+
+// GAP lines anywhere in a long file: each record keeps its line and the sample after it.
+TEST(RecordingReading, GapRecordsKeepTheirPlaceInLongFiles) {
+  std::string text = "t,gx\n";
+  std::vector<LostSamples> expected;
+  std::size_t line = 1, samples = 0;
+  for (std::size_t i = 0; i < 200'000; ++i) {
+    if (i % 7'919 == 5) {
+      RecordingLine gap;
+      text += formatGapLine(gap, i, 0.02 * static_cast<double>(i), 3, "fifo_overflow");
+      const auto parsed = parseLostSamplesLine(gap.view().substr(0, gap.size - 1));  // without its '\n'
+      ASSERT_TRUE(parsed.has_value());
+      LostSamples lost = *parsed;
+      lost.line = ++line;
+      lost.before_sample = samples;
+      expected.push_back(lost);
+    }
+    text += std::to_string(i) + ",0.25\n";
+    ++line;
+    ++samples;
+  }
+  TempFile f(text);
+  const Recording rec = readRecordingCsv(f.path());
+  EXPECT_EQ(rec.size(), samples);
+  EXPECT_EQ(rec.lost, expected);
 }
 
 TEST(RecordingReading, ProgressIsReportedEveryMillionLines) {

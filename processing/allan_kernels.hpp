@@ -1,0 +1,32 @@
+#pragma once
+// The two inner loops of the overlapping Allan sweep (processing/allan.cpp), kept apart so
+// that each is compiled for the machine it runs on: on x86-64 an AVX2 clone is chosen at
+// load time when the CPU has it (GCC/Clang function multiversioning), else the baseline
+// (SSE2); on ARM the one portable build (NEON on arm64). Every path does the same IEEE
+// operations lane by lane in the same order, without fused multiply-adds (ISO C++ mode
+// contracts nothing, and the AVX2 clone does not enable FMA), so every path gives the same
+// bits: the ISA changes the speed, never a result.
+#include <cstddef>
+
+namespace gyrod::processing::allan_kernels {
+
+// Σ over i in [k, block_end) of d_i², with d_i the second difference at averaging m of the
+// phase held as hi[i] + lo[i]:
+//   d_i = ((hi[i+2m] − hi[i+m]) − (hi[i+m] − hi[i])) + ((lo[i+2m] − lo[i+m]) − (lo[i+m] − lo[i])).
+// Lane j of a four-lane accumulator takes the terms k + 4q + j, the tail goes to lane 0, and
+// the total is (lane0 + lane1) + (lane2 + lane3).
+double overlappingBlockTotal(const double* hi, const float* lo, std::size_t m, std::size_t k, std::size_t block_end);
+
+// The phase of the mean-removed rate as the unevaluated sum hi[k] + lo[k], k = 0 … count
+// (hi[0] = lo[0] = 0): the double-double running sum of (rate[i] − mean), lo rounded to
+// float. Formed in fixed runs of kPhaseRun samples: every run's double-double total (pass 1),
+// the runs' starting sums by double-double addition of the totals before them (pass 2), then
+// every run's running sum from its start (pass 3). Passes 1 and 3 take four runs at once, one
+// per lane (independent chains: the latency of one hides behind the others), and share the
+// runs among threads. The run length is fixed, so the phase is the same bits for any number
+// of threads and any ISA; it differs from one serial running sum only by the errors of the
+// double-double additions (~ε²·|x| each, far below the float lo's 2⁻⁷⁷·|x|).
+inline constexpr std::size_t kPhaseRun = std::size_t{1} << 13;
+void integratePhase(const double* rate, std::size_t count, double mean, double* hi, float* lo);
+
+}  // namespace gyrod::processing::allan_kernels
