@@ -4,9 +4,11 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <random>
+#include <set>
 #include <string>
 
 #include "formats/kalibr_yaml.hpp"
@@ -178,4 +180,27 @@ TEST(GyroctlKalibr, BadOptionsAreRefusedBeforeTheAnalysis) {
   EXPECT_NE(kalibr.exit_status, 0);
   EXPECT_EQ(kalibr.exit_status, model.exit_status);
   EXPECT_NE(kalibr.err.find("refusing to write: it is a directory"), std::string::npos) << kalibr.err;
+}
+
+// docs/coming-from.md lists every noise key analyze writes, gyro and accelerometer, and no other.
+TEST(GyroctlAnalyzeAccel, TheDocumentedNoiseKeysAreTheJsonKeys) {
+  ScratchDir d;
+  const auto rec = d.write("acc.csv", accelRecording(2'000, 0.002, 0.0, 4));
+  const auto r = runGyroctl("analyze " + rec.string() + " --json --axis all", d.path());
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const json doc = json::parse(r.out);
+  std::set<std::string> written;
+  for (const char* axis : {"gx", "ax"})
+    for (const auto& [key, value] : doc["axes"][axis]["noise"].items()) written.insert(key);
+
+  std::ifstream in(std::string(GYROD_TEST_DATA_DIR) + "/../../docs/coming-from.md");
+  ASSERT_TRUE(in) << "docs/coming-from.md";
+  std::set<std::string> documented;
+  std::string line;
+  bool in_section = false;
+  while (std::getline(in, line)) {
+    if (line.rfind("## ", 0) == 0) in_section = line == "## gyroctl's noise keys";
+    if (in_section && line.rfind("| `", 0) == 0) documented.insert(line.substr(3, line.find('`', 3) - 3));
+  }
+  EXPECT_EQ(documented, written);
 }
