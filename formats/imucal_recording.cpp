@@ -1,5 +1,6 @@
 #include "formats/imucal_recording.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -46,10 +47,31 @@ bool parseLong(const std::string& s, long& v) {
   return used == s.size();
 }
 
+// One output column: its name, where it is in the logger's line, and its counts per unit.
+struct ImucalColumn {
+  std::string_view name;
+  std::size_t field = 0;
+  double lsb_per_unit = 1.0;
+};
+
+// The gyro columns present (°/s), then the accelerometer columns present (g).
+std::vector<ImucalColumn> outputColumns(const std::vector<std::string>& columns, double lsb_per_dps, double lsb_per_g) {
+  std::vector<ImucalColumn> out;
+  const auto add = [&](const auto& names, double lsb) {
+    for (const auto name : names)
+      for (std::size_t c = 0; c < columns.size(); ++c)
+        if (columns[c] == name) out.push_back({name, c, lsb});
+  };
+  add(kGyroColumns, lsb_per_dps);
+  add(kAccelColumns, lsb_per_g);
+  return out;
+}
+
 }  // namespace
 
-ImucalConversion convertImucal(std::istream& in, const std::string& path, int fs_sel) {
+ImucalConversion convertImucal(std::istream& in, const std::string& path, int fs_sel, int afs_sel) {
   if (fs_sel < 0 || fs_sel > 3) throw std::invalid_argument("FS_SEL " + std::to_string(fs_sel) + " is not in 0..3");
+  if (afs_sel < 0 || afs_sel > 3) throw std::invalid_argument("AFS_SEL " + std::to_string(afs_sel) + " is not in 0..3");
   BoundedLineReader reader(in);
   std::string line;
   std::size_t line_no = 0;
@@ -85,20 +107,20 @@ ImucalConversion convertImucal(std::istream& in, const std::string& path, int fs
     }
   }
   if (columns.empty()) fail(path, line_no, "no column-name line (ax,ay,az,gx,gy,gz) found");
-  int gcol[3] = {-1, -1, -1};
-  const auto& names = kGyroColumns;
-  for (std::size_t c = 0; c < columns.size(); ++c)
-    for (int a = 0; a < 3; ++a)
-      if (columns[c] == names[a]) gcol[a] = static_cast<int>(c);
-  std::vector<int> present;
-  for (int a = 0; a < 3; ++a)
-    if (gcol[a] >= 0) present.push_back(a);
-  if (present.empty()) fail(path, line_no, "no gyro column (gx, gy or gz) in " + formats::quotedValue(line));
-
   result.lsb_per_dps = kGyroLsbPerDps[fs_sel];
+  result.lsb_per_g = kAccelLsbPerG[afs_sel];
+  const auto outputs = outputColumns(columns, result.lsb_per_dps, result.lsb_per_g);
+  const auto is_gyro = [](const ImucalColumn& c) {
+    return std::find(kGyroColumns.begin(), kGyroColumns.end(), c.name) != kGyroColumns.end();
+  };
+  if (std::none_of(outputs.begin(), outputs.end(), is_gyro))
+    fail(path, line_no, "no gyro column (gx, gy or gz) in " + formats::quotedValue(line));
+  result.accel_columns = static_cast<std::size_t>(
+      std::count_if(outputs.begin(), outputs.end(), [&](const ImucalColumn& c) { return !is_gyro(c); }));
+
   std::string& out = result.csv;
   out = "t";
-  for (int a : present) out += "," + std::string(names[a]);
+  for (const auto& c : outputs) out += "," + std::string(c.name);
   out += '\n';
   std::size_t& samples = result.samples;
   char buf[40];
@@ -117,16 +139,15 @@ ImucalConversion convertImucal(std::istream& in, const std::string& path, int fs
                " / Fs is not a finite number");
     std::snprintf(buf, sizeof buf, "%.17g", t);
     out += buf;
-    for (int a : present) {
+    for (const auto& c : outputs) {
       long counts = 0;
-      const auto& field = f[static_cast<std::size_t>(gcol[a])];
-      const std::string_view column = names[a];
+      const auto& field = f[c.field];
       if (!parseLong(field, counts))
         fail(path, line_no,
-             "column '" + std::string(column) + "': " + formats::quotedValue(field) + " is not an integer count");
+             "column '" + std::string(c.name) + "': " + formats::quotedValue(field) + " is not an integer count");
       if (counts < -32768 || counts > 32767)
-        fail(path, line_no, "column '" + std::string(column) + "': " + field + " is outside the 16-bit range");
-      std::snprintf(buf, sizeof buf, ",%.17g", static_cast<double>(counts) / result.lsb_per_dps);
+        fail(path, line_no, "column '" + std::string(c.name) + "': " + field + " is outside the 16-bit range");
+      std::snprintf(buf, sizeof buf, ",%.17g", static_cast<double>(counts) / c.lsb_per_unit);
       out += buf;
     }
     out += '\n';

@@ -23,7 +23,8 @@
 namespace gyrod::recording {
 namespace {
 
-constexpr std::array<std::string_view, 8> kKnownColumns = {"t", "gx", "gy", "gz", "temp", "wx", "wy", "wz"};
+constexpr std::array<std::string_view, 11> kKnownColumns = {"t",  "gx", "gy", "gz", "temp", "wx",
+                                                            "wy", "wz", "ax", "ay", "az"};
 
 [[noreturn]] void fail(const std::string& path, std::size_t line, const std::string& cause) {
   std::ostringstream s;
@@ -145,7 +146,7 @@ std::size_t expectedLines(std::FILE* file, std::size_t line_bytes) {
   return static_cast<std::size_t>(st.st_size) / std::max<std::size_t>(line_bytes, 1) * 3 / 2 + 16;
 }
 
-enum class Role { T, Axis, Temp, Truth };
+enum class Role { T, Axis, Temp, Truth, Accel };
 using ColumnRole = std::pair<Role, std::size_t>;  // what a column feeds, and which axis
 
 // The columns of a header line; fills rec.axis_names and sizes rec.axes.
@@ -160,7 +161,7 @@ std::vector<ColumnRole> headerRoles(const std::string& path, std::size_t line_no
   for (auto name : names) {
     if (std::find(kKnownColumns.begin(), kKnownColumns.end(), name) == kKnownColumns.end())
       fail(path, line_no,
-           "unknown column " + formats::quotedValue(name) + " (expected any of t,gx,gy,gz,temp,wx,wy,wz)");
+           "unknown column " + formats::quotedValue(name) + " (expected any of t,gx,gy,gz,temp,wx,wy,wz,ax,ay,az)");
     for (std::size_t j = 0; j < roles.size(); ++j)
       if (names[j] == name) fail(path, line_no, "column '" + std::string(name) + "' appears twice");
     if (name == "t") {
@@ -170,6 +171,9 @@ std::vector<ColumnRole> headerRoles(const std::string& path, std::size_t line_no
     } else if (const auto truth = std::find(kTruthColumns.begin(), kTruthColumns.end(), name);
                truth != kTruthColumns.end()) {
       roles.push_back({Role::Truth, static_cast<std::size_t>(truth - kTruthColumns.begin())});
+    } else if (const auto accel = std::find(kAccelColumns.begin(), kAccelColumns.end(), name);
+               accel != kAccelColumns.end()) {
+      roles.push_back({Role::Accel, static_cast<std::size_t>(accel - kAccelColumns.begin())});
     } else {
       roles.push_back({Role::Axis, rec.axis_names.size()});
       rec.axis_names.emplace_back(name);
@@ -389,10 +393,11 @@ Recording parseRecordingFile(std::FILE* file, const std::string& path, const Rea
   std::vector<std::vector<double>*> targets;
   targets.reserve(roles.size());
   for (const auto& [role, index] : roles) {
-    targets.push_back(role == Role::T      ? &rec.t
-                      : role == Role::Temp ? &rec.temp
-                      : role == Role::Axis ? &rec.axes[index]
-                                           : &rec.true_rate[index]);
+    targets.push_back(role == Role::T       ? &rec.t
+                      : role == Role::Temp  ? &rec.temp
+                      : role == Role::Axis  ? &rec.axes[index]
+                      : role == Role::Accel ? &rec.accel_g[index]
+                                            : &rec.true_rate[index]);
   }
   const auto columnName = [&](std::size_t c) {
     const auto [role, index] = roles[c];
@@ -400,6 +405,7 @@ Recording parseRecordingFile(std::FILE* file, const std::string& path, const Rea
            : role == Role::T     ? std::string("t")
            : role == Role::Temp  ? std::string("temp")
            : role == Role::Truth ? std::string(kTruthColumns[index])
+           : role == Role::Accel ? std::string(kAccelColumns[index])
                                  : rec.axis_names[index];
   };
 

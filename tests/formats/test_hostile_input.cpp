@@ -121,7 +121,7 @@ TEST(RecordingHostileInput, BadValuesAreEscapedAndCut) {
   EXPECT_EQ(e, path + ":2: column 'gx': non-finite value '" + huge_number.substr(0, kQuotedValueMaxChars) +
                    "…' (20001 bytes)");
   e = errorOf("t,g\x1b[2J\n", &path);
-  EXPECT_EQ(e, path + ":1: unknown column 'g\\x1B[2J' (expected any of t,gx,gy,gz,temp,wx,wy,wz)");
+  EXPECT_EQ(e, path + ":1: unknown column 'g\\x1B[2J' (expected any of t,gx,gy,gz,temp,wx,wy,wz,ax,ay,az)");
 }
 
 // A directory opens as a stream but reads nothing: it must not pass for an empty file.

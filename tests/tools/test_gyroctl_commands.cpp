@@ -221,12 +221,16 @@ TEST(GyroctlImport, ConvertsTheRealImucalRecordingExactly) {
   ASSERT_EQ(r.exit_status, 0) << r.err;
   std::vector<std::string> header;
   const auto cols = parseCsv(readWholeFile(out), header);
-  EXPECT_EQ(header, (std::vector<std::string>{"t", "gx", "gy", "gz"}));
+  EXPECT_EQ(header, (std::vector<std::string>{"t", "gx", "gy", "gz", "ax", "ay", "az"}));
   ASSERT_EQ(cols[0].size(), 9986u);
   // First data line of the source: 748,244,15708,-480,193,-83.
   EXPECT_EQ(cols[1][0], -480.0 / 131.0);
   EXPECT_EQ(cols[2][0], 193.0 / 131.0);
   EXPECT_EQ(cols[3][0], -83.0 / 131.0);
+  // The accelerometer at ±2 g, 16384 LSB per g (exact in binary, so compared exactly).
+  EXPECT_EQ(cols[4][0], 748.0 / 16384.0);
+  EXPECT_EQ(cols[5][0], 244.0 / 16384.0);
+  EXPECT_EQ(cols[6][0], 15708.0 / 16384.0);
   EXPECT_EQ(cols[0][1], 0.01);
   EXPECT_EQ(cols[0][9985], 9985.0 / 100.0);
   // And analyze reads it, finding the rate from t.

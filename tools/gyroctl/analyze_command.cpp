@@ -10,6 +10,7 @@
 #include <string>
 
 #include "formats/calibration.hpp"
+#include "formats/kalibr_yaml.hpp"
 #include "formats/model_toml.hpp"
 #include "formats/output_file.hpp"
 #include "processing/allan.hpp"
@@ -17,7 +18,9 @@
 #include "processing/detrend.hpp"
 #include "processing/noise_fit.hpp"
 #include "processing/noise_terms.hpp"
+#include "processing/noise_units.hpp"
 #include "processing/warm_up_fit.hpp"
+#include "tools/gyroctl/analyze_imu.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
 #include "tools/gyroctl/series_checks.hpp"
@@ -52,6 +55,10 @@ void releaseColumnsNotAnalysed(recording::Recording& rec) {
   for (auto& truth : rec.true_rate) truth = std::vector<double>();
 }
 
+// The unit of a column's values, for key names ("dps", "g") and for text ("deg/s", "g").
+const char* unitKey(SensorKind s) { return s == SensorKind::Accel ? "g" : "dps"; }
+const char* unitText(SensorKind s) { return s == SensorKind::Accel ? "g" : "deg/s"; }
+
 struct AnalyzeOptions {
   std::string file;
   std::optional<double> rate_hz;
@@ -62,8 +69,10 @@ struct AnalyzeOptions {
   bool strict_timing = false;
   std::size_t mean_window = 20;
   double mean_threshold_dps = 0.3;
+  double accel_mean_threshold_g = 0.05;
   std::size_t max_ar_order = 3;
   std::string write_model;
+  KalibrOptions kalibr;
 };
 
 std::vector<double> parseTauList(const std::string& text) {
@@ -100,9 +109,12 @@ std::vector<std::size_t> clusterSizesFor(const std::string& spec, double rate_hz
   }
 }
 
-json noiseTermsJson(const NoiseTerms& t) {
+// Each term in the paper's units (or the accelerometer's counterparts) and in SI
+// (processing/noise_units.hpp names the keys).
+json noiseTermsJson(const NoiseTerms& t, SensorKind sensor) {
   json j = json::object();
-  for (NoiseTerm term : kAllNoiseTerms) j[std::string(noiseTermKey(term))] = t.get(term);
+  for (NoiseTerm term : kAllNoiseTerms)
+    for (const auto& figure : noiseFigures(term, t.get(term), sensor)) j[std::string(figure.key)] = figure.value;
   return j;
 }
 
@@ -120,8 +132,10 @@ json allanJson(const std::vector<AllanPoint>& curve) {
   return a;
 }
 
-json axisJson(const AxisAnalysis& a) {
+json axisJson(const AxisAnalysis& a, SensorKind sensor) {
+  const std::string unit = unitKey(sensor);
   json j;
+  j["unit"] = unitText(sensor);
   j["samples"] = a.samples;
   j["tests"] = {{"mean", a.zero_mean.mean},
                 {"mean_z", a.zero_mean.z},
@@ -134,12 +148,13 @@ json axisJson(const AxisAnalysis& a) {
                 {"chi2_critical", a.normality.critical},
                 {"chi2_p", a.normality.p_value},
                 {"normal", a.normality.normal}};
-  j["trend_removed"] = {{"offset_dps", a.trend_removed.offset}, {"slope_dps_per_s", a.trend_removed.slope_per_s}};
+  j["trend_removed"] = {{"offset_" + unit, a.trend_removed.offset},
+                        {"slope_" + unit + "_per_s", a.trend_removed.slope_per_s}};
   j["allan"] = allanJson(a.allan);
-  j["noise"] = noiseTermsJson(a.noise.value);
-  j["noise_uncertainty"] = noiseTermsJson(a.noise.uncertainty);
+  j["noise"] = noiseTermsJson(a.noise.value, sensor);
+  j["noise_uncertainty"] = noiseTermsJson(a.noise.uncertainty, sensor);
   j["noise_fit_reduced_chi2"] = a.noise.reduced_chi2;
-  j["noise_from_slopes"] = noiseTermsJson(a.noise_from_slopes);
+  j["noise_from_slopes"] = noiseTermsJson(a.noise_from_slopes, sensor);
   json ar = json::array();
   for (const auto& m : a.ar)
     ar.push_back({{"order", m.order()},
@@ -151,7 +166,7 @@ json axisJson(const AxisAnalysis& a) {
   j["ar"] = ar;
   j["ar_order_aic"] = a.ar_order_aic;
   j["ar_order_bic"] = a.ar_order_bic;
-  j["mean_filter"] = {{"window", a.filter.mean_window}, {"threshold_dps", a.filter.mean_threshold_dps}};
+  j["mean_filter"] = {{"window", a.filter.mean_window}, {"threshold_" + unit, a.filter.mean_threshold_dps}};
   j["kalman"] = {{"a", a.filter.kalman.a},
                  {"q", a.filter.kalman.q},
                  {"r", a.filter.kalman.r},
@@ -160,7 +175,7 @@ json axisJson(const AxisAnalysis& a) {
   j["variance"] = {{"raw", a.variance.raw}, {"mean", a.variance.mean}, {"kalman", a.variance.kalman}};
   j["peak_ratio"] = a.peak_ratio;
   j["allan_after_kalman"] = allanJson(a.allan_after_kalman);
-  j["noise_after_kalman"] = noiseTermsJson(a.noise_after_kalman.value);
+  j["noise_after_kalman"] = noiseTermsJson(a.noise_after_kalman.value, sensor);
   return j;
 }
 
@@ -170,11 +185,26 @@ std::string format(const char* fmt, double v) {
   return buf;
 }
 
+// Table 2 (or 4) lines of one term: one per figure (the paper's units, then SI).
+void printTermLines(std::ostream& o, NoiseTerm t, SensorKind sensor, const AxisAnalysis& a) {
+  char line[256];
+  const auto values = noiseFigures(t, a.noise.value.get(t), sensor);
+  const auto sigmas = noiseFigures(t, a.noise.uncertainty.get(t), sensor);
+  const auto slopes = noiseFigures(t, a.noise_from_slopes.get(t), sensor);
+  for (std::size_t f = 0; f < values.size(); ++f) {
+    std::snprintf(line, sizeof line, "  %-42s %12.5g +- %-11.3g | %12.5g\n", std::string(values[f].label).c_str(),
+                  values[f].value, sigmas[f].value, slopes[f].value);
+    o << line;
+  }
+}
+
 void printAxisText(std::ostream& o, const std::string& name, const AxisAnalysis& a) {
   char line[256];
+  const SensorKind sensor = sensorOfColumn(name);
+  const char* unit = unitText(sensor);
   o << "\n== " << name << " ==\n";
   o << "Tests on the raw series (5 % level)\n";
-  std::snprintf(line, sizeof line, "  zero mean     mean = %.6g deg/s, z = %.3f  -> %s\n", a.zero_mean.mean,
+  std::snprintf(line, sizeof line, "  zero mean     mean = %.6g %s, z = %.3f  -> %s\n", a.zero_mean.mean, unit,
                 a.zero_mean.z, a.zero_mean.zero_mean ? "zero mean" : "non-zero mean");
   o << line;
   std::snprintf(line, sizeof line,
@@ -187,12 +217,12 @@ void printAxisText(std::ostream& o, const std::string& name, const AxisAnalysis&
                 a.normality.normal ? "normal" : "not normal");
   o << line;
   if (a.trend_removed.offset != 0.0 || a.trend_removed.slope_per_s != 0.0) {
-    std::snprintf(line, sizeof line, "Removed: constant %.6g deg/s and trend %.6g deg/s per s\n",
-                  a.trend_removed.offset, a.trend_removed.slope_per_s);
+    std::snprintf(line, sizeof line, "Removed: constant %.6g %s and trend %.6g %s per s\n", a.trend_removed.offset,
+                  unit, a.trend_removed.slope_per_s, unit);
     o << line;
   }
 
-  o << "\nAllan deviation (deg/s; overlapping with 68.3 % chi2 interval)\n";
+  o << "\nAllan deviation (" << unit << "; overlapping with 68.3 % chi2 interval)\n";
   o << "      tau [s]        m         adev        oadev     oadev_lo     oadev_hi    terms  alpha\n";
   for (const auto& p : a.allan) {
     std::snprintf(line, sizeof line, "  %11.4f %8zu %12.5g %12.5g %12.5g %12.5g %8zu %6d\n", p.tau_s, p.m, p.adev,
@@ -201,11 +231,7 @@ void printAxisText(std::ostream& o, const std::string& name, const AxisAnalysis&
   }
 
   o << "\nTable 2: noise terms (weighted fit +- 1 sigma | slope-line reading)\n";
-  for (NoiseTerm t : kAllNoiseTerms) {
-    std::snprintf(line, sizeof line, "  %-36s %12.5g +- %-11.3g | %12.5g\n", std::string(noiseTermLabel(t)).c_str(),
-                  a.noise.value.get(t), a.noise.uncertainty.get(t), a.noise_from_slopes.get(t));
-    o << line;
-  }
+  for (NoiseTerm t : kAllNoiseTerms) printTermLines(o, t, sensor, a);
 
   o << "\nTable 3: AR models of the mean-filtered series (Yule-Walker)\n";
   o << "              ";
@@ -229,7 +255,7 @@ void printAxisText(std::ostream& o, const std::string& name, const AxisAnalysis&
                 "\nKalman on AR(1): A = %.5g, Q = %.5g, R = %.5g, P0 = %.3g, steady-state gain %.4f\n",
                 a.filter.kalman.a, a.filter.kalman.q, a.filter.kalman.r, a.filter.kalman.p0, a.steady_state_gain);
   o << line;
-  std::snprintf(line, sizeof line, "Variance (deg/s)^2: raw %.5g, mean filter %.5g, Kalman %.5g (%.1f %% of raw)\n",
+  std::snprintf(line, sizeof line, "Variance (%s)^2: raw %.5g, mean filter %.5g, Kalman %.5g (%.1f %% of raw)\n", unit,
                 a.variance.raw, a.variance.mean, a.variance.kalman,
                 a.variance.raw > 0 ? 100.0 * a.variance.kalman / a.variance.raw : 0.0);
   o << line;
@@ -238,8 +264,10 @@ void printAxisText(std::ostream& o, const std::string& name, const AxisAnalysis&
 
   o << "\nTable 4: noise terms before and after Kalman\n";
   for (NoiseTerm t : kAllNoiseTerms) {
-    const double before = a.noise.value.get(t), after = a.noise_after_kalman.value.get(t);
-    std::snprintf(line, sizeof line, "  %-36s %12.5g %12.5g", std::string(noiseTermLabel(t)).c_str(), before, after);
+    const auto before_figure = noiseFigures(t, a.noise.value.get(t), sensor).front();
+    const double before = before_figure.value;
+    const double after = noiseFigures(t, a.noise_after_kalman.value.get(t), sensor).front().value;
+    std::snprintf(line, sizeof line, "  %-42s %12.5g %12.5g", std::string(before_figure.label).c_str(), before, after);
     o << line;
     if (before > 0.0) o << format("  %+7.1f %%", 100.0 * (after - before) / before);
     o << '\n';
@@ -289,9 +317,20 @@ void calibrateAxisInto(recording::SensorModel& sensor, std::size_t slot, const s
   notes.push_back(note);
 }
 
+// imu.yaml for Kalibr; each term it could not fill is named on stderr as in the file.
+void writeKalibrImu(const AnalyzeOptions& opt, const LoadedInput& in, const std::vector<AxisAnalysis>& analyses) {
+  std::vector<std::string> columns, missing;
+  for (std::size_t idx : in.axis_indices) columns.push_back(in.recording.axis_names[idx]);
+  const auto imu = kalibrImuFromAnalyses(columns, analyses, in.rate_hz, opt.file, opt.kalibr, missing);
+  formats::writeFileAtomically(opt.kalibr.output, formats::kalibrImuYaml(imu), {opt.file});
+  for (const auto& m : missing) std::fprintf(stderr, "gyroctl analyze: %s: %s\n", opt.kalibr.output.c_str(), m.c_str());
+  if (!opt.json) std::printf("\nKalibr imu.yaml written to %s\n", opt.kalibr.output.c_str());
+}
+
 int runAnalyze(const AnalyzeOptions& opt) {
   // A target that cannot be written fails now, not after the analysis.
   if (!opt.write_model.empty()) formats::checkOutputTarget(opt.write_model, {opt.file});
+  if (!opt.kalibr.output.empty()) formats::checkOutputTarget(opt.kalibr.output, {opt.file});
   // A progress line left on the terminal would run into an error message: cleared on any exit.
   struct ClearProgressLine {
     bool active;
@@ -302,7 +341,9 @@ int runAnalyze(const AnalyzeOptions& opt) {
   recording::ReadOptions read;
   read.line_numbers = false;  // the line runs name any sample's line: 8 bytes a sample saved
   read.progress = readingProgress(opt.file);
-  LoadedInput in = loadInput(opt.file, opt.rate_hz, opt.axis, read);
+  // An accelerometer column is not among the gyro axes loadInput picks from.
+  LoadedInput in = loadInput(opt.file, opt.rate_hz, isAccelColumn(opt.axis) ? "all" : opt.axis, read);
+  selectAccelColumns(in, opt.axis);
   auto& rec = in.recording;
   const std::size_t samples = rec.size();
   if (rec.size() < kMinimumSamples) {
@@ -330,7 +371,10 @@ int runAnalyze(const AnalyzeOptions& opt) {
     if (show_progress)
       std::fprintf(stderr, "\ranalysing %s (%zu of %zu)...\033[K", rec.axis_names[idx].c_str(), k + 1,
                    in.axis_indices.size());
-    analyses.push_back(analyzeColumn(rec, idx, options, writes_model));
+    AnalysisOptions column_options = options;
+    if (sensorOfColumn(rec.axis_names[idx]) == SensorKind::Accel)
+      column_options.mean_threshold_dps = opt.accel_mean_threshold_g;
+    analyses.push_back(analyzeColumn(rec, idx, column_options, writes_model));
   }
   if (show_progress) std::fprintf(stderr, "\r\033[K");
 
@@ -366,7 +410,7 @@ int runAnalyze(const AnalyzeOptions& opt) {
       calibrateAxisInto(sensor, *slot, rec.axis_names[idx], secs, rec, idx, options, notes);
     }
     if (opt.json)
-      doc["axes"][rec.axis_names[idx]] = axisJson(a);
+      doc["axes"][rec.axis_names[idx]] = axisJson(a, sensorOfColumn(rec.axis_names[idx]));
     else
       printAxisText(std::cout, rec.axis_names[idx], a);
   }
@@ -376,6 +420,7 @@ int runAnalyze(const AnalyzeOptions& opt) {
     formats::writeFileAtomically(opt.write_model, head + recording::sensorModelToToml(sensor), {opt.file});
     if (!opt.json) std::printf("\nModel written to %s\n", opt.write_model.c_str());
   }
+  if (!opt.kalibr.output.empty()) writeKalibrImu(opt, in, analyses);
   if (opt.json) std::cout << doc.dump(1) << '\n';
   return kExitOk;
 }
@@ -390,7 +435,8 @@ void addAnalyzeCommand(CLI::App& app, CommandRunner& run) {
   sub->add_option("FILE", opt->file, "CSV with header t,gx,gy,gz,temp (any subset), or one column of bare numbers")
       ->required();
   sub->add_option("--rate", opt->rate_hz, "sample rate [Hz] (default: from t, else 50)");
-  sub->add_option("--axis", opt->axis, "gx, gy, gz or all")->default_val("all");
+  sub->add_option("--axis", opt->axis, "gx, gy, gz, ax, ay, az or all (every gyro and accelerometer column)")
+      ->default_val("all");
   sub->add_option("--taus", opt->taus, "octave, dense, or a list of tau in seconds (e.g. 1,10,100)")
       ->default_val("octave");
   sub->add_flag("--no-detrend", opt->no_detrend, "keep the constant and the linear trend");
@@ -403,6 +449,17 @@ void addAnalyzeCommand(CLI::App& app, CommandRunner& run) {
   sub->add_option("--mean-threshold", opt->mean_threshold_dps, "gross-error threshold r [deg/s]")
       ->default_val(0.3)
       ->check(CLI::PositiveNumber);
+  sub->add_option("--accel-mean-threshold", opt->accel_mean_threshold_g,
+                  "gross-error threshold r of the accelerometer columns [g]")
+      ->default_val(0.05)
+      ->check(CLI::PositiveNumber);
+  sub->add_option("--kalibr", opt->kalibr.output,
+                  "write Kalibr's imu.yaml (noise densities and random walks in SI, update_rate, rostopic)");
+  sub->add_option("--kalibr-inflate", opt->kalibr.inflate,
+                  "multiply the imu.yaml noise values by F (Kalibr advises inflating static Allan values)")
+      ->default_val(1.0)
+      ->check(CLI::PositiveNumber);
+  sub->add_option("--kalibr-rostopic", opt->kalibr.rostopic, "rostopic written in the imu.yaml")->default_val("/imu0");
   sub->add_option("--max-ar-order", opt->max_ar_order, "highest AR order for Table 3")
       ->default_val(3)
       ->check(CLI::Range(std::size_t{1}, std::size_t{8}));
