@@ -74,6 +74,11 @@ void readDevice(const Section& s, DeviceConfig& d) {
       s.failValue("full_scale_dps", "must be 250, 500, 1000 or 2000");
     d.full_scale_dps = static_cast<int>(*v);
   }
+  if (auto v = s.boolean("accel")) d.accel = *v;
+  if (auto v = s.integer("accel_range_g")) {
+    if (*v != 2 && *v != 4 && *v != 8 && *v != 16) s.failValue("accel_range_g", "must be 2, 4, 8 or 16");
+    d.accel_range_g = static_cast<int>(*v);
+  }
   if (auto v = s.number("rate_hz")) d.rate_hz = *v;
   // Checked even when rate_hz keeps its default, since dlpf changes the internal rate.
   // The chip's rule (driver/mpu6050_config.hpp): gyro output rate / (1 + SMPLRT_DIV).
@@ -481,7 +486,9 @@ GyrodConfig readConfig(const formats::TomlDocument& doc, ReferenceChecks checks)
   };
 
   // device first: allan checks τ against device.rate_hz.
-  readDevice(section("device", {"backend", "bus", "address", "rate_hz", "dlpf", "full_scale_dps"}), config.device);
+  readDevice(
+      section("device", {"backend", "bus", "address", "rate_hz", "dlpf", "full_scale_dps", "accel", "accel_range_g"}),
+      config.device);
   readGpio(section("gpio", {"chip", "line"}), config.gpio);
   const auto bias = section("bias", {"source", "still_seconds", "values"});
   readBias(bias, config.bias);

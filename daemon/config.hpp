@@ -39,6 +39,8 @@ struct DeviceConfig {
   double rate_hz = 50.0;           // internal rate / (1 + SMPLRT_DIV), checked to be reachable
   int dlpf = 4;                    // DLPF_CFG 0..6; 4 = 20 Hz gyro bandwidth (the paper's)
   int full_scale_dps = 250;        // FS_SEL: 250, 500, 1000 or 2000 °/s
+  bool accel = true;               // accel in the FIFO (14-byte frames); false: the 8-byte gyro frame
+  int accel_range_g = 2;           // AFS_SEL: 2, 4, 8 or 16 g
   bool operator==(const DeviceConfig&) const = default;
 };
 

@@ -100,6 +100,8 @@ DeviceParts makeDeviceParts(const GyrodConfig& config) {
   dc.sample_rate_hz = config.device.rate_hz;
   dc.dlpf_cfg = config.device.dlpf;
   dc.fs_sel = fsSelFor(config.device.full_scale_dps);
+  dc.accel = config.device.accel;
+  dc.afs_sel = driver::afsSelForRangeG(config.device.accel_range_g).value_or(-1);  // -1: validateConfig names it
 
   if (config.device.backend == DeviceBackend::Mock) {
     const auto& mc = config.mock;
@@ -128,6 +130,8 @@ DeviceParts makeDeviceParts(const GyrodConfig& config) {
     driver::MockMpu6050Config mock_config;
     mock_config.address = dc.address;
     mock_config.accel_noise_seed = mc.seed;
+    // A zero-g offset of a few mg per axis, like a real part's (product spec §6.2: ±50 mg).
+    mock_config.accel_bias_g = {0.012, -0.008, 0.02};
     auto mock = std::make_unique<driver::MockMpu6050>(*b.clock, *b.source, mock_config);
     mock->setFaultPlan(faultPlanFor(mc.faults));
     b.mock = mock.get();

@@ -279,7 +279,7 @@ void Gyrod::onSample(const driver::GyroSample& s) {
   last_sample_real_ns_ = monotonicNowNs();
   ProcessedSample out;
   try {
-    out = pipeline_.process(s.seq, static_cast<double>(s.t_ns) * 1e-9, s.rate_dps, s.temp_c);
+    out = pipeline_.process(s.seq, static_cast<double>(s.t_ns) * 1e-9, s.rate_dps, s.temp_c, s.accel_g);
   } catch (const std::exception& e) {  // a sample the statistics refuse (non-finite): skip it, say why
     spdlog::error("sample {} skipped: {}", s.seq, e.what());
     return;

@@ -133,7 +133,8 @@ void SamplePipeline::finishEstimation() {
   startFilters();
 }
 
-ProcessedSample SamplePipeline::process(std::uint64_t seq, double t_s, const Vec3& raw_dps, double temp_c) {
+ProcessedSample SamplePipeline::process(std::uint64_t seq, double t_s, const Vec3& raw_dps, double temp_c,
+                                        const Vec3& accel_g) {
   ProcessedSample out;
   out.seq = seq;
   out.t_s = t_s;
@@ -144,6 +145,7 @@ ProcessedSample SamplePipeline::process(std::uint64_t seq, double t_s, const Vec
   last_t_s_ = t_s;
   for (std::size_t axis = 0; axis < kAxes; ++axis) allan_raw_[axis].push(raw_dps[axis]);
   if (rate_) {
+    rate_->observeAccel(accel_g);  // a tilt the gyro cannot tell from bias is not still
     const processing::RateSample r = rate_->update(t_s, raw_dps, temp_c);
     out.rate = r.rate_dps;
     out.rate_bias = r.bias_dps;

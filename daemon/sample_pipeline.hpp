@@ -22,6 +22,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -35,6 +36,8 @@ namespace gyrod::daemon {
 
 inline constexpr std::size_t kAxes = 3;
 using Vec3 = std::array<double, kAxes>;
+inline constexpr Vec3 kNoAccel = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
+                                  std::numeric_limits<double>::quiet_NaN()};
 
 enum class BiasOrigin { Config, Model, Estimate };
 std::string_view toString(BiasOrigin origin);
@@ -105,7 +108,9 @@ class SamplePipeline {
   // shorter than needed to identify the filter when something must be identified, ...).
   explicit SamplePipeline(const PipelineSettings& settings);
 
-  ProcessedSample process(std::uint64_t seq, double t_s, const Vec3& raw_dps, double temp_c);
+  // `accel_g` (x, y, z in g, NaN when the device has none) feeds the still detector only.
+  ProcessedSample process(std::uint64_t seq, double t_s, const Vec3& raw_dps, double temp_c,
+                          const Vec3& accel_g = kNoAccel);
 
   // After samples were lost: the filters restart on the next sample (their history is no
   // longer contiguous). The Allan statistics continue over the delivered samples.

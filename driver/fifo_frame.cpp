@@ -2,6 +2,7 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 
 namespace gyrod::driver {
 
@@ -16,6 +17,21 @@ FifoFrame decodeFifoFrame(std::span<const std::uint8_t, kFrameBytes> bytes) {
   return frame;
 }
 
+FifoFrame decodeFifoFrame(std::span<const std::uint8_t, kAccelFrameBytes> bytes) {
+  mpu6050::fifo::FullFrame raw;
+  std::memcpy(&raw, bytes.data(), sizeof raw);
+  FifoFrame frame;
+  frame.temp = mpu6050::combineBigEndian(raw.TEMP_OUT_H, raw.TEMP_OUT_L);
+  frame.gyro = {mpu6050::combineBigEndian(raw.GYRO_XOUT_H, raw.GYRO_XOUT_L),
+                mpu6050::combineBigEndian(raw.GYRO_YOUT_H, raw.GYRO_YOUT_L),
+                mpu6050::combineBigEndian(raw.GYRO_ZOUT_H, raw.GYRO_ZOUT_L)};
+  frame.has_accel = true;
+  frame.accel = {mpu6050::combineBigEndian(raw.ACCEL_XOUT_H, raw.ACCEL_XOUT_L),
+                 mpu6050::combineBigEndian(raw.ACCEL_YOUT_H, raw.ACCEL_YOUT_L),
+                 mpu6050::combineBigEndian(raw.ACCEL_ZOUT_H, raw.ACCEL_ZOUT_L)};
+  return frame;
+}
+
 std::optional<std::size_t> firstMisalignedFrame(const FifoFrames& frames, std::int16_t temp_out,
                                                 std::int16_t bound_lsb) {
   for (std::size_t i = 0; i < frames.size(); ++i) {
@@ -24,13 +40,18 @@ std::optional<std::size_t> firstMisalignedFrame(const FifoFrames& frames, std::i
   return std::nullopt;
 }
 
-void convertFifoFrame(const FifoFrame& frame, double gyro_lsb_per_dps, GyroSample& sample) {
+void convertFifoFrame(const FifoFrame& frame, double gyro_lsb_per_dps, GyroSample& sample, double accel_lsb_per_g) {
   sample.raw_temp = frame.temp;
   for (std::size_t axis = 0; axis < 3; ++axis) {
     sample.raw_gyro[axis] = frame.gyro[axis];
     sample.rate_dps[axis] = static_cast<double>(frame.gyro[axis]) / gyro_lsb_per_dps;
   }
   sample.temp_c = mpu6050::temperatureDegCFromRaw(frame.temp);
+  for (std::size_t axis = 0; axis < 3; ++axis) {
+    sample.raw_accel[axis] = frame.has_accel ? frame.accel[axis] : std::int16_t{0};
+    sample.accel_g[axis] = frame.has_accel ? static_cast<double>(frame.accel[axis]) / accel_lsb_per_g
+                                           : std::numeric_limits<double>::quiet_NaN();
+  }
 }
 
 }  // namespace gyrod::driver

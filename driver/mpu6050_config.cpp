@@ -88,7 +88,8 @@ double nominalSamplePeriodNs(const Mpu6050Config& c) {
 std::int64_t pollingPeriodNs(const Mpu6050Config& c) {
   const double fastest_period = nominalSamplePeriodNs(c) / (1.0 + c.max_clock_error);
   // Whole frames only: a partial frame at the FIFO's end is no sample.
-  const double frames = static_cast<double>(kCloneFifoSize / kFrameBytes);  // NOLINT(bugprone-integer-division)
+  const double frames =
+      static_cast<double>(kCloneFifoSize / frameBytesFor(c.accel));  // NOLINT(bugprone-integer-division)
   double period = std::min(
       {frames * fastest_period / 4.0, 100e6, static_cast<double>(c.max_frames_per_wakeup) * fastest_period / 2.0});
   period = std::max(period, 1e6);
@@ -104,10 +105,11 @@ void validateConfig(const Mpu6050Config& c) {
   }
   (void)sampleRateDivider(c);  // checks dlpf_cfg and sample_rate_hz
   if (c.fs_sel < 0 || c.fs_sel > 3) bad("fs_sel", "must be 0..3, got " + std::to_string(c.fs_sel));
+  if (c.afs_sel < 0 || c.afs_sel > 3) bad("afs_sel", "must be 0..3, got " + std::to_string(c.afs_sel));
   if (c.transfer_attempts < 1 || c.transfer_attempts > 10) {
     bad("transfer_attempts", "must be 1..10, got " + std::to_string(c.transfer_attempts));
   }
-  const int max_frames = static_cast<int>(mpu6050::fifo::kSize / kFrameBytes);
+  const int max_frames = static_cast<int>(mpu6050::fifo::kSize / frameBytesFor(c.accel));
   if (c.max_frames_per_wakeup < 1 || c.max_frames_per_wakeup > max_frames) {
     bad("max_frames_per_wakeup",
         "must be 1.." + std::to_string(max_frames) + ", got " + std::to_string(c.max_frames_per_wakeup));
@@ -141,7 +143,7 @@ void validateConfig(const Mpu6050Config& c) {
 // ---------------------------------------------------------------------------------------
 // The register table
 
-std::array<RegisterSetting, kRegisterTableSize> registerTableFor(const Mpu6050Config& c) {
+std::vector<RegisterSetting> registerTableFor(const Mpu6050Config& c) {
   validateConfig(c);
   const std::uint8_t div = sampleRateDivider(c);
   const auto dlpf = static_cast<std::uint8_t>(c.dlpf_cfg);
@@ -151,12 +153,16 @@ std::array<RegisterSetting, kRegisterTableSize> registerTableFor(const Mpu6050Co
   if (c.int_open_drain) pin |= reg::INT_OPEN;
   const std::uint8_t pin_clear = static_cast<std::uint8_t>(((reg::INT_LEVEL | reg::INT_OPEN) & ~pin) |
                                                            reg::LATCH_INT_EN | reg::INT_RD_CLEAR | reg::FSYNC_INT_EN);
-  return {{
+  const auto accel_standby = static_cast<std::uint8_t>(reg::STBY_XA | reg::STBY_YA | reg::STBY_ZA);
+  const auto afs = static_cast<std::uint8_t>(c.afs_sel << reg::kAfsSelShift);
+  const std::uint8_t fifo_en = fifoEnableFor(c.accel);
+  std::vector<RegisterSetting> table = {{
       // Written in this order. Wake with the PLL on the X gyro as clock source (RM Register
       // 107 recommends a gyro reference over the internal oscillator).
       {Register::PWR_MGMT_1, reg::CLKSEL_PLL_XGYRO,
        static_cast<std::uint8_t>(reg::DEVICE_RESET | reg::SLEEP | reg::CYCLE | reg::TEMP_DIS | reg::Bit2 | reg::Bit1)},
-      {Register::PWR_MGMT_2, 0, reg::STBY_XG | reg::STBY_YG | reg::STBY_ZG},
+      {Register::PWR_MGMT_2, 0,
+       static_cast<std::uint8_t>(reg::STBY_XG | reg::STBY_YG | reg::STBY_ZG | (c.accel ? accel_standby : 0))},
       {Register::SMPLRT_DIV, div, static_cast<std::uint8_t>(~div)},
       {Register::CONFIG, dlpf, static_cast<std::uint8_t>(reg::EXT_SYNC_SET_MASK | (reg::DLPF_CFG_MASK & ~dlpf))},
       {Register::GYRO_CONFIG, fs,
@@ -165,11 +171,22 @@ std::array<RegisterSetting, kRegisterTableSize> registerTableFor(const Mpu6050Co
       // edge without any INT_STATUS read.
       {Register::INT_PIN_CFG, pin, pin_clear},
       {Register::INT_ENABLE, reg::DATA_RDY_EN | reg::FIFO_OFLOW_EN, reg::I2C_MST_INT_EN},
-      {Register::FIFO_EN, kFifoEnable,
-       static_cast<std::uint8_t>(reg::ACCEL_FIFO_EN | reg::SLV2_FIFO_EN | reg::SLV1_FIFO_EN | reg::SLV0_FIFO_EN)},
+      {Register::FIFO_EN, fifo_en,
+       static_cast<std::uint8_t>((reg::ACCEL_FIFO_EN & ~fifo_en) | reg::SLV2_FIFO_EN | reg::SLV1_FIFO_EN |
+                                 reg::SLV0_FIFO_EN)},
       {Register::USER_CTRL, reg::USER_CTRL_BIT::FIFO_EN,
        static_cast<std::uint8_t>(reg::USER_CTRL_BIT::I2C_MST_EN | reg::USER_CTRL_BIT::I2C_IF_DIS)},
   }};
+  if (c.accel) {
+    // After GYRO_CONFIG: the accel's full scale, self-test off. Without accel the register
+    // keeps whatever it holds (the 8-byte frame and the write sequence stay as they were).
+    const auto after_gyro = std::find_if(table.begin(), table.end(),
+                                         [](const RegisterSetting& s) { return s.reg == Register::GYRO_CONFIG; });
+    table.insert(after_gyro + 1,
+                 {Register::ACCEL_CONFIG, afs,
+                  static_cast<std::uint8_t>(reg::XA_ST | reg::YA_ST | reg::ZA_ST | (reg::AFS_SEL_MASK & ~afs))});
+  }
+  return table;
 }
 
 }  // namespace gyrod::driver

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <vector>
 
 #include "driver/mpu6050_registers.hpp"
 #include "driver/mpu6050_types.hpp"
@@ -27,6 +28,14 @@ inline std::optional<std::uint8_t> smplrtDivFor(int dlpf_cfg, double rate_hz) {
   const double rounded = std::round(n);
   if (rounded < 1.0 || rounded > 256.0 || std::fabs(n - rounded) > 1e-9 * n) return std::nullopt;
   return static_cast<std::uint8_t>(rounded - 1.0);
+}
+
+// AFS_SEL for an accel full-scale range of ±range_g (2, 4, 8, 16 → 0..3; product spec §6.2),
+// or nullopt for any other range.
+constexpr std::optional<int> afsSelForRangeG(int range_g) {
+  for (int afs = 0; afs < 4; ++afs)
+    if (range_g == (2 << afs)) return afs;
+  return std::nullopt;
 }
 
 // Throws std::invalid_argument naming the field and value when a config is unusable.
@@ -59,10 +68,11 @@ struct RegisterSetting {
 
   bool matches(std::uint8_t value) const { return (value & set) == set && (value & clear) == 0; }
 };
+// Entries without accel; with accel ACCEL_CONFIG is one more.
 inline constexpr std::size_t kRegisterTableSize = 9;
 
 // The table for a configuration, in the order it is written (exposed for tests and for
 // `gyroctl` diagnostics). Throws std::invalid_argument for an invalid config.
-std::array<RegisterSetting, kRegisterTableSize> registerTableFor(const Mpu6050Config& config);
+std::vector<RegisterSetting> registerTableFor(const Mpu6050Config& config);
 
 }  // namespace gyrod::driver

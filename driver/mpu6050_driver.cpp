@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "driver/fifo_frame.hpp"
 #include "driver/i2c_messages.hpp"
 
 namespace gyrod::driver {
@@ -62,6 +63,8 @@ Mpu6050Driver::Mpu6050Driver(I2cBus& bus, DataReadySource& data_ready, const Clo
   alignment_bound_lsb_ =
       static_cast<std::int16_t>(std::lround(config_.alignment_bound_c * mpu6050::kTemperatureLsbPerDegC));
   gyro_lsb_per_dps_ = mpu6050::kGyroLsbPerDps[static_cast<std::size_t>(config_.fs_sel)];
+  accel_lsb_per_g_ = mpu6050::kAccelLsbPerG[static_cast<std::size_t>(config_.afs_sel)];
+  frame_bytes_ = frameBytesFor(config_.accel);
 }
 
 void Mpu6050Driver::start() {

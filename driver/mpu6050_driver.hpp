@@ -26,6 +26,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "driver/clock.hpp"
 #include "driver/data_ready.hpp"
@@ -122,7 +123,7 @@ class Mpu6050Driver {
   SampleSink& sink_;
   Mpu6050Config config_;
   LogFunction log_;
-  std::array<RegisterSetting, kRegisterTableSize> table_;
+  std::vector<RegisterSetting> table_;
   SampleClock sample_clock_;
 
   // Derived constants.
@@ -131,6 +132,8 @@ class Mpu6050Driver {
   std::int64_t watchdog_ns_;
   std::int16_t alignment_bound_lsb_;
   double gyro_lsb_per_dps_;
+  double accel_lsb_per_g_;
+  std::size_t frame_bytes_;  // kFrameBytes, or kAccelFrameBytes with accel
 
   // State machine.
   Step step_ = Step::Idle;

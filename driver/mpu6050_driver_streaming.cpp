@@ -164,7 +164,7 @@ void Mpu6050Driver::readFifo(Trigger trigger) {
                        "samples are reported as a gap)");
     return;
   }
-  const std::size_t available = count / kFrameBytes;
+  const std::size_t available = count / frame_bytes_;
   if (available == 0) {
     if (trigger == Trigger::Edge || trigger == Trigger::Poll) ++counters_.empty_wakeups;
     return;
@@ -230,9 +230,10 @@ void Mpu6050Driver::observeNewestFrame(std::int64_t observation_ns, std::size_t 
 }
 
 bool Mpu6050Driver::readFrames(std::size_t frames) {
-  const std::size_t bytes = frames * kFrameBytes;
+  const std::size_t bytes = frames * frame_bytes_;
   const std::size_t burst = bus_.maxBurstLength();
-  const std::size_t chunk = burst >= kFrameBytes ? burst / kFrameBytes * kFrameBytes : std::max<std::size_t>(burst, 1);
+  const std::size_t chunk =
+      burst >= frame_bytes_ ? burst / frame_bytes_ * frame_bytes_ : std::max<std::size_t>(burst, 1);
   for (std::size_t off = 0; off < bytes;) {
     const std::size_t len = std::min(chunk, bytes - off);
     const int br = bus_.readBlock(mpu6050::address(Register::FIFO_R_W), std::span(fifo_bytes_.data() + off, len));
@@ -251,10 +252,11 @@ bool Mpu6050Driver::readFrames(std::size_t frames) {
 }
 
 bool Mpu6050Driver::framesAligned(std::size_t frames) {
-  // Every frame starts with the temperature word, which must agree with TEMP_OUT (the
-  // newest sample's temperature; the die warms by far less than the bound within one
-  // FIFO's worth of samples). A gyro word in that place almost never does — except near
-  // 36.53 °C, where TEMP_OUT ≈ 0 and a still gyro also reads ≈ 0.
+  // Every frame carries the temperature word (first, or after the three accel words), which
+  // must agree with TEMP_OUT (the newest sample's temperature; the die warms by far less than
+  // the bound within one FIFO's worth of samples). A gyro or accel word in that place almost
+  // never does — except near 36.53 °C, where TEMP_OUT ≈ 0 and a still gyro (or a level
+  // board's x/y accel) also reads ≈ 0.
   std::uint16_t temp_word = 0;
   const int tr = readWord(Register::TEMP_OUT_H, temp_word);
   if (tr != 0) {
@@ -265,7 +267,7 @@ bool Mpu6050Driver::framesAligned(std::size_t frames) {
     return false;
   }
   const auto temp_out = static_cast<std::int16_t>(temp_word);
-  const FifoFrames burst(std::span<const std::uint8_t>(fifo_bytes_.data(), frames * kFrameBytes));
+  const FifoFrames burst(std::span<const std::uint8_t>(fifo_bytes_.data(), frames * frame_bytes_), frame_bytes_);
   const std::optional<std::size_t> bad = firstMisalignedFrame(burst, temp_out, alignment_bound_lsb_);
   if (!bad) return true;
   abandonSegment(GapCause::MisalignedFrames, counters_.misaligned_bursts,
@@ -342,7 +344,7 @@ bool Mpu6050Driver::determineSegmentBase(std::optional<std::int64_t> observation
 }
 
 void Mpu6050Driver::deliverFrames(std::size_t frames) {
-  const FifoFrames burst(std::span<const std::uint8_t>(fifo_bytes_.data(), frames * kFrameBytes));
+  const FifoFrames burst(std::span<const std::uint8_t>(fifo_bytes_.data(), frames * frame_bytes_), frame_bytes_);
   GyroSample s;
   for (std::size_t i = 0; i < frames; ++i) {
     s.seq = segment_base_ + segment_frames_ + i;
@@ -350,7 +352,7 @@ void Mpu6050Driver::deliverFrames(std::size_t frames) {
     if (t <= last_t_ns_) t = last_t_ns_ + 1;  // strictly increasing, even across a re-anchor
     s.t_ns = t;
     last_t_ns_ = t;
-    convertFifoFrame(burst[i], gyro_lsb_per_dps_, s);
+    convertFifoFrame(burst[i], gyro_lsb_per_dps_, s, accel_lsb_per_g_);
     sink_.onSample(s);
   }
   segment_frames_ += frames;
@@ -360,9 +362,10 @@ void Mpu6050Driver::deliverFrames(std::size_t frames) {
   if (status_.state != DeviceState::Streaming) {
     recovery_attempts_ = 0;
     setState(DeviceState::Streaming);
-    log(LogLevel::Info, "streaming from the " + where() + " at " + std::to_string(config_.sample_rate_hz) +
-                            " Hz (FS_SEL " + std::to_string(config_.fs_sel) + ", DLPF_CFG " +
-                            std::to_string(config_.dlpf_cfg) + ")");
+    log(LogLevel::Info,
+        "streaming from the " + where() + " at " + std::to_string(config_.sample_rate_hz) + " Hz (FS_SEL " +
+            std::to_string(config_.fs_sel) + ", DLPF_CFG " + std::to_string(config_.dlpf_cfg) +
+            (config_.accel ? ", accel AFS_SEL " + std::to_string(config_.afs_sel) : ", no accel") + ")");
   }
 }
 

@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
 #include <string_view>
 
@@ -24,6 +25,12 @@ struct GyroSample {
   double temp_c = 0.0;                     // die temperature, °C
   std::array<std::int16_t, 3> raw_gyro{};  // the frame's words, for recording and tests
   std::int16_t raw_temp = 0;
+  // x, y, z specific force [g] from the same FIFO frame; NaN when the FIFO carries no accel.
+  std::array<double, 3> accel_g{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
+                                std::numeric_limits<double>::quiet_NaN()};
+  std::array<std::int16_t, 3> raw_accel{};
+  // CLOCK_REALTIME ns at the same data-ready edge as t_ns; 0 when unknown.
+  std::int64_t wall_ns = 0;
 };
 
 enum class GapCause : std::uint8_t {
@@ -142,6 +149,11 @@ struct Mpu6050Config {
   std::int64_t reset_wait_ns = 100'000'000;  // after DEVICE_RESET (PX4 waits 100 ms)
   std::int64_t settle_ns = 50'000'000;       // after waking: gyro start-up is ~30 ms
   std::string bus_name = "I2C bus";          // for messages: the device path, e.g. "/dev/i2c-1"
+
+  // The accelerometer in the FIFO (14-byte frames: accel, temperature, gyro). Off, the FIFO
+  // carries the 8-byte temperature + gyro frame and ACCEL_CONFIG is not written.
+  bool accel = false;
+  int afs_sel = 0;  // ACCEL_CONFIG.AFS_SEL 0..3: ±2, ±4, ±8, ±16 g (16384 / 8192 / 4096 / 2048 LSB/g)
 };
 
 // The rules about a config (validation, SMPLRT_DIV, periods, the register table) are in

@@ -228,4 +228,34 @@ double MotionProfile::settledFrom() const {
   return kForever;
 }
 
+void AttitudeIntegrator::step(const AngularRate& rate_dps, double dt_s) {
+  constexpr double kRadPerDeg = std::numbers::pi / 180.0;
+  const double wx = rate_dps[0] * kRadPerDeg, wy = rate_dps[1] * kRadPerDeg, wz = rate_dps[2] * kRadPerDeg;
+  const double norm = std::sqrt(wx * wx + wy * wy + wz * wz);
+  double angle = norm * dt_s;  // rad
+  if (!(angle > 0.0)) return;
+  // portable::tan takes |x| ≤ 1.2: Exp(θ) is applied in equal sub-steps of θ/4 ≤ 1.
+  const double pieces = std::ceil(angle / 4.0);
+  angle /= pieces;
+  const double u = portable::tan(0.25 * angle);     // tan(θ/4): half-angle formulas for θ/2
+  const double c = (1.0 - u * u) / (1.0 + u * u);   // cos(θ/2)
+  const double s = 2.0 * u / (1.0 + u * u) / norm;  // sin(θ/2)/|ω|
+  const Quaternion d{c, s * wx, s * wy, s * wz};
+  for (double i = 0.0; i < pieces; i += 1.0) {
+    const Quaternion& q = q_;
+    const Quaternion r{
+        q[0] * d[0] - q[1] * d[1] - q[2] * d[2] - q[3] * d[3], q[0] * d[1] + q[1] * d[0] + q[2] * d[3] - q[3] * d[2],
+        q[0] * d[2] - q[1] * d[3] + q[2] * d[0] + q[3] * d[1], q[0] * d[3] + q[1] * d[2] - q[2] * d[1] + q[3] * d[0]};
+    // Renormalised every step so that rounding cannot grow the norm over a long run.
+    const double n = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3]);
+    q_ = {r[0] / n, r[1] / n, r[2] / n, r[3] / n};
+  }
+}
+
+AttitudeIntegrator::Vector AttitudeIntegrator::gravityInBody() const {
+  // The third row of R(q) (= the third column of Rᵀ): Rᵀ·(0, 0, 1).
+  const auto [w, x, y, z] = q_;
+  return {2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y)};
+}
+
 }  // namespace gyrod::processing

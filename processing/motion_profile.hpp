@@ -75,6 +75,29 @@ struct MotionSegment {
   double duration_s = 0.0;
 };
 
+// The board's attitude, integrated from its true body rates, and what gravity makes an ideal
+// accelerometer read in it. Convention (Solà, "Quaternion kinematics for the error-state
+// Kalman filter", 2017, eqs. 214 and 101): Hamilton quaternion q = q_wb (body → world), local
+// rates, q ← q ⊗ Exp(ω·Δt) with ω held over the step (exact for rates constant over it). The
+// world is z up; at the start the board is level, body = world, and an accelerometer at rest
+// reads the specific force f_b = R(q)ᵀ·(0, 0, +1) g = (0, 0, +1) g. The same bits on every
+// IEEE-754 machine (portable::tan, no FMA contraction in this file).
+class AttitudeIntegrator {
+ public:
+  using Quaternion = std::array<double, 4>;  // w, x, y, z
+  using Vector = std::array<double, kMotionAxes>;
+
+  AttitudeIntegrator() = default;  // level
+  // Turns the board by rate_dps (body axes, °/s) held for dt_s ≥ 0 seconds.
+  void step(const AngularRate& rate_dps, double dt_s);
+  // f_b of gravity at rest in the body axes, in g (unit length).
+  Vector gravityInBody() const;
+  const Quaternion& quaternion() const { return q_; }
+
+ private:
+  Quaternion q_{1.0, 0.0, 0.0, 0.0};
+};
+
 // sin(2π·cycles) from portable::tan, the same bits on every machine: the phase is reduced
 // to whole turns, then to [−π/2, π/2], then the half-angle formula 2u/(1 + u²), u = tan(x/2).
 double portableSinOfCycles(double cycles);

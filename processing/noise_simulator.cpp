@@ -24,6 +24,9 @@ std::string formatNumber(double v) {
 
 std::string axisPrefix(std::size_t axis) { return std::string("axis ") + kAxisNames[axis] + ": "; }
 
+// Accel sensitivity for AFS_SEL 0..3 (product spec §6.2): 16384, 8192, 4096, 2048 LSB per g.
+double accelLsbPerG(int afs_sel) { return 16384.0 / static_cast<double>(1 << afs_sel); }
+
 void requireFinite(double v, const std::string& what) {
   if (!std::isfinite(v)) throw std::invalid_argument(what + " must be finite, got " + formatNumber(v));
 }
@@ -130,6 +133,18 @@ void validateSimulationModel(const SimulationModel& model) {
   requireFinite(temp.final_c, "temperature.final_c");
   requirePositive(temp.time_constant_s, "temperature.time_constant_s");
   requireNonNegative(temp.noise_std_c, "temperature.noise_std_c");
+  if (model.accel) {
+    if (model.accel->afs_sel < 0 || model.accel->afs_sel > 3)
+      throw std::invalid_argument("accel.afs_sel must be 0..3, got " + std::to_string(model.accel->afs_sel));
+    for (std::size_t a = 0; a < kSimulatedAxes; ++a) {
+      const AccelAxisNoise& n = model.accel->axes[a];
+      const std::string prefix = "accel " + axisPrefix(a);
+      requireFinite(n.bias_g, prefix + "bias_g");
+      requireNonNegative(n.velocity_random_walk_g_per_sqrt_hz, prefix + "velocity_random_walk_g_per_sqrt_hz");
+      requireNonNegative(n.bias_instability_g, prefix + "bias_instability_g");
+      requireNonNegative(n.acceleration_random_walk_g_per_sqrt_s, prefix + "acceleration_random_walk_g_per_sqrt_s");
+    }
+  }
 }
 
 TemperatureModel withWarmUp(TemperatureModel temperature, const WarmUp& warm_up) {
@@ -263,6 +278,59 @@ NoiseSimulator::NoiseSimulator(const SimulationModel& model, double duration_s, 
     initAr(axis, m.ar);
   }
   initExtras(seed, duration_s);
+  initAccel(seed, duration_s);
+}
+
+NoiseSimulator::AccelAxisState::AccelAxisState(SplitMix64& seeder)
+    : white_noise(seeder), walk_noise(seeder), flicker_noise(seeder) {}
+
+void NoiseSimulator::initAccel(std::uint64_t seed, double duration_s) {
+  if (!model_.accel) return;  // nothing drawn: the gyro stream is the one without accel
+  // A generator of its own (another constant than the extras'), so the gyro's numbers never
+  // depend on the accel.
+  SplitMix64 accel_seeder(seed ^ 0xACCE1E20AE5EED5FULL);
+  const double tau0 = 1.0 / model_.rate_hz;
+  // (2·ln2/π): the flat Allan variance of bias instability per B² (IEEE 952).
+  constexpr double kFlickerFloor = 2.0 * std::numbers::ln2 / std::numbers::pi;
+  accel_axes_.reserve(kSimulatedAxes);
+  for (std::size_t a = 0; a < kSimulatedAxes; ++a) {
+    accel_axes_.emplace_back(accel_seeder);
+    AccelAxisState& axis = accel_axes_.back();
+    const AccelAxisNoise& n = model_.accel->axes[a];
+    axis.white_std = n.velocity_random_walk_g_per_sqrt_hz * std::sqrt(model_.rate_hz);  // σ² = N²/τ0 at τ0
+    axis.walk_step_std = n.acceleration_random_walk_g_per_sqrt_s * std::sqrt(tau0);     // σ² = K²τ/3
+    const std::vector<GaussMarkovComponent> bank =
+        flickerGaussMarkovBank(kFlickerFloor * n.bias_instability_g * n.bias_instability_g, tau0, duration_s);
+    for (const GaussMarkovComponent& c : bank) {
+      const double h = tau0 / c.correlation_time_s;
+      GaussMarkovState st;
+      st.decay = portable::exp(-h);
+      st.innovation_std = std::sqrt(c.variance * -portable::expm1(-2.0 * h));
+      st.value = std::sqrt(c.variance) * axis.flicker_noise.next();  // stationary start
+      axis.flicker.push_back(st);
+    }
+  }
+}
+
+std::array<double, kSimulatedAxes> NoiseSimulator::accelAt(const std::array<double, kSimulatedAxes>& gravity_g) {
+  std::array<double, kSimulatedAxes> out{};
+  const AccelModel& model = *model_.accel;
+  for (std::size_t a = 0; a < kSimulatedAxes; ++a) {
+    AccelAxisState& axis = accel_axes_[a];
+    double v = gravity_g[a] + model.axes[a].bias_g + axis.walk_value;
+    if (axis.white_std > 0.0) v += axis.white_std * axis.white_noise.next();
+    if (axis.walk_step_std > 0.0) axis.walk_value += axis.walk_step_std * axis.walk_noise.next();
+    for (GaussMarkovState& st : axis.flicker) {
+      v += st.value;
+      st.value = st.decay * st.value + st.innovation_std * axis.flicker_noise.next();
+    }
+    if (lsb_per_dps_) {
+      const double lsb_per_g = accelLsbPerG(model.afs_sel);
+      v = quantizeToInt16(v, lsb_per_g) / lsb_per_g;  // saturates at ±range like the chip
+    }
+    out[a] = v;
+  }
+  return out;
 }
 
 void NoiseSimulator::initExtras(std::uint64_t seed, double duration_s) {
@@ -369,6 +437,11 @@ SimulatedSample NoiseSimulator::nextAnalog() {
     out.true_rate_dps = motion_->rateAt(t);
     for (std::size_t a = 0; a < kSimulatedAxes; ++a) out.rate_dps[a] += out.true_rate_dps[a];
   }
+  if (model_.accel) {
+    // Gravity at this sample's attitude; then the board turns at the true rate until the next.
+    out.accel_g = attitude_.gravityInBody();
+    if (motion_) attitude_.step(out.true_rate_dps, 1.0 / internal_rate_hz_);
+  }
   const TemperatureModel& temp = model_.temperature;
   // Without a warm-up the curve is final + (+0)·e^{…} = final + 0.0 bit for bit: skip the
   // exponential (it was 8 % of a model check's time, which simulates that case).
@@ -432,6 +505,7 @@ SimulatedSample NoiseSimulator::next() {
   out.temperature_c = analog.temperature_c;
   if (motion_) out.true_rate_dps = motion_->rateAt(out.t_s);
   for (std::size_t a = 0; a < kSimulatedAxes; ++a) out.rate_dps[a] = rate[a] + output_noise[a];
+  if (model_.accel) out.accel_g = accelAt(analog.accel_g);
   if (lsb_per_dps_) {
     for (double& r : out.rate_dps) r = quantizeToInt16(r, *lsb_per_dps_) / *lsb_per_dps_;
     out.temperature_c =

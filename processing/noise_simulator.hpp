@@ -13,6 +13,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -96,9 +97,34 @@ TemperatureModel withWarmUp(TemperatureModel temperature, const WarmUp& warm_up)
 // k is 0): what next() adds at the output rate, and what the mock adds to the analog rate.
 double temperatureCouplingDps(const AxisExtraEffects& extra, const TemperatureModel& temperature, double t_s);
 
+// ---- the accelerometer (docs/simulator.md "Accelerometer") -------------------------------
+// Per axis, in g: the reading is gravity's specific force in the body axes (the attitude
+// integrated from the motion's true rates, processing/motion_profile.hpp AttitudeIntegrator;
+// (0, 0, +1) g at rest) + bias + three Allan terms, generated at the output rate:
+//   N  velocity random walk, white accel of density N [g/√Hz]:     σ²(τ) = N²/τ
+//   B  bias instability [g], a 1/f floor (the gyro's GM bank):      σ²(τ) = (2·ln2/π)·B²
+//   K  acceleration random walk [g/√s] (= g/s/√Hz):                 σ²(τ) = K²·τ/3
+// (In SI: N·9.80665 m/s²/√Hz is Kalibr's accelerometer_noise_density, K·9.80665 m/s³/√Hz its
+// accelerometer_random_walk; N·9.80665·60 is the VRW in m/s/√h.)
+struct AccelAxisNoise {
+  double bias_g = 0.0;
+  double velocity_random_walk_g_per_sqrt_hz = 0.0;     // N
+  double bias_instability_g = 0.0;                     // B
+  double acceleration_random_walk_g_per_sqrt_s = 0.0;  // K
+};
+struct AccelModel {
+  std::array<AccelAxisNoise, kSimulatedAxes> axes;
+  // AFS_SEL 0..3 (±2, ±4, ±8, ±16 g): the accel is quantised and saturated at it whenever the
+  // gyro is (SimulationModel::fs_sel set).
+  int afs_sel = 0;
+};
+
 struct SimulationModel {
   std::array<AxisNoiseModel, kSimulatedAxes> axes;
   TemperatureModel temperature;
+  // None: no accelerometer (SimulatedSample::accel_g NaN), and not a single number of the
+  // gyro stream depends on whether it is set (its random numbers come from a stream of its own).
+  std::optional<AccelModel> accel;
   double rate_hz = 50.0;        // output rate (default: the paper's 50 Hz)
   std::optional<int> dlpf_cfg;  // DLPF_CFG 0..6; none = no DLPF, generated at rate_hz
   std::optional<int> fs_sel;    // FS_SEL 0..3; none = no quantisation or saturation
@@ -151,6 +177,10 @@ struct SimulatedSample {
   // The true rotation rate at t_s (the motion profile, before the DLPF and everything the
   // sensor adds); zero without motion. For scoring a stream against the truth.
   std::array<double, kSimulatedAxes> true_rate_dps{};
+  // Accelerometer x, y, z in g when the model has one, else NaN. From nextAnalog(): gravity
+  // alone (the ideal reading at the sample's attitude); from next(): with bias and noise.
+  std::array<double, kSimulatedAxes> accel_g{kNoAccel, kNoAccel, kNoAccel};
+  static constexpr double kNoAccel = std::numeric_limits<double>::quiet_NaN();
 };
 
 class NoiseSimulator {
@@ -242,6 +272,20 @@ class NoiseSimulator {
   std::optional<ZigguratNormalGenerator> extra_noise_;
   std::uint64_t extra_index_ = 0;        // output samples produced by nextOutputRateNoise()
   std::optional<MotionProfile> motion_;  // none: at rest
+
+  // The accelerometer (only with model_.accel).
+  struct AccelAxisState {
+    double white_std = 0.0;      // per output sample
+    double walk_step_std = 0.0;  // per output sample
+    double walk_value = 0.0;
+    std::vector<GaussMarkovState> flicker;
+    ZigguratNormalGenerator white_noise, walk_noise, flicker_noise;
+    explicit AccelAxisState(SplitMix64& seeder);
+  };
+  void initAccel(std::uint64_t seed, double duration_s);
+  std::array<double, kSimulatedAxes> accelAt(const std::array<double, kSimulatedAxes>& gravity_g);
+  std::vector<AccelAxisState> accel_axes_;  // empty without model_.accel
+  AttitudeIntegrator attitude_;
 };
 
 }  // namespace gyrod::processing

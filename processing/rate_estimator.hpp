@@ -83,6 +83,8 @@ class RateEstimator {
   // raw rate, die temperature.
   RateSample update(double t_s, const AngularRate& raw_dps, double temperature_c);
   void reset();
+  // The accel of the sample about to be update()d, for the still detector (NaN: none).
+  void observeAccel(const std::array<double, kMotionAxes>& accel_g) { detector_.observeAccel(accel_g); }
 
   const StillDetector& detector() const { return detector_; }
   // r̂ at the current temperature and its variance h·P·hᵀ (h = [1, T − T_start]).

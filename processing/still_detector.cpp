@@ -46,9 +46,56 @@ StillDetector::StillDetector(const StillDetectorParameters& params,
   difference_threshold_ =
       kDifferenceScale * chiSquareQuantile(1.0 - params_.difference_false_alarm, differenceDof(params_.window_samples));
   ring_.assign(kMotionAxes * params_.window_samples, 0.0);
+  if (params_.accel_window_samples < 3)
+    throw std::invalid_argument("still.accel_window_samples must be >= 3, got " +
+                                std::to_string(params_.accel_window_samples));
+  requirePositiveLevel(params_.accel_noise_g, "still.accel_noise_g");
+  const auto wa = static_cast<double>(params_.accel_window_samples);
+  accel_difference_threshold_ = kDifferenceScale * chiSquareQuantile(1.0 - params_.difference_false_alarm,
+                                                                     differenceDof(params_.accel_window_samples));
+  accel_slope_bound_ = params_.mean_threshold_sigmas * params_.accel_noise_g / std::sqrt(wa * (wa * wa - 1.0) / 12.0);
+  accel_ring_.assign(kMotionAxes * params_.accel_window_samples, 0.0);
+}
+
+void StillDetector::observeAccel(const std::array<double, kMotionAxes>& accel_g) {
+  const bool finite = std::isfinite(accel_g[0]) && std::isfinite(accel_g[1]) && std::isfinite(accel_g[2]);
+  if (!finite) {
+    accel_present_ = false;
+    accel_next_ = accel_filled_ = 0;
+    return;
+  }
+  accel_present_ = true;
+  const std::size_t wa = params_.accel_window_samples;
+  for (std::size_t a = 0; a < kMotionAxes; ++a) accel_ring_[a * wa + accel_next_] = accel_g[a];
+  accel_next_ = (accel_next_ + 1) % wa;
+  if (accel_filled_ < wa) ++accel_filled_;
+}
+
+bool StillDetector::accelSteady() const {
+  const std::size_t wa = params_.accel_window_samples;
+  if (!accel_present_ || accel_filled_ < wa) return false;
+  // Recomputed over the ring each time (O(Wa), no running sums to drift): the slope about the
+  // window's centre k̄ = (Wa − 1)/2, and the sum of squared differences, oldest first.
+  const double centre = 0.5 * static_cast<double>(wa - 1);
+  const double s = static_cast<double>(wa) * (static_cast<double>(wa) * static_cast<double>(wa) - 1.0) / 12.0;
+  const double two_var = 2.0 * params_.accel_noise_g * params_.accel_noise_g;
+  for (std::size_t a = 0; a < kMotionAxes; ++a) {
+    const double* ring = &accel_ring_[a * wa];
+    double weighted = 0.0, diff = 0.0, previous = 0.0;
+    for (std::size_t i = 0; i < wa; ++i) {
+      const double v = ring[(accel_next_ + i) % wa];
+      weighted += (static_cast<double>(i) - centre) * v;
+      if (i > 0) diff += (v - previous) * (v - previous);
+      previous = v;
+    }
+    if (std::fabs(weighted / s) > accel_slope_bound_ || diff / two_var > accel_difference_threshold_) return false;
+  }
+  return true;
 }
 
 void StillDetector::reset() {
+  accel_next_ = accel_filled_ = 0;
+  accel_present_ = false;
   next_slot_ = filled_ = still_run_ = 0;
   still_ = false;
   sum_ = diff_sq_sum_ = last_ = {};
@@ -103,6 +150,7 @@ bool StillDetector::update(const AngularRate& corrected, const AngularRate& expe
     still =
         std::fabs(mean - expected[a]) <= params_.mean_threshold_sigmas * spread && d_statistic <= difference_threshold_;
   }
+  if (still && accel_present_) still = accelSteady();
   still_ = still;
   still_run_ = still ? still_run_ + 1 : 0;
   return still;

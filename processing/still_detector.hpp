@@ -24,8 +24,21 @@
 // What cannot be told apart: a rotation that is constant over the window and smaller than the
 // resolution looks exactly like a bias change of the same size. No test on the gyro alone
 // separates them; the detector passes such windows, and the residual filter (RateEstimator)
-// then learns the rotation as bias at the speed its process noise allows. The accelerometer
-// (a later issue) is the second sensor that can split them.
+// then learns the rotation as bias at the speed its process noise allows.
+//
+// The accelerometer splits them for any rotation that tilts the board (changes the direction
+// of gravity in the chip's axes; a turn about the vertical does not). When observeAccel() is
+// fed finite values, a window is still only if, in addition, the last Wa accel samples are
+// steady on every axis (σa the accel's white noise per sample, g):
+//   slope test       |β̂| ≤ z·σa/√S,  β̂ the least-squares slope of a over the Wa samples (g per
+//                   sample), S = Σ(k − k̄)² = Wa(Wa² − 1)/12 (β̂'s std for white noise is σa/√S);
+//   difference test  Σ(a_k − a_{k−1})²/(2σa²) ≤ g·χ²_{1−αd}(h), as for the gyro with Wa.
+// A tilt at ω rad/s moves a horizontal axis by about ω/rate g per sample; over Wa = 250
+// samples at 50 Hz and σa = 3 mg the slope test resolves z·σa·rate/√S ≈ 0.4 mg/s, i.e. tilts
+// of 0.02 °/s, well below the gyro's 0.07 °/s. The mean of a is not tested: a board at rest
+// in any attitude is still. Without accel (nothing fed, or NaN) the verdict is the gyro's
+// alone, exactly as before. Per window at rest the accel adds a false-moving probability of
+// 1 − ((1 − αm)(1 − αd))³ for white accel noise at σa.
 //
 // Storage: a ring of W samples per axis, sized at construction; update() allocates nothing.
 // Running sums are recomputed from the ring once per W samples, so rounding does not pile up.
@@ -42,6 +55,9 @@ struct StillDetectorParameters {
   std::size_t window_samples = 25;       // W (0.5 s at 50 Hz); ≥ 3
   double mean_threshold_sigmas = 3.0;    // z
   double difference_false_alarm = 1e-3;  // αd, per axis and window at rest
+  // The accelerometer's part (used only when accel is fed): Wa and σa of the header.
+  std::size_t accel_window_samples = 250;  // Wa (5 s at 50 Hz); ≥ 3
+  double accel_noise_g = 0.003;            // σa, white noise per sample and axis, g
 };
 
 // The noise level of one axis at rest.
@@ -61,6 +77,12 @@ class StillDetector {
   // One sample of c = raw − model bias; `expected` is r̂ per axis and `expected_variance` P.
   // Returns whether the window ending here passes on every axis (false until W samples).
   bool update(const AngularRate& corrected, const AngularRate& expected, const AngularRate& expected_variance);
+  // The same sample's accel (x, y, z in g), before update(). Any NaN means "no accel": the
+  // accel window empties and the verdict is the gyro's alone until finite values come again.
+  void observeAccel(const std::array<double, kMotionAxes>& accel_g);
+  // Whether the last update() required the accel (and its window was full and steady).
+  bool usingAccel() const { return accel_present_; }
+  bool accelSteady() const;
 
   bool still() const { return still_; }
   // Consecutive samples whose window passed (0 when the last one did not).
@@ -86,6 +108,12 @@ class StillDetector {
   std::size_t still_run_ = 0;
   bool still_ = false;
   void recomputeSums();
+  // Accel ring: Wa samples per axis, axis-major like ring_.
+  std::vector<double> accel_ring_;
+  std::size_t accel_next_ = 0, accel_filled_ = 0;
+  bool accel_present_ = false;
+  double accel_difference_threshold_ = 0.0;
+  double accel_slope_bound_ = 0.0;  // z·σa/√S
 };
 
 }  // namespace gyrod::processing

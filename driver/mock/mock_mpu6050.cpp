@@ -35,6 +35,9 @@ void validate(const MockMpu6050Config& config) {
   if (config.max_burst_length == 0) {
     throw std::invalid_argument("MockMpu6050Config.max_burst_length must be > 0");
   }
+  for (double g : config.accel_bias_g) {
+    if (!std::isfinite(g)) throw std::invalid_argument("MockMpu6050Config.accel_bias_g must be finite");
+  }
   for (double g : config.accel_g) {
     if (!std::isfinite(g)) throw std::invalid_argument("MockMpu6050Config.accel_g must be finite");
   }

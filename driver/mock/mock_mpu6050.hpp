@@ -42,8 +42,11 @@ struct MockMpu6050Config {
   std::int64_t reset_duration_ns = 100 * kNsPerMillisecond;
   // Longest burst the emulated adapter allows: 32 is the SMBus block limit.
   std::size_t max_burst_length = 32;
-  // The accelerometer sees a fixed vector (g) plus white noise of this standard deviation.
+  // The accelerometer sees a fixed vector (g) — or, when the SignalSource knows it, gravity at
+  // the board's attitude — plus a constant bias and white noise of this standard deviation,
+  // saturated at the AFS_SEL range like the chip.
   std::array<double, 3> accel_g = {0.0, 0.0, 1.0};
+  std::array<double, 3> accel_bias_g = {0.0, 0.0, 0.0};
   double accel_noise_g = 0.002;
   std::uint64_t accel_noise_seed = 1;
   // The host's view of the INT line: which edges count, and how many may queue unread
@@ -173,6 +176,7 @@ class MockMpu6050 final : public I2cBus, private mock::ChipTimeline {
   std::array<processing::DigitalLowPassFilter, 3> filters_;
   std::array<double, 3> filtered_dps_{};
   double temperature_c_ = 25.0;
+  std::array<double, 3> true_accel_g_{};  // the source's gravity at the last tick, or accel_g
   mock::BoxMullerNormal accel_noise_;
 
   mock::Fifo fifo_;

@@ -2,6 +2,7 @@
 // output registers and the FIFO, the tick train started and stopped with the power state,
 // and the chip's reset.
 #include <array>
+#include <cmath>
 
 #include "driver/mock/mock_mpu6050.hpp"
 
@@ -33,6 +34,9 @@ void MockMpu6050::internalTick(std::int64_t t_ns) {
   }
   prime_filters_ = false;
   temperature_c_ = in.temperature_c;
+  const bool source_knows_accel =
+      std::isfinite(in.accel_g[0]) && std::isfinite(in.accel_g[1]) && std::isfinite(in.accel_g[2]);
+  true_accel_g_ = source_knows_accel ? in.accel_g : config_.accel_g;
   // Sample rate = gyro output rate / (1 + SMPLRT_DIV) (RM §4.2 p.11).
   if (ticks_.countTowardsSample(regs_.sampleRateDivider())) sampleTick(t_ns);
 }
@@ -45,7 +49,9 @@ void MockMpu6050::sampleTick(std::int64_t t_ns) {
   const int afs_sel = regs_.afsSel();
   for (int i = 0; i < 3; ++i) {
     s.gyro[i] = processing::quantizeToInt16(filtered_dps_[i], mpu6050::kGyroLsbPerDps[fs_sel]);
-    s.accel[i] = processing::quantizeToInt16(config_.accel_g[i] + accelNoise(), mpu6050::kAccelLsbPerG[afs_sel]);
+    // quantizeToInt16 saturates at ±32767/−32768 LSB, i.e. at the AFS_SEL range, as the chip does.
+    s.accel[i] = processing::quantizeToInt16(true_accel_g_[i] + config_.accel_bias_g[i] + accelNoise(),
+                                             mpu6050::kAccelLsbPerG[afs_sel]);
   }
   // TEMP_OUT = (T − 36.53) · 340, the inverse of RM Registers 65–66.
   s.temperature =

@@ -12,6 +12,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace gyrod::driver {
@@ -19,6 +20,10 @@ namespace gyrod::driver {
 struct AnalogSample {
   std::array<double, 3> rate_dps{};  // x, y, z, °/s
   double temperature_c = 25.0;
+  // What an ideal accelerometer reads (x, y, z, g: gravity at the board's attitude) when the
+  // source knows it; NaN: the mock uses its configured fixed vector (MockMpu6050Config).
+  std::array<double, 3> accel_g{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
+                                std::numeric_limits<double>::quiet_NaN()};
 };
 
 class SignalSource {

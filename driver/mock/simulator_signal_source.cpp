@@ -17,6 +17,9 @@ processing::SimulationModel modelAtInternalRate(processing::SimulationModel mode
   model.dlpf_cfg = cfg;
   model.fs_sel.reset();
   model.rate_hz = mpu6050::gyroOutputRateHz(cfg);
+  // Gravity at the integrated attitude only: the mock adds its own accel noise and bias.
+  // (The accel draws from a stream of its own, so the gyro samples are the same with it.)
+  model.accel = processing::AccelModel{};
   return model;
 }
 }  // namespace
@@ -40,6 +43,7 @@ AnalogSample SimulatorSignalSource::nextTick(double /*t_s*/) {
     if (model.axes[axis].extra.temperature_coefficient_dps_per_c != 0.0)
       a.rate_dps[axis] += processing::temperatureCouplingDps(model.axes[axis].extra, model.temperature, s.t_s);
   a.temperature_c = s.temperature_c;
+  a.accel_g = s.accel_g;
   return a;
 }
 

@@ -5,6 +5,10 @@
 // The mock applies the DLPF, decimation, saturation and quantisation itself, so they act on
 // the motion as on the chip.
 //
+// With motion the source also tells the mock what gravity reads in the chip's axes: the
+// attitude integrated from the true rates (processing::AttitudeIntegrator, level at the first
+// tick), so the mock's accel tilts with the board; the mock adds its accel noise and bias.
+//
 // The temperature coupling k·(T(t) − T_ref) of the model's [x.extra] (the bias following a
 // warm-up) is added to the analog rate, so it passes the DLPF like the rest of the bias.
 //

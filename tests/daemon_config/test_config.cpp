@@ -292,7 +292,7 @@ TEST(ConfigErrors, TomlSyntaxErrorNamesFileLineAndColumn) {
 TEST(ConfigErrors, UnknownKeyNamesFileLineKeyAndTheValidKeys) {
   EXPECT_EQ(errorOf("[device]\nbackend = \"mock\"\nrat_hz = 50\n"),
             "x.toml:3: unknown key 'rat_hz' in [device] (valid keys: backend, bus, address, rate_hz, dlpf, "
-            "full_scale_dps); did you mean 'rate_hz'?");
+            "full_scale_dps, accel, accel_range_g); did you mean 'rate_hz'?");
   // Nothing close: no suggestion.
   EXPECT_EQ(errorOf("[log]\nverbosity = 3\n"), "x.toml:2: unknown key 'verbosity' in [log] (valid keys: level)");
 }

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -98,6 +99,64 @@ TEST(FifoFrame, ConversionToDegreesPerSecondAndCelsius) {
   f.temp = 340;
   convertFifoFrame(f, 16.4, s);
   EXPECT_DOUBLE_EQ(s.temp_c, 37.53);
+}
+
+TEST(FifoFrame, WithAccelTheFrameIsAccelTemperatureGyroFourteenBytes) {
+  EXPECT_EQ(kAccelFrameBytes, 14u);
+  EXPECT_EQ(kFifoEnableWithAccel, 0xF8);
+  EXPECT_EQ(fifoEnableFor(false), kFifoEnable);
+  EXPECT_EQ(frameBytesFor(true), kAccelFrameBytes);
+  // Registers 0x3B..0x48 in order: ACCEL_X, ACCEL_Y, ACCEL_Z, TEMP, GYRO_X, GYRO_Y, GYRO_Z.
+  const std::array<std::uint8_t, kAccelFrameBytes> bytes = {0x40, 0x00, 0xFF, 0xFE, 0xC0, 0x00, 0xF2,
+                                                            0xB8, 0x00, 0x83, 0xFF, 0x7D, 0x80, 0x00};
+  const FifoFrame f = decodeFifoFrame(std::span<const std::uint8_t, kAccelFrameBytes>(bytes));
+  EXPECT_TRUE(f.has_accel);
+  EXPECT_EQ(f.accel[0], 16384);
+  EXPECT_EQ(f.accel[1], -2);
+  EXPECT_EQ(f.accel[2], -16384);
+  EXPECT_EQ(f.temp, -3400);
+  EXPECT_EQ(f.gyro[0], 131);
+  EXPECT_EQ(f.gyro[1], -131);
+  EXPECT_EQ(f.gyro[2], INT16_MIN);
+  EXPECT_FALSE(decode({0, 0, 0, 0, 0, 0, 0, 0}).has_accel);
+}
+
+TEST(FifoFrame, ConversionOfAccelIsExactAtTheGivenScaleAndNaNWithout) {
+  FifoFrame f;
+  f.has_accel = true;
+  f.accel = {16384, -8192, INT16_MIN};
+  GyroSample s;
+  convertFifoFrame(f, 131.0, s, 16384.0);
+  EXPECT_EQ(s.accel_g[0], 1.0);
+  EXPECT_EQ(s.accel_g[1], -0.5);
+  EXPECT_EQ(s.accel_g[2], -2.0);
+  EXPECT_EQ(s.raw_accel[2], INT16_MIN);
+  convertFifoFrame(f, 131.0, s, 2048.0);
+  EXPECT_EQ(s.accel_g[0], 8.0);
+  EXPECT_EQ(s.accel_g[2], -16.0);
+  f.has_accel = false;
+  convertFifoFrame(f, 131.0, s);
+  EXPECT_TRUE(std::isnan(s.accel_g[0]) && std::isnan(s.accel_g[1]) && std::isnan(s.accel_g[2]));
+  EXPECT_EQ(s.raw_accel, (std::array<std::int16_t, 3>{}));
+}
+
+TEST(FifoFrame, AlignmentCheckOnLongFramesFindsAShiftedBoundary) {
+  // Two 14-byte frames of a level board at 26.53 °C (TEMP_OUT −3400): accel (0, 0, 1 g).
+  std::vector<std::uint8_t> bytes;
+  for (int k = 0; k < 3; ++k) {
+    const std::vector<std::uint8_t> frame = {0x00, 0x00, 0x00, 0x01, 0x40, 0x00, 0xF2,
+                                             0xB8, 0x00, 0x02, 0xFF, 0xFE, 0x00, 0x05};
+    bytes.insert(bytes.end(), frame.begin(), frame.end());
+  }
+  const FifoFrames aligned{std::span<const std::uint8_t>(bytes), kAccelFrameBytes};
+  ASSERT_EQ(aligned.size(), 3u);
+  EXPECT_EQ(aligned[1].accel[2], 16384);
+  EXPECT_EQ(firstMisalignedFrame(aligned, -3400, 340), std::nullopt);
+  // One word lost at the start: ACCEL_Z's word lands where TEMP belongs, and TEMP where GYRO_X was.
+  for (std::size_t shift : {1u, 2u, 4u, 6u, 8u}) {
+    const FifoFrames shifted{std::span<const std::uint8_t>(bytes).subspan(shift), kAccelFrameBytes};
+    EXPECT_EQ(firstMisalignedFrame(shifted, -3400, 340), std::optional<std::size_t>(0)) << "shift " << shift;
+  }
 }
 
 }  // namespace

@@ -48,7 +48,9 @@ std::string sensorModel() {
 std::string rateConfig(const std::filesystem::path& dir, const std::filesystem::path& model,
                        const std::string& extra = "") {
   std::ostringstream c;
-  c << "[device]\nbackend = \"mock\"\nrate_hz = 50\n"
+  // accel off: the offline rate stream (gyroctl filter on the recording) has no accel to give
+  // the still detector, and live and offline must be the same bits.
+  c << "[device]\nbackend = \"mock\"\nrate_hz = 50\naccel = false\n"
     << "[bias]\nsource = \"config\"\nvalues = [-3.34, 1.09, -0.5]\n"
     << "[filter]\nmodel = \"" << model.string() << "\"\n"
     << "[filter.kalman]\na = 0.9\nq = 0.0001\nr = 0.01\n"

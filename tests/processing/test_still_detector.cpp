@@ -167,3 +167,130 @@ TEST(StillDetector, BadParametersNameTheParameter) {
   const std::string msg = message({}, bad);
   EXPECT_NE(msg.find("axis z: sample_allan_variance"), std::string::npos) << msg;
 }
+
+// ---- with the accelerometer -------------------------------------------------------------
+
+namespace {
+
+// The white-noise gyro of the tests above with an accelerometer of 2 mg per sample at 50 Hz
+// (N = 2 mg·/√50 Hz = 283 µg/√Hz, a little quieter than the product spec's 400 µg/√Hz).
+SimulationModel withAccel(double sigma_g = 0.002) {
+  SimulationModel m = whiteNoiseModel();
+  m.accel = AccelModel{};
+  for (auto& axis : m.accel->axes) axis.velocity_random_walk_g_per_sqrt_hz = sigma_g / std::sqrt(kRateHz);
+  return m;
+}
+
+struct Verdicts {
+  WindowCount gyro_only, with_accel;
+};
+
+// Both detectors see the same samples from `from_s` on; only one is fed the accel.
+Verdicts runBoth(const StillDetectorParameters& p, NoiseSimulator& sim, double seconds, double from_s) {
+  const auto levels = levelsOf(whiteNoiseModel(), p.window_samples);
+  StillDetector gyro_only(p, levels), with_accel(p, levels);
+  Verdicts v;
+  const AngularRate zero{};
+  const auto samples = static_cast<std::size_t>(seconds * kRateHz);
+  for (std::size_t i = 1; i <= samples; ++i) {
+    const SimulatedSample s = sim.next();
+    with_accel.observeAccel(s.accel_g);
+    const bool a = gyro_only.update(s.rate_dps, zero, zero);
+    const bool b = with_accel.update(s.rate_dps, zero, zero);
+    if (s.t_s < from_s || i % p.window_samples != 0) continue;
+    ++v.gyro_only.windows;
+    ++v.with_accel.windows;
+    v.gyro_only.still += a ? 1 : 0;
+    v.with_accel.still += b ? 1 : 0;
+  }
+  return v;
+}
+
+}  // namespace
+
+TEST(StillDetectorAccel, ASlowTiltBelowTheGyrosResolutionIsCaughtByTheAccel) {
+  const SimulationModel m = withAccel();
+  StillDetectorParameters p;  // W = 25, Wa = 250, z = 3, σa = 3 mg
+  StillDetector probe(p, levelsOf(m, p.window_samples));
+  const double resolution = p.mean_threshold_sigmas * std::sqrt(probe.windowVariance(0));
+  const double omega = 0.6 * resolution;  // 0.04 °/s about x: the gyro's mean test passes it mostly
+  NoiseSimulator sim(m, 600.0, 21, MotionProfile::constant(0, omega));
+  const Verdicts v = runBoth(p, sim, 600.0, 10.0);
+  std::printf("tilt at %.4f deg/s (resolution %.4f): still by the gyro alone %.3f, with accel %.3f (%zu windows)\n",
+              omega, resolution, v.gyro_only.fraction(), v.with_accel.fraction(), v.gyro_only.windows);
+  // The gyro alone: P_fs(0.6·resolution) ≈ 0.88 (header formula).
+  EXPECT_NEAR(v.gyro_only.fraction(), probe.falseStillProbability(0, omega), 0.05);
+  // The accel sees gravity move by ω/rate = 14 µg per sample against a slope bound of 7.9 µg.
+  EXPECT_LT(v.with_accel.fraction(), 0.01);
+}
+
+TEST(StillDetectorAccel, AtRestInAnyAttitudeTheAccelRarelyObjects) {
+  // Tilted by 30° about y before the record starts (the attitude does not matter, only
+  // its steadiness), accel noise at the configured σa: the accel adds about
+  // 1 − ((1 − αm)(1 − αd))³ ≈ 1.1 % false moving per window.
+  SimulationModel m = withAccel(0.003);
+  NoiseSimulator sim(m, 2000.0, 23, MotionProfile::constant(1, 30.0, 0.0, 1.0));
+  StillDetectorParameters p;
+  const Verdicts v = runBoth(p, sim, 2000.0, 10.0);
+  std::printf("at rest: still by the gyro alone %.4f, with accel %.4f (%zu windows)\n", v.gyro_only.fraction(),
+              v.with_accel.fraction(), v.gyro_only.windows);
+  EXPECT_GT(v.gyro_only.fraction(), 0.97);
+  EXPECT_GT(v.with_accel.fraction(), v.gyro_only.fraction() - 0.04);
+  EXPECT_LE(v.with_accel.still, v.gyro_only.still);  // the accel can only veto
+}
+
+TEST(StillDetectorAccel, VibrationOnTheAccelAloneIsCaughtByItsDifferenceTest) {
+  // A board on a vibrating table that does not rotate: 20 mg at 7 Hz on z, no gyro signal.
+  StillDetectorParameters p;
+  const auto levels = levelsOf(whiteNoiseModel(), p.window_samples);
+  StillDetector d(p, levels);
+  NoiseSimulator sim(withAccel(), 60.0, 31);
+  const AngularRate zero{};
+  std::size_t still = 0;
+  for (int i = 0; i < 3000; ++i) {
+    SimulatedSample s = sim.next();
+    s.accel_g[2] += 0.02 * portableSinOfCycles(7.0 * s.t_s);
+    d.observeAccel(s.accel_g);
+    if (d.update(s.rate_dps, zero, zero) && i >= 250) ++still;
+  }
+  EXPECT_EQ(still, 0u);
+}
+
+TEST(StillDetectorAccel, WithoutAccelTheVerdictsAreExactlyTheGyrosAlone) {
+  // NaN accel (a device without it) and no accel at all give the same verdicts sample by sample.
+  const SimulationModel m = whiteNoiseModel();
+  StillDetectorParameters p;
+  StillDetector plain(p, levelsOf(m, p.window_samples)), fed_nan(p, levelsOf(m, p.window_samples));
+  NoiseSimulator sim(m, 200.0, 41, MotionProfile::sine(2, 0.2, 0.3, 50.0, 50.0));
+  const AngularRate zero{};
+  const std::array<double, 3> none = {std::nan(""), std::nan(""), std::nan("")};
+  std::size_t still = 0;
+  for (int i = 0; i < 10000; ++i) {
+    const SimulatedSample s = sim.next();
+    fed_nan.observeAccel(none);
+    const bool a = plain.update(s.rate_dps, zero, zero);
+    ASSERT_EQ(fed_nan.update(s.rate_dps, zero, zero), a) << "sample " << i;
+    EXPECT_FALSE(fed_nan.usingAccel());
+    still += a ? 1 : 0;
+  }
+  EXPECT_GT(still, 1000u);  // the comparison covered both verdicts
+  EXPECT_LT(still, 10000u);
+}
+
+TEST(StillDetectorAccel, BadAccelParametersNameTheParameter) {
+  const auto levels = levelsOf(whiteNoiseModel(), 25);
+  auto message = [&](StillDetectorParameters p) -> std::string {
+    try {
+      StillDetector d(p, levels);
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "";
+  };
+  StillDetectorParameters p;
+  p.accel_window_samples = 2;
+  EXPECT_NE(message(p).find("still.accel_window_samples"), std::string::npos);
+  p = {};
+  p.accel_noise_g = 0.0;
+  EXPECT_NE(message(p).find("still.accel_noise_g"), std::string::npos);
+}

@@ -42,7 +42,9 @@ vm_chip emulate /dev/i2c-0 &
 # is identified over a still period of 200 samples, which vm_chip's constant frames refuse)
 conf() {
   {
-    printf '[device]\nbackend = "i2c"\nbus = %s\naddress = %s\n[gpio]\nchip = "%s"\n' "$2" "$3" "$4"
+    printf '[device]\nbackend = "i2c"\nbus = %s\naddress = %s\n' "$2" "$3"
+    printf 'accel = false\n' # vm_chip serves the 8-byte gyro-only frame (FIFO_COUNT held at 8)
+    printf '[gpio]\nchip = "%s"\n' "$4"
     [ -n "$4" ] && printf 'line = 0\n'
     printf '[bias]\nsource = "config"\nstill_seconds = 4\n'
   } >/tmp/$1.toml

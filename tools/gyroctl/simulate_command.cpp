@@ -1,6 +1,10 @@
 // gyroctl simulate: a recording of the simulated gyro (docs/simulator.md), as the CSV that
 // analyze/filter read: t,gx,gy,gz,temp; with --motion, turned by a motion spec
-// (formats/motion_spec.hpp) and followed by the truth wx,wy,wz that any stream can be scored on.
+// (formats/motion_spec.hpp) and followed by the truth wx,wy,wz that any stream can be scored on;
+// with --accel, the accelerometer ax,ay,az [g] after temp (gravity at the attitude the motion
+// turns the board to, plus the accel noise terms).
+#include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
@@ -33,6 +37,13 @@ struct SimulateOptions {
   std::string warm_up;                  // DELTA_C,TAU_S; empty: the model's temperature curve
   std::string temperature_coefficient;  // K or KX,KY,KZ [°/s per °C]; empty: the model's coupling
   std::string motion;                   // empty: at rest, and no truth columns (the output stays as it always was)
+  // --accel: ax,ay,az columns. Without it nothing of the accel is computed or written.
+  bool accel = false;
+  double accel_noise_density = 4e-4;  // N [g/√Hz]: the product spec's 400 µg/√Hz (§6.2)
+  double accel_bias_instability = 0.0;
+  double accel_random_walk = 0.0;
+  std::string accel_bias;  // B or BX,BY,BZ [g]; empty: 0
+  int accel_range_g = 2;
   std::string output;
 };
 
@@ -43,6 +54,7 @@ constexpr double kMaxSimulateDurationS = 1e7;  // about 116 days
 // four commas and a newline. The estimate is an upper bound, real lines are a little shorter.
 constexpr std::uint64_t kMaxSimulateLineBytes = 5 * 24 + 5;
 constexpr std::uint64_t kMaxSimulateLineBytesWithTruth = 8 * 24 + 8;  // + wx,wy,wz
+constexpr std::uint64_t kAccelLineBytes = 3 * 24 + 3;                 // + ax,ay,az
 constexpr std::size_t kSamplesBetweenWriteChecks = 1 << 16;
 
 std::string byteCount(double bytes) {
@@ -101,6 +113,25 @@ int runSimulate(const SimulateOptions& opt) {
     for (std::size_t a = 0; a < kSimulatedAxes; ++a) model.axes[a].extra.temperature_coefficient_dps_per_c = k[a];
   }
 
+  if (opt.accel) {
+    AccelModel accel;
+    const int ranges[] = {2, 4, 8, 16};
+    const auto range = std::find(std::begin(ranges), std::end(ranges), opt.accel_range_g);
+    if (range == std::end(ranges))
+      throw std::invalid_argument("--accel-range-g must be 2, 4, 8 or 16, got " + std::to_string(opt.accel_range_g));
+    accel.afs_sel = static_cast<int>(range - std::begin(ranges));
+    const std::array<double, kSimulatedAxes> bias = opt.accel_bias.empty()
+                                                        ? std::array<double, kSimulatedAxes>{}
+                                                        : recording::parseAxisValues(opt.accel_bias, "--accel-bias");
+    for (std::size_t a = 0; a < kSimulatedAxes; ++a) {
+      accel.axes[a].bias_g = bias[a];
+      accel.axes[a].velocity_random_walk_g_per_sqrt_hz = opt.accel_noise_density;
+      accel.axes[a].bias_instability_g = opt.accel_bias_instability;
+      accel.axes[a].acceleration_random_walk_g_per_sqrt_s = opt.accel_random_walk;
+    }
+    model.accel = accel;
+  }
+
   requireDurationWithinBound(opt.duration_s);
   // Both validate: std::invalid_argument (bad model or profile text) and RecordingError (bad
   // motion CSV) → exit 2.
@@ -112,9 +143,13 @@ int runSimulate(const SimulateOptions& opt) {
   if (with_motion && !recording::isMotionProfileText(opt.motion)) inputs.push_back(opt.motion);
   formats::AtomicOutputFile out(opt.output, inputs);
   const std::size_t n = sim.sampleCount();
-  requireRoomFor(n, with_motion ? kMaxSimulateLineBytesWithTruth : kMaxSimulateLineBytes, out);
+  requireRoomFor(
+      n, (with_motion ? kMaxSimulateLineBytesWithTruth : kMaxSimulateLineBytes) + (opt.accel ? kAccelLineBytes : 0),
+      out);
   std::FILE* f = out.stream();
-  std::fputs(with_motion ? "t,gx,gy,gz,temp,wx,wy,wz\n" : "t,gx,gy,gz,temp\n", f);
+  std::fputs("t,gx,gy,gz,temp", f);
+  if (opt.accel) std::fputs(",ax,ay,az", f);
+  std::fputs(with_motion ? ",wx,wy,wz\n" : "\n", f);
   for (std::size_t i = 0; i < n; ++i) {
     // Stop at the first failed write (a full disk) instead of computing the rest.
     if (i % kSamplesBetweenWriteChecks == 0 && out.failed()) break;
@@ -122,6 +157,7 @@ int runSimulate(const SimulateOptions& opt) {
     // 17 significant digits: every double survives the text round trip exactly.
     std::fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g", s.t_s, s.rate_dps[0], s.rate_dps[1], s.rate_dps[2],
                  s.temperature_c);
+    if (opt.accel) std::fprintf(f, ",%.17g,%.17g,%.17g", s.accel_g[0], s.accel_g[1], s.accel_g[2]);
     if (with_motion) std::fprintf(f, ",%.17g,%.17g,%.17g", s.true_rate_dps[0], s.true_rate_dps[1], s.true_rate_dps[2]);
     std::fputc('\n', f);
   }
@@ -164,6 +200,25 @@ void addSimulateCommand(CLI::App& app, CommandRunner& run) {
   sub->add_option("--motion", opt->motion,
                   "true rotation: profiles such as step:axis=z,at=5,rate=10 (summed with +), or a CSV t,wx,wy,wz; "
                   "adds the truth columns wx,wy,wz (docs/simulator.md)");
+  auto* accel =
+      sub->add_flag("--accel", opt->accel,
+                    "also write the accelerometer ax,ay,az [g] after temp: gravity at the attitude integrated "
+                    "from the motion's true rates, plus the accel noise terms (docs/simulator.md)");
+  sub->add_option("--accel-noise-density", opt->accel_noise_density,
+                  "accel white noise N [g/sqrt(Hz)] (velocity random walk; default 4e-4, the product spec's)")
+      ->check(CLI::NonNegativeNumber)
+      ->needs(accel);
+  sub->add_option("--accel-bias-instability", opt->accel_bias_instability, "accel bias instability B [g] (default 0)")
+      ->check(CLI::NonNegativeNumber)
+      ->needs(accel);
+  sub->add_option("--accel-random-walk", opt->accel_random_walk,
+                  "accel random walk K [g/sqrt(s)] (acceleration random walk; default 0)")
+      ->check(CLI::NonNegativeNumber)
+      ->needs(accel);
+  sub->add_option("--accel-bias", opt->accel_bias, "B or BX,BY,BZ [g]: constant accel bias (default 0)")->needs(accel);
+  sub->add_option("--accel-range-g", opt->accel_range_g,
+                  "accel full scale 2, 4, 8 or 16 g (AFS_SEL), used with --fs-sel")
+      ->needs(accel);
   sub->add_option("-o,--output", opt->output, "output CSV")->required();
   sub->callback([&run, opt] { run = [opt] { return runSimulate(*opt); }; });
 }
