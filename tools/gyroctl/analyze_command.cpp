@@ -18,6 +18,7 @@
 #include "processing/noise_fit.hpp"
 #include "processing/noise_terms.hpp"
 #include "processing/warm_up_fit.hpp"
+#include "protocol/allan_table.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
 #include "tools/gyroctl/series_checks.hpp"
@@ -106,19 +107,8 @@ json noiseTermsJson(const NoiseTerms& t) {
   return j;
 }
 
-json allanJson(const std::vector<AllanPoint>& curve) {
-  json a = json::array();
-  for (const auto& p : curve) {
-    json j = {{"tau_s", p.tau_s},       {"m", p.m},
-              {"adev", p.adev},         {"oadev", p.oadev},
-              {"oadev_lo", p.oadev_lo}, {"oadev_hi", p.oadev_hi},
-              {"n", p.oadev_terms},     {"adev_n", p.adev_terms},
-              {"edf", p.edf},           {"noise_alpha", p.noise_alpha}};
-    if (!std::isfinite(p.adev)) j.erase("adev");  // fewer than two clusters: omitted, not null
-    a.push_back(j);
-  }
-  return a;
-}
+// The shared shape of an Allan table (protocol/allan_table.hpp), as the ALLAN reply sends it.
+json allanJson(const std::vector<AllanPoint>& curve) { return json(protocol::allanTableJson(curve)); }
 
 json axisJson(const AxisAnalysis& a) {
   json j;
@@ -170,6 +160,16 @@ std::string format(const char* fmt, double v) {
   return buf;
 }
 
+// A noise term is never shown without its uncertainty: "value +- 1 sigma", or a mark.
+std::string termWithUncertainty(double value, double sigma) {
+  char text[64];
+  if (!std::isfinite(value) || !std::isfinite(sigma))
+    std::snprintf(text, sizeof text, "%27s", "not enough data");
+  else
+    std::snprintf(text, sizeof text, "%12.5g +- %-11.3g", value, sigma);
+  return text;
+}
+
 void printAxisText(std::ostream& o, const std::string& name, const AxisAnalysis& a) {
   char line[256];
   o << "\n== " << name << " ==\n";
@@ -200,10 +200,11 @@ void printAxisText(std::ostream& o, const std::string& name, const AxisAnalysis&
     o << line;
   }
 
-  o << "\nTable 2: noise terms (weighted fit +- 1 sigma | slope-line reading)\n";
+  o << "\nTable 2: noise terms (weighted fit +- 1 sigma | slope-line reading, a cross-check without uncertainty)\n";
   for (NoiseTerm t : kAllNoiseTerms) {
-    std::snprintf(line, sizeof line, "  %-36s %12.5g +- %-11.3g | %12.5g\n", std::string(noiseTermLabel(t)).c_str(),
-                  a.noise.value.get(t), a.noise.uncertainty.get(t), a.noise_from_slopes.get(t));
+    std::snprintf(line, sizeof line, "  %-36s %s | %12.5g\n", std::string(noiseTermLabel(t)).c_str(),
+                  termWithUncertainty(a.noise.value.get(t), a.noise.uncertainty.get(t)).c_str(),
+                  a.noise_from_slopes.get(t));
     o << line;
   }
 
@@ -236,10 +237,12 @@ void printAxisText(std::ostream& o, const std::string& name, const AxisAnalysis&
   std::snprintf(line, sizeof line, "Peak after Kalman: %.1f %% of before\n", 100.0 * a.peak_ratio);
   o << line;
 
-  o << "\nTable 4: noise terms before and after Kalman\n";
+  o << "\nTable 4: noise terms before and after Kalman (+- 1 sigma)\n";
   for (NoiseTerm t : kAllNoiseTerms) {
     const double before = a.noise.value.get(t), after = a.noise_after_kalman.value.get(t);
-    std::snprintf(line, sizeof line, "  %-36s %12.5g %12.5g", std::string(noiseTermLabel(t)).c_str(), before, after);
+    std::snprintf(line, sizeof line, "  %-36s %s %s", std::string(noiseTermLabel(t)).c_str(),
+                  termWithUncertainty(before, a.noise.uncertainty.get(t)).c_str(),
+                  termWithUncertainty(after, a.noise_after_kalman.uncertainty.get(t)).c_str());
     o << line;
     if (before > 0.0) o << format("  %+7.1f %%", 100.0 * (after - before) / before);
     o << '\n';
