@@ -11,6 +11,7 @@
 #include <string>
 
 #include "gyrod_process.hpp"
+#include "tools/run_command.hpp"
 
 using namespace gyrod::test;
 using nlohmann::json;
