@@ -31,7 +31,7 @@ std::string turnAtStartConfig(const std::filesystem::path& dir) {
   return c.str();
 }
 
-json status(const std::filesystem::path& socket) {
+json statusReply(const std::filesystem::path& socket) {
   LineClient asker(socket.string());
   if (!asker.connected() || !asker.readLine()) return {};
   asker.send("{\"cmd\":\"status\"}\n");
@@ -64,7 +64,7 @@ TEST(GyrodStillPeriod, ATurnDuringTheStillPeriodIsReportedAndNotAbsorbedIntoTheB
   ASSERT_TRUE(first_rate.has_value());
   EXPECT_GE((*first_rate)["seq"].get<std::uint64_t>(), 399u);  // not after the first window (seq 199)
 
-  const json s = status(socket);
+  const json s = statusReply(socket);
   ASSERT_EQ(s["class"], "STATUS") << s.dump();
   EXPECT_EQ(s["still_check"], "still") << s.dump();
   EXPECT_NE(s["still_check_detail"].get<std::string>().find("window 2 of at most 3"), std::string::npos) << s.dump();
