@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "daemon/memory_budget.hpp"
+#include "daemon/sample_pipeline.hpp"
 #include "driver/mpu6050_config.hpp"
 #include "formats/model_toml.hpp"
 #include "formats/motion_spec.hpp"
@@ -122,6 +123,25 @@ void readBias(const Section& s, BiasConfig& b) {
     b.values.clear();
     for (const auto& e : *a) b.values.push_back(s.numberFrom(e, "values"));
   }
+}
+
+// The still period must hold the samples its uses need (SamplePipeline refuses fewer): checked
+// here, so that it is a configuration error at its line (EX_CONFIG) rather than a failure at start.
+void checkStillPeriodLength(const Section& bias, GyrodConfig& c) {
+  const auto& k = c.filter.kalman;
+  const bool identifying = !(k.a && k.q && k.r);
+  if (!identifying && c.bias.source != BiasSource::Estimate) return;  // no still period
+  const double needed = identifying ? static_cast<double>(kMinimumIdentificationSamples) : 1.0;
+  if (static_cast<double>(std::llround(c.bias.still_seconds * c.device.rate_hz)) >= needed) return;
+  if (!bias.has("still_seconds")) {  // the default 10 s is too short below 10 Hz: as long as needed
+    c.bias.still_seconds = std::ceil(needed / c.device.rate_hz);
+    return;
+  }
+  std::ostringstream requirement;
+  requirement << "must give at least " << shortest(needed) << (needed > 1.0 ? " samples" : " sample")
+              << " at device.rate_hz = " << shortest(c.device.rate_hz) << " Hz (" << shortest(needed / c.device.rate_hz)
+              << " s)" << (identifying ? " to identify the Kalman filter, unless filter.kalman gives a, q and r" : "");
+  bias.failValue("still_seconds", requirement.str());
 }
 
 void readFilter(const Section& s, FilterConfig& f, double rate_hz) {
@@ -498,6 +518,7 @@ GyrodConfig readConfig(const formats::TomlDocument& doc, ReferenceChecks checks)
     filter.failValue("rate_low_pass_hz", "needs filter.model (without a model, rate is raw − the constant bias)");
   if (config.bias.source == BiasSource::Model && config.filter.model.empty())
     bias.failValue("source", "\"model\" needs filter.model (a model file from `gyroctl analyze --write-model`)");
+  checkStillPeriodLength(bias, config);
   readAllan(section("allan", {"window_s", "refit_interval_s", "taus"}), config.allan, config.device.rate_hz);
   const auto socket = section("socket", {"path", "mode", "group", "client_buffer_kib"});
   readSocket(socket, config.socket);

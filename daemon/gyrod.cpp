@@ -284,6 +284,7 @@ void Gyrod::onSample(const driver::GyroSample& s) {
     spdlog::error("sample {} skipped: {}", s.seq, e.what());
     return;
   }
+  if (pipeline_.stillPeriod().verdicts != still_verdicts_logged_) logStillPeriodVerdict();
   RateSample r;
   r.seq = out.seq;
   r.t_s = out.t_s;
@@ -378,17 +379,71 @@ std::string Gyrod::rateModelDescription() const {
   return "bias";
 }
 
+namespace {
+
+std::string_view stillCheckToken(StillPeriodState state) {
+  switch (state) {
+    case StillPeriodState::Collecting: return protocol::stillCheckName(protocol::StillCheck::Pending);
+    case StillPeriodState::MovedRetrying: return protocol::stillCheckName(protocol::StillCheck::MovedRetrying);
+    case StillPeriodState::Still: return protocol::stillCheckName(protocol::StillCheck::Still);
+    case StillPeriodState::MovedKept: return protocol::stillCheckName(protocol::StillCheck::MovedKept);
+    case StillPeriodState::None: break;
+  }
+  return {};
+}
+
+// What the last check found, for the log and STATUS still_check_detail.
+std::string stillCheckDetail(const StillPeriodReport& r) {
+  const auto& v = r.verdict;
+  std::ostringstream s;
+  s.precision(3);
+  s << "window " << r.attempts << " of at most " << kMaxStillAttempts << ": axis "
+    << "xyz"[v.axis % 3] << " Allan deviation " << v.adev_dps << " deg/s at tau " << v.tau_s << " s, "
+    << (v.moved ? "over" : "within") << " the " << v.allowed_dps << " deg/s its own noise allows at rest";
+  return s.str();
+}
+
+}  // namespace
+
+void Gyrod::logStillPeriodVerdict() {
+  const StillPeriodReport& r = pipeline_.stillPeriod();
+  still_verdicts_logged_ = r.verdicts;
+  const std::string detail = stillCheckDetail(r);
+  switch (r.state) {
+    case StillPeriodState::MovedRetrying:
+      spdlog::warn("start-up still period: the board moved ({}); discarding it and estimating again over the next {} s",
+                   detail, pipeline_.stillSecondsNeeded());
+      break;
+    case StillPeriodState::MovedKept:
+      spdlog::error(
+          "start-up still period: the board moved in every window ({}); using the last one: its bias is suspect "
+          "(STATUS still_check moved_kept; restart gyrod with the board at rest)",
+          detail);
+      break;
+    default: spdlog::info("start-up still period: at rest ({})", detail); break;
+  }
+}
+
 AllanReport Gyrod::allanReport() {
   AllanWindowDeviations d = pipeline_.allanWindowDeviations();
   AllanReport report;
   report.tau0_s = d.tau0_s;
   report.window_s = d.window_s;
+  // What the statistics are computed from, not what the window could hold: gaps excepted,
+  // the time the samples cover.
+  report.samples = d.samples;
+  report.span_s = static_cast<double>(d.samples) * d.tau0_s;
+  report.confidence = processing::AllanOptions{}.confidence;
   report.tau_s = std::move(d.tau_s);
-  report.samples = std::min<std::uint64_t>(pipeline_.samplesProcessed(),
-                                           static_cast<std::uint64_t>(std::llround(d.window_s / d.tau0_s)));
   for (std::size_t axis = 0; axis < kAxes; ++axis) {
-    for (std::size_t k = 0; k < 3; ++k) report.curves[axis][k].adev_dps = std::move(d.oadev[axis][k]);
-    if (const auto& fit = pipeline_.noiseTerms()[axis]) report.curves[axis][0].noise = fit->value;
+    for (std::size_t k = 0; k < kStreams; ++k) {
+      report.curves[axis][k].adev_dps = std::move(d.oadev[axis][k]);
+      report.curves[axis][k].points = std::move(d.points[axis][k]);
+    }
+    if (const auto& fit = pipeline_.noiseTerms()[axis]) {
+      report.curves[axis][0].noise = fit->value;
+      report.curves[axis][0].noise_uncertainty = fit->uncertainty;
+    }
   }
   return report;
 }
@@ -421,6 +476,11 @@ StatusReport Gyrod::statusReport() {
     bias << " [" << pipeline_.bias()[0] << ", " << pipeline_.bias()[1] << ", " << pipeline_.bias()[2] << "] deg/s";
   }
   r.bias_source = bias.str();
+  const StillPeriodReport& still = pipeline_.stillPeriod();
+  if (still.state != StillPeriodState::None) {
+    r.still_check = std::string(stillCheckToken(still.state));
+    if (still.attempts > 0) r.still_check_detail = stillCheckDetail(still);
+  }
   r.rate_model = rateModelDescription();
   if (recorder_) {
     r.recording = recorder_->currentFile();

@@ -55,6 +55,7 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   static LoadedRateModel loadRateModel(const GyrodConfig& config);
   static PipelineSettings pipelineSettings(const GyrodConfig& config, const LoadedRateModel& rate_model);
   std::string rateModelDescription() const;
+  void logStillPeriodVerdict();
   void serviceDriver();
   void rearmDriverTimer();
   void pumpVirtualClock();
@@ -86,6 +87,7 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   std::uint64_t missing_samples_ = 0;
   std::optional<double> last_temp_c_;
   std::optional<double> last_t_s_;
+  std::uint64_t still_verdicts_logged_ = 0;  // StillPeriodReport::verdicts already logged
   std::uint64_t reloads_ = 0;
 };
 

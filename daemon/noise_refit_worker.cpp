@@ -37,35 +37,37 @@ NoiseRefitWorker::~NoiseRefitWorker() {
 }
 
 bool NoiseRefitWorker::startCycle() {
-  if (axis_) return false;
-  startAxis(0);
+  if (job_) return false;
+  startJob(0);
   return true;
 }
 
-void NoiseRefitWorker::startAxis(std::size_t axis) {
-  axis_ = axis;
+void NoiseRefitWorker::startJob(std::size_t job) {
+  job_ = job;
+  const auto stream = static_cast<AllanStream>(job % kStreams);
   {
     const std::lock_guard lock(mutex_);
-    copy_ = pipeline_.rawAllan(axis);  // same sizes: reuses copy_'s memory
+    copy_ = pipeline_.allanStream(job / kStreams, stream);  // same sizes: reuses copy_'s memory
+    fit_terms_ = stream == AllanStream::Raw;
     work_ = true;
   }
   wake_.notify_one();
 }
 
 void NoiseRefitWorker::onAxisDone() {
-  if (!axis_) return;
+  if (!job_) return;
   NoiseRefit result;
   {
     const std::lock_guard lock(mutex_);
     if (work_) return;  // not done yet (a stale wake-up)
-    result = result_;   // trivially copyable: a plain copy
+    result = std::move(result_);
   }
-  pipeline_.applyNoiseRefit(*axis_, result);
-  if (*axis_ + 1 < kAxes) {
-    startAxis(*axis_ + 1);
+  pipeline_.applyNoiseRefit(*job_ / kStreams, static_cast<AllanStream>(*job_ % kStreams), result);
+  if (*job_ + 1 < kAxes * kStreams) {
+    startJob(*job_ + 1);
     return;
   }
-  axis_.reset();
+  job_.reset();
   if (on_cycle_done_) on_cycle_done_();
 }
 
@@ -82,12 +84,12 @@ void NoiseRefitWorker::threadMain() {
     lock.unlock();
     NoiseRefit result;
     try {
-      result = refitNoiseTerms(copy_, tau0_s_);
+      result = refitNoiseTerms(copy_, tau0_s_, fit_terms_);
     } catch (const std::exception& e) {
       spdlog::error("noise refit failed: {}", e.what());
     }
     lock.lock();
-    result_ = result;
+    result_ = std::move(result);
     work_ = false;
     const std::uint64_t one = 1;
     [[maybe_unused]] const ssize_t n = ::write(done_fd_.get(), &one, sizeof one);

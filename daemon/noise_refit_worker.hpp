@@ -4,8 +4,9 @@
 // for 3.6 M samples), far longer than the chip's FIFO lasts (~128 ms at 1 kHz); on the loop
 // it made gyrod lose samples. Here the loop only copies one raw stream's state into a
 // buffer allocated once (~20 ms for 3.6 M samples), and a worker thread refits the copy.
-// The axes are refitted one after the other; the result of each is applied on the loop, so
-// the pipeline is only ever touched by the loop thread. The numbers are exactly those of
+// The axes are refitted one after the other, each raw stream (the noise terms and types) then
+// its mean and Kalman streams (their noise types, for the ALLAN reply's intervals); the result
+// of each is applied on the loop, so the pipeline is only ever touched by the loop thread. The numbers are exactly those of
 // SamplePipeline::refitNoiseTerms on the state at the moment of the copy.
 #include <condition_variable>
 #include <cstddef>
@@ -31,10 +32,10 @@ class NoiseRefitWorker {
   // Starts refitting the three axes, unless a cycle is still running (then no effect:
   // returns false).
   bool startCycle();
-  bool busy() const { return axis_.has_value(); }
+  bool busy() const { return job_.has_value(); }
 
  private:
-  void startAxis(std::size_t axis);
+  void startJob(std::size_t job);  // job = axis·kStreams + stream
   void onAxisDone();
   void threadMain();
 
@@ -42,12 +43,13 @@ class NoiseRefitWorker {
   SamplePipeline& pipeline_;
   double tau0_s_;
   std::function<void()> on_cycle_done_;
-  std::optional<std::size_t> axis_;  // the axis being refitted (loop thread only)
-  Fd done_fd_;                       // eventfd: the worker's "result ready" to the loop
+  std::optional<std::size_t> job_;  // the (axis, stream) being refitted (loop thread only)
+  Fd done_fd_;                      // eventfd: the worker's "result ready" to the loop
 
   std::mutex mutex_;
   std::condition_variable wake_;
-  bool work_ = false;  // copy_ holds a stream to refit
+  bool work_ = false;      // copy_ holds a stream to refit
+  bool fit_terms_ = true;  // copy_ is a raw stream: fit the noise terms too
   bool stop_ = false;
   processing::RollingOverlappingAllan copy_;  // written by the loop only while !work_
   NoiseRefit result_;

@@ -1,6 +1,7 @@
 #include "daemon/sample_pipeline.hpp"
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -8,10 +9,6 @@ namespace gyrod::daemon {
 namespace {
 
 using processing::RollingOverlappingAllan;
-
-// identifyFilterChain fits AR(1) on the mean-filtered still period: fewer samples than
-// this give a φ1 too uncertain to run a filter on (standard error ≈ 1/√n ≈ 0.1).
-constexpr std::size_t kMinimumIdentificationSamples = 100;
 
 RollingOverlappingAllan makeAllan(const PipelineSettings& s) {
   if (s.allan_cluster_sizes.empty()) return RollingOverlappingAllan(s.allan_window_samples);
@@ -72,6 +69,7 @@ SamplePipeline::SamplePipeline(const PipelineSettings& settings)
       throw std::invalid_argument("bias.still_seconds must give at least one sample to estimate the bias");
     for (auto& v : still_) v.reserve(still_samples_);
     phase_ = PipelinePhase::Estimating;
+    still_period_.state = StillPeriodState::Collecting;
   } else {
     for (auto& p : params_) p.kalman = {*settings_.kalman.a, *settings_.kalman.q, *settings_.kalman.r, 0.0, {}};
     startFilters();
@@ -97,7 +95,25 @@ void SamplePipeline::startFilters() {
   phase_ = PipelinePhase::Running;
 }
 
+bool SamplePipeline::stillWindowMoved() {
+  still_period_.verdict = processing::checkStillPeriod({still_[0], still_[1], still_[2]}, settings_.rate_hz);
+  ++still_period_.attempts;
+  ++still_period_.verdicts;
+  if (!still_period_.verdict.moved) {
+    still_period_.state = StillPeriodState::Still;
+    return false;
+  }
+  if (still_period_.attempts >= kMaxStillAttempts) {
+    still_period_.state = StillPeriodState::MovedKept;
+    return false;
+  }
+  still_period_.state = StillPeriodState::MovedRetrying;
+  for (auto& x : still_) x.clear();  // capacity kept: the next window allocates nothing
+  return true;
+}
+
 void SamplePipeline::finishEstimation() {
+  if (stillWindowMoved()) return;  // collect the still period again
   // Worked on copies: a still period that cannot identify the filter (a sensor whose output
   // never changes gives zero variance) changes nothing and starts again, rather than being
   // retried and refused at every following sample with the samples piling up.
@@ -120,7 +136,9 @@ void SamplePipeline::finishEstimation() {
       }
     }
   } catch (const std::invalid_argument& e) {
-    for (auto& x : still_) x.clear();  // capacity kept: the next still period allocates nothing
+    for (auto& x : still_) x.clear();                    // capacity kept: the next still period allocates nothing
+    still_period_.state = StillPeriodState::Collecting;  // a fresh start, motion check included
+    still_period_.attempts = 0;
     std::ostringstream msg;
     msg << "the still period cannot identify the filter (" << e.what()
         << "; a sensor whose output never changes?): estimating again over the next " << settings_.still_seconds
@@ -230,28 +248,73 @@ AllanStreams SamplePipeline::allanSnapshot() const {
   return s;
 }
 
+const RollingOverlappingAllan& SamplePipeline::allanStream(std::size_t axis, AllanStream stream) const {
+  switch (stream) {
+    case AllanStream::Raw: return allan_raw_.at(axis);
+    case AllanStream::Mean: return allan_mean_.at(axis);
+    case AllanStream::Kalman: return allan_kalman_.at(axis);
+  }
+  return allan_raw_.at(axis);
+}
+
+namespace {
+
+// The window point at cluster index i, with the noise type `alphas` found at the last refit
+// (none: edf and interval NaN), computed as RollingOverlappingAllan::snapshot() does.
+processing::AllanPoint windowPoint(const RollingOverlappingAllan& a, std::size_t i, double tau0_s,
+                                   const std::vector<int>& alphas) {
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  processing::AllanPoint p;
+  p.m = a.clusterSizes()[i];
+  p.tau_s = static_cast<double>(p.m) * tau0_s;
+  p.oadev = std::sqrt(a.windowVariance(i));
+  p.oadev_terms = a.windowTerms(i);
+  p.adev = kNaN;  // the non-overlapping estimator is not kept
+  p.edf = p.oadev_lo = p.oadev_hi = kNaN;
+  if (alphas.size() != a.clusterSizes().size() || !std::isfinite(p.oadev) || a.windowCount() < 4) return p;
+  try {
+    p.noise_alpha = alphas[i];
+    p.edf = processing::overlappingAllanEdf(p.noise_alpha, a.windowCount() + 1, p.m);
+    const auto interval =
+        processing::allanDeviationConfidenceInterval(p.oadev, p.edf, processing::AllanOptions{}.confidence);
+    p.oadev_lo = interval.lo;
+    p.oadev_hi = interval.hi;
+  } catch (const std::invalid_argument&) {
+    p.noise_alpha = 0;
+    p.edf = p.oadev_lo = p.oadev_hi = kNaN;
+  }
+  return p;
+}
+
+}  // namespace
+
 AllanWindowDeviations SamplePipeline::allanWindowDeviations() const {
   AllanWindowDeviations d;
   d.tau0_s = 1.0 / settings_.rate_hz;
   d.window_s = static_cast<double>(settings_.allan_window_samples) / settings_.rate_hz;
+  d.samples = allan_raw_[0].windowCount();
   for (const std::size_t m : allan_raw_[0].clusterSizes()) d.tau_s.push_back(static_cast<double>(m) * d.tau0_s);
   for (std::size_t axis = 0; axis < kAxes; ++axis) {
-    const std::array<const RollingOverlappingAllan*, 3> streams = {&allan_raw_[axis], &allan_mean_[axis],
-                                                                   &allan_kalman_[axis]};
-    for (std::size_t k = 0; k < 3; ++k)
-      for (std::size_t i = 0; i < d.tau_s.size(); ++i)
-        d.oadev[axis][k].push_back(std::sqrt(streams[k]->windowVariance(i)));
+    for (std::size_t k = 0; k < kStreams; ++k) {
+      const RollingOverlappingAllan& stream = allanStream(axis, static_cast<AllanStream>(k));
+      for (std::size_t i = 0; i < d.tau_s.size(); ++i) {
+        d.points[axis][k].push_back(windowPoint(stream, i, d.tau0_s, noise_alpha_[axis][k]));
+        d.oadev[axis][k].push_back(d.points[axis][k].back().oadev);
+      }
+    }
   }
   return d;
 }
 
-NoiseRefit refitNoiseTerms(const RollingOverlappingAllan& raw_stream, double tau0_s) {
+NoiseRefit refitNoiseTerms(const RollingOverlappingAllan& stream, double tau0_s, bool fit_terms) {
   NoiseRefit refit;
-  const auto snap = raw_stream.snapshot(tau0_s);
+  const auto snap = stream.snapshot(tau0_s);
   std::size_t usable = 0;
   for (const auto& p : snap.window) usable += (p.oadev_terms >= 2 && std::isfinite(p.oadev)) ? 1 : 0;
   if (usable < 3) return refit;  // too early for a fit of five terms to mean anything
   refit.too_early = false;
+  for (const auto& p : snap.window) refit.noise_alpha.push_back(p.noise_alpha);
+  if (!fit_terms) return refit;
   try {
     refit.fit = processing::fitNoiseTerms(snap.window);
   } catch (const std::exception&) {
@@ -260,14 +323,20 @@ NoiseRefit refitNoiseTerms(const RollingOverlappingAllan& raw_stream, double tau
   return refit;
 }
 
-void SamplePipeline::applyNoiseRefit(std::size_t axis, const NoiseRefit& refit) {
-  if (!refit.too_early) noise_terms_.at(axis) = refit.fit;
+void SamplePipeline::applyNoiseRefit(std::size_t axis, AllanStream stream, const NoiseRefit& refit) {
+  if (refit.too_early) return;
+  if (stream == AllanStream::Raw) noise_terms_.at(axis) = refit.fit;
+  noise_alpha_.at(axis)[static_cast<std::size_t>(stream)] = refit.noise_alpha;
 }
 
 void SamplePipeline::refitNoiseTerms() {
   const double tau0 = 1.0 / settings_.rate_hz;
   for (std::size_t axis = 0; axis < kAxes; ++axis)
-    applyNoiseRefit(axis, daemon::refitNoiseTerms(allan_raw_[axis], tau0));
+    for (std::size_t k = 0; k < kStreams; ++k) {
+      const auto stream = static_cast<AllanStream>(k);
+      applyNoiseRefit(axis, stream,
+                      daemon::refitNoiseTerms(allanStream(axis, stream), tau0, stream == AllanStream::Raw));
+    }
 }
 
 }  // namespace gyrod::daemon

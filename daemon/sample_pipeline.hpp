@@ -31,6 +31,7 @@
 #include "processing/noise_fit.hpp"
 #include "processing/rate_estimator.hpp"
 #include "processing/rolling_allan.hpp"
+#include "processing/still_period_check.hpp"
 
 namespace gyrod::daemon {
 
@@ -62,6 +63,25 @@ struct PipelineSettings {
 
 enum class PipelinePhase { Estimating, Running };
 
+// The motion check of the start-up still period (processing/still_period_check.hpp). A window
+// in which the board moved is discarded and collected again, up to kMaxStillAttempts windows;
+// if the last one moved too it is used (gyrod cannot wait for ever on a board that never
+// rests) and the state says its bias is suspect.
+enum class StillPeriodState {
+  None,           // no still period (bias and filter configured)
+  Collecting,     // the first window is being collected
+  MovedRetrying,  // a window moved; the next is being collected
+  Still,          // the window used passed the check
+  MovedKept,      // every window moved; the last one was used
+};
+inline constexpr std::size_t kMaxStillAttempts = 3;
+struct StillPeriodReport {
+  StillPeriodState state = StillPeriodState::None;
+  std::size_t attempts = 0;                // windows checked so far
+  processing::StillPeriodVerdict verdict;  // of the last window checked
+  std::uint64_t verdicts = 0;              // +1 per window checked (gyrod logs each)
+};
+
 struct ProcessedSample {
   std::uint64_t seq = 0;
   double t_s = 0.0;
@@ -82,25 +102,39 @@ struct AllanStreams {
   std::array<processing::RollingOverlappingAllan::Snapshot, kAxes> raw, mean, kalman;
 };
 
+// identifyFilterChain fits AR(1) on the mean-filtered still period: fewer samples than
+// this give a φ1 too uncertain to run a filter on (standard error ≈ 1/√n ≈ 0.1).
+inline constexpr std::size_t kMinimumIdentificationSamples = 100;
+
+inline constexpr std::size_t kStreams = 3;  // raw, mean, kalman
+enum class AllanStream { Raw = 0, Mean, Kalman };
+
 // The window's overlapping Allan deviation of every stream at every τ, read from the
-// rolling sums in O(number of τ): the numbers of allanSnapshot()'s window points, without
-// their noise identification (O(window) per τ). What the ALLAN reply carries.
+// rolling sums in O(number of τ): the numbers of allanSnapshot()'s window points. Their noise
+// type (O(window) per τ to identify) is the one the last noise refit identified on that
+// stream; edf and the χ² interval are then computed as allanSnapshot() does, for the samples
+// in the window now (NaN until a refit has identified the type). What the ALLAN reply carries.
 struct AllanWindowDeviations {
   double tau0_s = 0.0;
-  double window_s = 0.0;
+  double window_s = 0.0;      // configured
+  std::uint64_t samples = 0;  // in the raw window now
   std::vector<double> tau_s;
-  std::array<std::array<std::vector<double>, 3>, kAxes> oadev;  // [axis][raw, mean, kalman]
+  std::array<std::array<std::vector<double>, kStreams>, kAxes> oadev;  // [axis][raw, mean, kalman]
+  std::array<std::array<std::vector<processing::AllanPoint>, kStreams>, kAxes> points;
 };
 
-// One axis's noise refit: too early (fewer than 3 usable τ: keep the previous fit), or the
-// fit (empty when nothing can be fitted, e.g. a constant signal).
+// One stream's noise refit: too early (fewer than 3 usable τ: keep the previous fit), or the
+// fit (empty when nothing can be fitted, e.g. a constant signal), and the noise type found at
+// each τ (lag-1 method; empty while too early).
 struct NoiseRefit {
   bool too_early = true;
   std::optional<processing::NoiseTermFit> fit;
+  std::vector<int> noise_alpha;
 };
 // The refit of refitNoiseTerms for one raw stream; a free function so that it can run on a
-// copy of the stream's state, off the event loop (seconds at a 1 h window at 1 kHz).
-NoiseRefit refitNoiseTerms(const processing::RollingOverlappingAllan& raw_stream, double tau0_s);
+// copy of the stream's state, off the event loop (seconds at a 1 h window at 1 kHz). With
+// fit_terms false only the noise types are identified (the mean and Kalman streams).
+NoiseRefit refitNoiseTerms(const processing::RollingOverlappingAllan& stream, double tau0_s, bool fit_terms = true);
 
 class SamplePipeline {
  public:
@@ -129,14 +163,18 @@ class SamplePipeline {
   // Not per sample (allocates): the Allan curves of the window and since start.
   AllanStreams allanSnapshot() const;
   AllanWindowDeviations allanWindowDeviations() const;
-  // Refit the five noise terms on the window of each raw axis (fitNoiseTerms).
+  // Refit the five noise terms on the window of each raw axis (fitNoiseTerms), and identify
+  // the noise type of every stream (for the ALLAN reply's intervals).
   void refitNoiseTerms();
   // The same in parts: the raw stream of an axis, and the result of refitNoiseTerms on it.
   const processing::RollingOverlappingAllan& rawAllan(std::size_t axis) const { return allan_raw_.at(axis); }
-  void applyNoiseRefit(std::size_t axis, const NoiseRefit& refit);
+  const processing::RollingOverlappingAllan& allanStream(std::size_t axis, AllanStream stream) const;
+  void applyNoiseRefit(std::size_t axis, const NoiseRefit& refit) { applyNoiseRefit(axis, AllanStream::Raw, refit); }
+  void applyNoiseRefit(std::size_t axis, AllanStream stream, const NoiseRefit& refit);
   const std::array<std::optional<processing::NoiseTermFit>, kAxes>& noiseTerms() const { return noise_terms_; }
 
   PipelinePhase phase() const { return phase_; }
+  const StillPeriodReport& stillPeriod() const { return still_period_; }
   const Vec3& bias() const { return bias_; }
   BiasOrigin biasOrigin() const { return settings_.bias_origin; }
   // Parameters the filters run with (valid once Running).
@@ -149,6 +187,8 @@ class SamplePipeline {
  private:
   bool needsStillPeriod() const;
   void finishEstimation();
+  // Checks the collected still window for motion; true: it moved and is being collected again.
+  bool stillWindowMoved();
   void startFilters();
 
   PipelineSettings settings_;
@@ -156,11 +196,13 @@ class SamplePipeline {
   Vec3 bias_{};
   std::size_t still_samples_ = 0;
   std::array<std::vector<double>, kAxes> still_;  // reserved once
+  StillPeriodReport still_period_;
   std::array<processing::FilterChainParameters, kAxes> params_{};
   std::vector<processing::AxisFilterChain> chains_;  // kAxes, built at start and on reload
   std::optional<processing::RateEstimator> rate_;    // with a sensor model
   std::array<processing::RollingOverlappingAllan, kAxes> allan_raw_, allan_mean_, allan_kalman_;
   std::array<std::optional<processing::NoiseTermFit>, kAxes> noise_terms_;
+  std::array<std::array<std::vector<int>, kStreams>, kAxes> noise_alpha_;  // of the last refit, per τ
   std::uint64_t processed_ = 0;
   std::optional<double> first_t_s_;  // of the first sample: the warm-up shape's origin
   double last_t_s_ = 0.0;

@@ -3,6 +3,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "protocol/allan_table.hpp"
 #include "protocol/protocol.hpp"
 
 namespace gyrod::protocol {
@@ -106,10 +107,14 @@ AllanReport allanOf(const json& j) {
   AllanReport r;
   r.samples = count(j, "ALLAN", "samples");
   r.window_s = realOr(j, "ALLAN", "window", kNaN);
+  r.span_s = realOr(j, "ALLAN", "span", kNaN);
   r.tau0_s = realOr(j, "ALLAN", "tau0", kNaN);
+  r.confidence = realOr(j, "ALLAN", "confidence", kNaN);
   if (const json* tau = field(j, "ALLAN", "tau", &json::is_array, "a list")) r.tau_s = reals(*tau, "\"tau\"");
   const json* adev = field(j, "ALLAN", "adev", &json::is_object, "an object");
   const json* noise = field(j, "ALLAN", "noise", &json::is_object, "an object");
+  const json* uncertainty = field(j, "ALLAN", "noise_uncertainty", &json::is_object, "an object");
+  const json* table = field(j, "ALLAN", "table", &json::is_object, "an object");
   for (std::size_t a = 0; a < kAxisNames.size(); ++a) {
     for (std::size_t s = 0; s < kStreamNames.size(); ++s) {
       AllanCurve& curve = r.curves[a][s];
@@ -128,6 +133,23 @@ AllanReport allanOf(const json& j) {
           fitted.set(t, it != terms->end() && it->is_number() ? it->get<double>() : kNaN);
         }
         curve.noise = fitted;
+      }
+      if (const json* terms = member(member(uncertainty, kAxisNames[a]), kStreamNames[s])) {
+        processing::NoiseTerms sigma;
+        for (const auto t : processing::kAllNoiseTerms) {
+          const auto it = terms->find(std::string(processing::noiseTermKey(t)));
+          sigma.set(t, it != terms->end() && it->is_number() ? it->get<double>() : kNaN);
+        }
+        curve.noise_uncertainty = sigma;
+      }
+      if (const json* axis = member(table, kAxisNames[a])) {
+        if (const auto it = axis->find(std::string(kStreamNames[s])); it != axis->end()) {
+          try {
+            curve.points = allanTableFromJson(*it);
+          } catch (const std::invalid_argument& e) {
+            malformed("ALLAN", "table " + name + ": " + e.what());
+          }
+        }
       }
     }
   }
@@ -150,11 +172,33 @@ ClientStatus clientOf(const json& c) {
 }
 
 // The STATUS fields this version reads; any other is kept as an OtherField.
-constexpr std::string_view kStatusFields[] = {
-    "class",         "uptime",        "samples",         "gaps",     "missing", "bus_errors",    "resets",
-    "device_state",  "device_reason", "device_retrying", "device",   "rate",    "nominal_rate",  "temp",
-    "bias_source",   "rate_model",    "recording",       "counters", "clients", "clients_total", "clients_dropped",
-    "lines_dropped", "client_buffer", "client_list",     "recorder"};
+constexpr std::string_view kStatusFields[] = {"class",
+                                              "uptime",
+                                              "samples",
+                                              "gaps",
+                                              "missing",
+                                              "bus_errors",
+                                              "resets",
+                                              "device_state",
+                                              "device_reason",
+                                              "device_retrying",
+                                              "device",
+                                              "rate",
+                                              "nominal_rate",
+                                              "temp",
+                                              "bias_source",
+                                              "rate_model",
+                                              "recording",
+                                              "counters",
+                                              "clients",
+                                              "clients_total",
+                                              "clients_dropped",
+                                              "lines_dropped",
+                                              "client_buffer",
+                                              "client_list",
+                                              "recorder",
+                                              "still_check",
+                                              "still_check_detail"};
 
 StatusReply statusOf(const json& j) {
   constexpr std::string_view cls = "STATUS";
@@ -174,6 +218,8 @@ StatusReply statusOf(const json& j) {
   d.nominal_rate_hz = optionalReal(j, cls, "nominal_rate");
   d.temp_c = optionalReal(j, cls, "temp");
   d.bias_source = optionalText(j, cls, "bias_source");
+  d.still_check = optionalText(j, cls, "still_check");
+  d.still_check_detail = optionalText(j, cls, "still_check_detail");
   d.rate_model = optionalText(j, cls, "rate_model");
   d.recording = optionalText(j, cls, "recording");
   if (const json* recorder = field(j, cls, "recorder", &json::is_object, "an object")) {

@@ -1,5 +1,7 @@
 #include "protocol/protocol.hpp"
 
+#include "protocol/allan_table.hpp"
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -144,6 +146,16 @@ std::string_view errorCodeName(ErrorCode code) {
   return "internal";
 }
 
+std::string_view stillCheckName(StillCheck check) {
+  switch (check) {
+    case StillCheck::Pending: return "pending";
+    case StillCheck::Still: return "still";
+    case StillCheck::MovedRetrying: return "moved_retrying";
+    case StillCheck::MovedKept: return "moved_kept";
+  }
+  return "unknown";
+}
+
 std::string errorLine(ErrorCode code, std::string_view message) {
   // The message may quote client bytes that are not UTF-8: replace them, never throw.
   return json({{"class", "ERROR"}, {"code", errorCodeName(code)}, {"message", message}})
@@ -171,15 +183,21 @@ std::string allanLine(const AllanReport& r) {
   }
   json j = {{"class", "ALLAN"}, {"samples", r.samples}};
   if (std::isfinite(r.window_s)) j["window"] = r.window_s;
+  if (std::isfinite(r.span_s)) j["span"] = r.span_s;
   if (std::isfinite(r.tau0_s) && r.tau0_s > 0.0) j["tau0"] = r.tau0_s;
+  if (std::isfinite(r.confidence)) j["confidence"] = r.confidence;
   json taus = json::array();
   for (const std::size_t i : keep) taus.push_back(r.tau_s[i]);
   j["tau"] = std::move(taus);
   json adev = json::object();
   json noise = json::object();
+  json uncertainty = json::object();
+  json table = json::object();
   for (std::size_t a = 0; a < 3; ++a) {
     json axis_adev = json::object();
     json axis_noise = json::object();
+    json axis_uncertainty = json::object();
+    json axis_table = json::object();
     for (std::size_t s = 0; s < 3; ++s) {
       const AllanCurve& c = r.curves[a][s];
       const std::string stream(kStreamNames[s]);
@@ -196,12 +214,27 @@ std::string allanLine(const AllanReport& r) {
         }
         if (!terms.empty()) axis_noise[stream] = std::move(terms);
       }
+      if (c.noise && c.noise_uncertainty) {
+        json terms = json::object();
+        for (const auto t : processing::kAllNoiseTerms) {
+          const double v = c.noise_uncertainty->get(t);
+          // An uncertainty only beside a value: a term left out has nothing to be uncertain about.
+          if (std::isfinite(v) && std::isfinite(c.noise->get(t))) terms[std::string(processing::noiseTermKey(t))] = v;
+        }
+        if (!terms.empty()) axis_uncertainty[stream] = std::move(terms);
+      }
+      if (!c.points.empty()) axis_table[stream] = allanTableJson(c.points);
     }
-    if (!axis_adev.empty()) adev[std::string(kAxisNames[a])] = std::move(axis_adev);
-    if (!axis_noise.empty()) noise[std::string(kAxisNames[a])] = std::move(axis_noise);
+    const std::string axis(kAxisNames[a]);
+    if (!axis_adev.empty()) adev[axis] = std::move(axis_adev);
+    if (!axis_noise.empty()) noise[axis] = std::move(axis_noise);
+    if (!axis_uncertainty.empty()) uncertainty[axis] = std::move(axis_uncertainty);
+    if (!axis_table.empty()) table[axis] = std::move(axis_table);
   }
   j["adev"] = std::move(adev);
   if (!noise.empty()) j["noise"] = std::move(noise);
+  if (!uncertainty.empty()) j["noise_uncertainty"] = std::move(uncertainty);
+  if (!table.empty()) j["table"] = std::move(table);
   return jsonLine(j);
 }
 
@@ -217,6 +250,8 @@ std::string statusLine(const StatusReport& d, const ServerStatus& s) {
   putIfFinite(j, "nominal_rate", d.nominal_rate_hz);
   putIfFinite(j, "temp", d.temp_c);
   if (d.bias_source) j["bias_source"] = *d.bias_source;
+  if (d.still_check) j["still_check"] = *d.still_check;
+  if (d.still_check_detail) j["still_check_detail"] = *d.still_check_detail;
   if (d.rate_model) j["rate_model"] = *d.rate_model;
   if (d.recording) j["recording"] = *d.recording;
   if (d.recorder) {

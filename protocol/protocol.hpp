@@ -17,12 +17,13 @@
 #include <variant>
 #include <vector>
 
+#include "processing/allan.hpp"
 #include "processing/noise_terms.hpp"
 
 namespace gyrod::protocol {
 
 inline constexpr int kProtocolMajor = 1;  // incompatible changes
-inline constexpr int kProtocolMinor = 2;  // compatible additions (new classes, new fields)
+inline constexpr int kProtocolMinor = 3;  // compatible additions (new classes, new fields)
 
 // A client line longer than this (not counting the '\n' and an optional '\r') is refused
 // with an ERROR and the client is disconnected.
@@ -99,13 +100,19 @@ std::string errorLine(ErrorCode code, std::string_view message);
 struct AllanCurve {
   std::vector<double> adev_dps;                 // overlapping Allan deviation at each τ [°/s]; empty: not computed
   std::optional<processing::NoiseTerms> noise;  // fitted IEEE 952 terms (NaN term: not estimated)
+  std::optional<processing::NoiseTerms> noise_uncertainty;  // their 1 σ (NaN: not known); with noise
+  // The curve as a table (protocol/allan_table.hpp): per τ the deviation, its terms, and,
+  // once the noise type is identified, edf and the confidence interval. Empty: not sent.
+  std::vector<processing::AllanPoint> points;
 };
 struct AllanReport {
-  double window_s = 0.0;                            // time spanned by the samples in the window [s]
-  std::uint64_t samples = 0;                        // samples in the window
-  double tau0_s = 0.0;                              // sample period [s]
-  std::vector<double> tau_s;                        // averaging times [s]
-  std::array<std::array<AllanCurve, 3>, 3> curves;  // [axis x,y,z][stream raw,mean,kalman]
+  double window_s = 0.0;                                         // the configured window (allan.window_s) [s]
+  double span_s = std::numeric_limits<double>::quiet_NaN();      // time the samples cover: samples·τ0 [s]
+  std::uint64_t samples = 0;                                     // samples in the window now
+  double tau0_s = 0.0;                                           // sample period [s]
+  double confidence = std::numeric_limits<double>::quiet_NaN();  // two-sided level of the intervals
+  std::vector<double> tau_s;                                     // averaging times [s]
+  std::array<std::array<AllanCurve, 3>, 3> curves;               // [axis x,y,z][stream raw,mean,kalman]
 };
 // Throws std::invalid_argument when a computed curve's length differs from tau_s's. A τ at
 // which some computed curve is not finite is left out of every list (no nulls).
@@ -131,25 +138,36 @@ struct RecorderStatus {
   bool operator==(const RecorderStatus&) const = default;
 };
 
+// The verdict on the start-up still period (STATUS "still_check", docs/protocol.md).
+enum class StillCheck {
+  Pending,        // the still period is being collected
+  Still,          // it passed: the bias and filter come from a window at rest
+  MovedRetrying,  // the board moved: the window was discarded and the still period restarted
+  MovedKept,      // it moved at every attempt: the last window was used, its bias is suspect
+};
+std::string_view stillCheckName(StillCheck check);  // "unknown" for a value not listed
+
 struct StatusReport {
-  double uptime_s = 0.0;                    // since the daemon started [s]
-  std::uint64_t samples = 0;                // samples published since start
-  std::uint64_t gaps = 0;                   // GAP events since start
-  std::uint64_t missing_samples = 0;        // samples lost in those gaps
-  std::uint64_t bus_errors = 0;             // failed bus transfers
-  std::uint64_t resets = 0;                 // device resets (FIFO overflow, silent reset, errors)
-  std::string device_state;                 // e.g. "streaming" (docs/protocol.md lists them)
-  std::string device_reason;                // why the device is in that state; empty (omitted) while all is well
-  std::optional<bool> device_retrying;      // whether the driver keeps trying to reach the device
-  std::vector<NamedCount> device_counters;  // every counter of the driver, in its order ("counters")
-  std::optional<std::string> device;        // e.g. "/dev/i2c-1@0x68"
-  std::optional<double> rate_hz;            // measured sample rate [Hz]
-  std::optional<double> nominal_rate_hz;    // configured sample rate [Hz]
-  std::optional<double> temp_c;             // latest die temperature [°C]
-  std::optional<std::string> bias_source;   // where the bias subtracted from raw comes from
-  std::optional<std::string> rate_model;    // what the rate stream subtracts: "model FILE" or "bias"
-  std::optional<std::string> recording;     // file being recorded to
-  std::optional<RecorderStatus> recorder;   // the recorder's counts, while recording
+  double uptime_s = 0.0;                          // since the daemon started [s]
+  std::uint64_t samples = 0;                      // samples published since start
+  std::uint64_t gaps = 0;                         // GAP events since start
+  std::uint64_t missing_samples = 0;              // samples lost in those gaps
+  std::uint64_t bus_errors = 0;                   // failed bus transfers
+  std::uint64_t resets = 0;                       // device resets (FIFO overflow, silent reset, errors)
+  std::string device_state;                       // e.g. "streaming" (docs/protocol.md lists them)
+  std::string device_reason;                      // why the device is in that state; empty (omitted) while all is well
+  std::optional<bool> device_retrying;            // whether the driver keeps trying to reach the device
+  std::vector<NamedCount> device_counters;        // every counter of the driver, in its order ("counters")
+  std::optional<std::string> device;              // e.g. "/dev/i2c-1@0x68"
+  std::optional<double> rate_hz;                  // measured sample rate [Hz]
+  std::optional<double> nominal_rate_hz;          // configured sample rate [Hz]
+  std::optional<double> temp_c;                   // latest die temperature [°C]
+  std::optional<std::string> bias_source;         // where the bias subtracted from raw comes from
+  std::optional<std::string> still_check;         // stillCheckName(); none: no still period at start
+  std::optional<std::string> still_check_detail;  // what the check found, for a person
+  std::optional<std::string> rate_model;          // what the rate stream subtracts: "model FILE" or "bias"
+  std::optional<std::string> recording;           // file being recorded to
+  std::optional<RecorderStatus> recorder;         // the recorder's counts, while recording
 };
 
 // What the server knows about its clients; added to every STATUS line.

@@ -209,7 +209,7 @@ TEST_F(GyroctlTest, StatusHumanAndJson) {
 
   const CommandResult h = run({"status", "--socket", socketPath()});
   ASSERT_EQ(h.exit_status, 0) << h.err;
-  EXPECT_NE(h.out.find(std::string("gyrod ") + GYROD_RELEASE + " (protocol 1.2)"), std::string::npos) << h.out;
+  EXPECT_NE(h.out.find(std::string("gyrod ") + GYROD_RELEASE + " (protocol 1.3)"), std::string::npos) << h.out;
   EXPECT_NE(h.out.find("device_state:    streaming\n"), std::string::npos) << h.out;
   EXPECT_NE(h.out.find("device:          /dev/i2c-1@0x68\n"), std::string::npos) << h.out;
   EXPECT_NE(h.out.find("samples:         1234\n"), std::string::npos) << h.out;
@@ -263,6 +263,28 @@ protocol::AllanReport exampleAllan() {
   t.rrw_deg_per_h_sqrt_h = std::numeric_limits<double>::quiet_NaN();
   t.rate_ramp_deg_per_h2 = std::numeric_limits<double>::quiet_NaN();
   a.curves[0][0].noise = t;
+  processing::NoiseTerms sigma = t;
+  sigma.arw_deg_per_sqrt_h = 0.03;
+  a.curves[0][0].noise_uncertainty = sigma;
+  a.span_s = 600.0;
+  a.confidence = 0.683;
+  // The x raw curve as a table: an interval at the first two τ, none yet at the third.
+  for (std::size_t i = 0; i < a.tau_s.size(); ++i) {
+    processing::AllanPoint p;
+    p.tau_s = a.tau_s[i];
+    p.m = static_cast<std::size_t>(std::llround(a.tau_s[i] / a.tau0_s));
+    p.oadev = a.curves[0][0].adev_dps[i];
+    p.oadev_terms = 30000 - 2 * p.m + 1;
+    p.adev = std::numeric_limits<double>::quiet_NaN();
+    p.edf = p.oadev_lo = p.oadev_hi = std::numeric_limits<double>::quiet_NaN();
+    if (i < 2) {
+      p.noise_alpha = 0;
+      p.edf = 1000.0 / static_cast<double>(i + 1);
+      p.oadev_lo = 0.9 * p.oadev;
+      p.oadev_hi = 1.1 * p.oadev;
+    }
+    a.curves[0][0].points.push_back(p);
+  }
   return a;
 }
 
@@ -275,7 +297,9 @@ TEST_F(GyroctlTest, AllanTableJsonAndPlot) {
   ASSERT_EQ(h.exit_status, 0) << h.err;
   const auto lines = splitLines(h.out);
   ASSERT_GE(lines.size(), 5u) << h.out;
-  EXPECT_NE(lines[0].find("window 600 s (30000 samples, tau0 0.02 s)"), std::string::npos) << lines[0];
+  // How much data: the samples and the span they cover, then the configured window.
+  EXPECT_NE(lines[0].find("of 30000 samples covering 600 s (window up to 600 s, tau0 0.02 s)"), std::string::npos)
+      << lines[0];
   const auto head = words(lines[1]);
   const std::vector<std::string> expected_head = {"tau", "[s]", "x",      "raw", "x",   "kalman", "y",
                                                   "raw", "y",   "kalman", "z",   "raw", "z",      "kalman"};
@@ -287,7 +311,17 @@ TEST_F(GyroctlTest, AllanTableJsonAndPlot) {
     std::snprintf(buf, sizeof buf, "%.4e", content_.allan.curves[1][2].adev_dps[i]);
     EXPECT_EQ(w[4], buf);  // y kalman
   }
-  EXPECT_NE(h.out.find("x raw: angle random walk N [deg/sqrt(h)] = 0.42"), std::string::npos) << h.out;
+  // No noise term without its uncertainty or a "not enough data" mark.
+  EXPECT_NE(h.out.find("angle random walk N [deg/sqrt(h)]    = 0.42 +- 0.03\n"), std::string::npos) << h.out;
+  EXPECT_NE(h.out.find("bias instability B [deg/h]           not enough data\n"), std::string::npos) << h.out;
+  // The intervals of the x raw table, and the τ without one yet.
+  EXPECT_NE(h.out.find("68.3 % chi2 confidence intervals"), std::string::npos) << h.out;
+  char row[160];
+  const auto& p0 = content_.allan.curves[0][0].points[0];
+  std::snprintf(row, sizeof row, "  %11.6g %11.4e %11.4e %11.4e %10zu", p0.tau_s, p0.oadev, p0.oadev_lo, p0.oadev_hi,
+                p0.oadev_terms);
+  EXPECT_NE(h.out.find(row), std::string::npos) << row << "\n" << h.out;
+  EXPECT_NE(h.out.find("not enough data"), std::string::npos) << h.out;
 
   const CommandResult j = run({"allan", "--socket", socketPath(), "--json"});
   ASSERT_EQ(j.exit_status, 0) << j.err;
@@ -300,6 +334,18 @@ TEST_F(GyroctlTest, AllanTableJsonAndPlot) {
   const std::string image = readWholeFile(png);
   ASSERT_GT(image.size(), 1000u);
   EXPECT_EQ(image.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  // The error bars and the fitted term lines are drawn: a plot with them differs from one without.
+  protocol::AllanReport bare = content_.allan;
+  for (auto& axis : bare.curves)
+    for (auto& curve : axis) {
+      curve.points.clear();
+      curve.noise.reset();
+      curve.noise_uncertainty.reset();
+    }
+  content_.allan = bare;
+  const auto bare_png = dir_.path() / "bare.png";
+  ASSERT_EQ(run({"allan", "--socket", socketPath(), "--plot", bare_png.string()}).exit_status, 0);
+  EXPECT_NE(readWholeFile(bare_png), image);
 }
 
 TEST_F(GyroctlTest, PlotWithoutGnuplotSaysSoAfterTheTable) {
@@ -313,7 +359,7 @@ TEST_F(GyroctlTest, PlotWithoutGnuplotSaysSoAfterTheTable) {
   EXPECT_NE(r.out.find("tau [s]"), std::string::npos) << r.out;
   EXPECT_FALSE(std::filesystem::exists(png));
   const CommandResult bad = run({"allan", "--socket", socketPath(), "--plot", (dir_.path() / "adev.gif").string()});
-  EXPECT_EQ(bad.exit_status, 2);
+  EXPECT_EQ(bad.exit_status, 64);  // EX_USAGE: a bad option value
   EXPECT_NE(bad.err.find("must end in .png, .svg or .pdf"), std::string::npos) << bad.err;
 }
 
@@ -321,7 +367,7 @@ TEST_F(GyroctlTest, ConnectionProblemsAreExplained) {
   const std::string missing = (dir_.path() / "none.sock").string();
   for (const char* cmd : {"watch", "allan", "status"}) {
     const CommandResult r = run({cmd, "--socket", missing});
-    EXPECT_EQ(r.exit_status, 1) << cmd;
+    EXPECT_EQ(r.exit_status, 69) << cmd;  // EX_UNAVAILABLE
     EXPECT_EQ(r.err, "gyroctl: " + missing + ": no such socket (is gyrod running?)\n") << cmd;
     EXPECT_TRUE(r.out.empty());
   }
@@ -334,7 +380,7 @@ TEST_F(GyroctlTest, ConnectionProblemsAreExplained) {
     daemon::bindListeningSocket(so);
   }
   const CommandResult refused = run({"status", "--socket", stale});
-  EXPECT_EQ(refused.exit_status, 1);
+  EXPECT_EQ(refused.exit_status, 69);
   EXPECT_NE(refused.err.find("connection refused"), std::string::npos) << refused.err;
 
   // A socket the user may not open (root may open anything, so run as nobody then).
@@ -349,7 +395,7 @@ TEST_F(GyroctlTest, ConnectionProblemsAreExplained) {
     as_user = nobody->pw_uid;
   }
   const CommandResult r = run({"status", "--socket", socketPath()}, {}, as_user);
-  EXPECT_EQ(r.exit_status, 1) << r.err;
+  EXPECT_EQ(r.exit_status, 69) << r.err;
   EXPECT_NE(r.err.find(socketPath() + ": permission denied (the socket is for members of group '"), std::string::npos)
       << r.err;
 }

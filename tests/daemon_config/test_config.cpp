@@ -543,3 +543,32 @@ TEST(ConfigErrors, ReferencedFilesAndGroupAreCheckedWhenLoadingAFile) {
   EXPECT_NO_THROW(parseConfig(readText(model), "x.toml"));
   EXPECT_NO_THROW(parseConfig(readText(group), "x.toml"));
 }
+
+// bias.still_seconds out of range, or too short for what the still period must do at the
+// configured rate, is a configuration error naming the file, the line and the key (exit 78)
+// rather than a failure after start.
+TEST(ConfigErrors, StillSecondsOutOfRangeOrTooShortNamesFileLineAndKey) {
+  EXPECT_EQ(errorOf("[bias]\nstill_seconds = 0\n"),
+            "x.toml:2: key 'bias.still_seconds': must be > 0 and ≤ 3600 s (got 0)");
+  EXPECT_EQ(errorOf("[bias]\nstill_seconds = 4000\n"),
+            "x.toml:2: key 'bias.still_seconds': must be > 0 and ≤ 3600 s (got 4000)");
+  EXPECT_EQ(errorOf("[bias]\nstill_seconds = 1\n"),
+            "x.toml:2: key 'bias.still_seconds': must give at least 100 samples at device.rate_hz = 50 Hz (2 s) to "
+            "identify the Kalman filter, unless filter.kalman gives a, q and r (got 1)");
+  // With a, q and r given the still period only averages the bias: one sample is enough.
+  EXPECT_EQ(errorOf("[bias]\nstill_seconds = 1\n[filter.kalman]\na = 0.5\nq = 0.01\nr = 0.02\n"), "");
+  EXPECT_EQ(errorOf("[bias]\nstill_seconds = 0.001\n[filter.kalman]\na = 0.5\nq = 0.01\nr = 0.02\n"),
+            "x.toml:2: key 'bias.still_seconds': must give at least 1 sample at device.rate_hz = 50 Hz (0.02 s) "
+            "(got 0.001)");
+  // Nothing to estimate or identify: no still period, no requirement.
+  EXPECT_EQ(errorOf("[bias]\nsource = \"config\"\nstill_seconds = 0.001\n[filter.kalman]\na = 0.5\nq = 0.01\n"
+                    "r = 0.02\n"),
+            "");
+  EXPECT_EQ(exitCodeForConfigError(), 78);
+}
+
+TEST(ConfigValues, TheDefaultStillPeriodGrowsToTheSamplesItNeedsBelowTenHertz) {
+  EXPECT_EQ(parseConfig("[device]\nrate_hz = 50\n", "x.toml").bias.still_seconds, 10.0);
+  // 1000 / 256 Hz: 100 samples take 25.6 s.
+  EXPECT_EQ(parseConfig("[device]\nrate_hz = 3.90625\n", "x.toml").bias.still_seconds, 26.0);
+}

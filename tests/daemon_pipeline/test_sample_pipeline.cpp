@@ -327,3 +327,100 @@ TEST(SamplePipeline, AStillPeriodWithoutVarianceIsRefusedOnceAndStartsAgain) {
     EXPECT_EQ(pipeline.filterParameters()[axis].kalman.q, expected.kalman.q);
   }
 }
+
+// The start-up still window is checked for motion (processing/still_period_check.hpp): a
+// window in which the board turned is discarded and collected again; the bias comes from the
+// first window at rest, and STATUS's state says what happened.
+TEST(SamplePipeline, AStillWindowInWhichTheBoardTurnedIsCollectedAgain) {
+  const Vec3 bias{0.75, -1.0, 2.0};
+  const Stream s = noisyStream(1000, 5, bias);
+  PipelineSettings p = baseSettings();
+  p.bias_origin = BiasOrigin::Estimate;
+  p.still_seconds = 10.0;  // 500 samples
+  p.kalman = {0.5, 0.01, 0.02};
+  SamplePipeline pipeline(p);
+  EXPECT_EQ(pipeline.stillPeriod().state, StillPeriodState::Collecting);
+  for (std::size_t i = 0; i < 1000; ++i) {
+    Vec3 raw{s.x[0][i], s.x[1][i], s.x[2][i]};
+    if (i >= 200 && i < 300) raw[2] += 5.0;  // a 10° turn about z in the first window
+    pipeline.process(i, i / 50.0, raw, 25.0);
+    if (i == 499) {
+      EXPECT_EQ(pipeline.stillPeriod().state, StillPeriodState::MovedRetrying);
+      EXPECT_EQ(pipeline.stillPeriod().verdict.axis, 2u);
+      EXPECT_EQ(pipeline.phase(), PipelinePhase::Estimating);
+    }
+  }
+  const StillPeriodReport& r = pipeline.stillPeriod();
+  EXPECT_EQ(r.state, StillPeriodState::Still);
+  EXPECT_EQ(r.attempts, 2u);
+  EXPECT_EQ(r.verdicts, 2u);
+  ASSERT_EQ(pipeline.phase(), PipelinePhase::Running);
+  for (std::size_t axis = 0; axis < kAxes; ++axis) {
+    double mean = 0.0;
+    for (std::size_t i = 500; i < 1000; ++i) mean += s.x[axis][i];
+    EXPECT_NEAR(pipeline.bias()[axis], mean / 500.0, 1e-12) << axis;  // the second window's, not the first's
+  }
+}
+
+TEST(SamplePipeline, ABoardThatNeverRestsKeepsTheLastWindowAndSaysItsBiasIsSuspect) {
+  const Stream s = noisyStream(kMaxStillAttempts * 500, 6, {0.0, 0.0, 0.0});
+  PipelineSettings p = baseSettings();
+  p.bias_origin = BiasOrigin::Estimate;
+  p.still_seconds = 10.0;
+  p.kalman = {0.5, 0.01, 0.02};
+  SamplePipeline pipeline(p);
+  for (std::size_t i = 0; i < kMaxStillAttempts * 500; ++i) {
+    const double sway = 2.0 * std::sin(2.0 * M_PI * 0.3 * static_cast<double>(i) / 50.0);
+    pipeline.process(i, i / 50.0, {s.x[0][i] + sway, s.x[1][i], s.x[2][i]}, 25.0);
+  }
+  EXPECT_EQ(pipeline.stillPeriod().state, StillPeriodState::MovedKept);
+  EXPECT_EQ(pipeline.stillPeriod().attempts, kMaxStillAttempts);
+  EXPECT_EQ(pipeline.stillPeriod().verdict.axis, 0u);
+  EXPECT_EQ(pipeline.phase(), PipelinePhase::Running);  // gyrod does not wait for ever
+}
+
+TEST(SamplePipeline, NoStillPeriodNoStillCheck) {
+  PipelineSettings p = baseSettings();
+  p.bias_origin = BiasOrigin::Config;
+  p.kalman = {0.5, 0.01, 0.02};
+  const SamplePipeline pipeline(p);
+  EXPECT_EQ(pipeline.stillPeriod().state, StillPeriodState::None);
+}
+
+// The ALLAN reply's intervals: none before the first refit has identified the noise types;
+// right after it, for every stream, the noise type, edf and χ² interval of the snapshot
+// (the lag-1 identification on the whole window, as offline analyze does).
+TEST(SamplePipeline, WindowIntervalsAfterARefitAreTheSnapshots) {
+  const Stream s = noisyStream(3000, 7, {0.1, 0.2, 0.3});
+  PipelineSettings p = baseSettings();
+  p.bias_origin = BiasOrigin::Config;
+  p.kalman = {0.5, 0.01, 0.02};
+  SamplePipeline pipeline(p);
+  for (std::size_t i = 0; i < 3000; ++i) pipeline.process(i, i / 50.0, {s.x[0][i], s.x[1][i], s.x[2][i]}, 25.0);
+  const AllanWindowDeviations before = pipeline.allanWindowDeviations();
+  EXPECT_EQ(before.samples, 2048u);  // the window's, not the 3000 processed
+  for (const auto& point : before.points[0][0]) EXPECT_TRUE(std::isnan(point.edf));
+
+  pipeline.refitNoiseTerms();
+  const AllanWindowDeviations after = pipeline.allanWindowDeviations();
+  const AllanStreams snap = pipeline.allanSnapshot();
+  for (std::size_t axis = 0; axis < kAxes; ++axis) {
+    const std::array<const std::vector<AllanPoint>*, kStreams> expected = {
+        &snap.raw[axis].window, &snap.mean[axis].window, &snap.kalman[axis].window};
+    for (std::size_t k = 0; k < kStreams; ++k) {
+      ASSERT_EQ(after.points[axis][k].size(), expected[k]->size());
+      for (std::size_t i = 0; i < expected[k]->size(); ++i) {
+        const AllanPoint& got = after.points[axis][k][i];
+        const AllanPoint& want = (*expected[k])[i];
+        EXPECT_EQ(got.m, want.m);
+        EXPECT_EQ(got.noise_alpha, want.noise_alpha) << axis << "/" << k << " m " << want.m;
+        EXPECT_NEAR(got.oadev, want.oadev, 1e-12 * want.oadev);
+        EXPECT_NEAR(got.edf, want.edf, 1e-12 * want.edf);
+        EXPECT_NEAR(got.oadev_lo, want.oadev_lo, 1e-12 * want.oadev_lo);
+        EXPECT_NEAR(got.oadev_hi, want.oadev_hi, 1e-12 * want.oadev_hi);
+        EXPECT_LT(got.oadev_lo, got.oadev);
+        EXPECT_GT(got.oadev_hi, got.oadev);
+      }
+    }
+  }
+}

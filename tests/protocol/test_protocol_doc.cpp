@@ -1,5 +1,5 @@
 // docs/protocol.md lists names the code defines: the STATUS fields, the device states, the
-// gap reasons and the driver counters. Each list is read from the page and compared with
+// gap reasons, the driver counters, the still checks, and the ALLAN and Allan-table fields. Each list is read from the page and compared with
 // what the code sends, so neither can change without the other.
 #include <gtest/gtest.h>
 
@@ -12,6 +12,7 @@
 
 #include "driver/counter_names.hpp"
 #include "driver/mpu6050_types.hpp"
+#include "protocol/allan_table.hpp"
 #include "protocol/protocol.hpp"
 
 using namespace gyrod;
@@ -54,6 +55,22 @@ std::set<std::string> firstColumnNames(const std::string& text) {
   return names;
 }
 
+// Every `code` name in the first cell of each table row of `text` ("| `a`, `b` | ..." gives both).
+std::set<std::string> firstCellNames(const std::string& text) {
+  std::set<std::string> names;
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("| `", 0) != 0) continue;
+    const std::string cell = line.substr(1, line.find('|', 1) - 1);
+    for (std::size_t open = cell.find('`'); open != std::string::npos; open = cell.find('`', open)) {
+      const std::size_t close = cell.find('`', open + 1);
+      names.insert(cell.substr(open + 1, close - open - 1));
+      open = close + 1;
+    }
+  }
+  return names;
+}
+
 // The names of enum values 0..255 that `name_of` knows (it says "unknown" for the others).
 template <class Enum, class NameOf>
 std::set<std::string> enumNames(NameOf name_of) {
@@ -77,6 +94,8 @@ nlohmann::json fullStatus() {
   d.rate_hz = d.nominal_rate_hz = 50.0;
   d.temp_c = 30.0;
   d.bias_source = "config";
+  d.still_check = "still";
+  d.still_check_detail = "window 1 of at most 3: ...";
   d.rate_model = "bias";
   d.recording = "file.csv";
   d.recorder = protocol::RecorderStatus{1, 2, 3, 4, "write to file.csv: No space left on device"};
@@ -101,6 +120,7 @@ TEST(ProtocolDoc, StatusFieldsAreTheOnesSent) {
   std::erase_if(documented, [](const std::string& n) { return n.starts_with("counters."); });  // below
   // The state names of the device-state table sit in the same section.
   for (const auto& state : firstColumnNames(section(readDoc(), "#### Device states"))) documented.erase(state);
+  for (const auto& check : firstColumnNames(section(readDoc(), "#### Still checks"))) documented.erase(check);
   EXPECT_EQ(documented, sent);
 }
 
@@ -138,4 +158,66 @@ TEST(ProtocolDoc, RateFieldsAreTheOnesSent) {
   const nlohmann::json line = nlohmann::json::parse(std::string(buf.data(), n - 1));
   for (const auto& [key, value] : line.items()) sent.insert(key);
   EXPECT_EQ(firstColumnNames(section(readDoc(), "### RATE")), sent);
+}
+
+TEST(ProtocolDoc, StillChecksAreTheOnesTheCodeNames) {
+  const auto documented = firstColumnNames(section(readDoc(), "#### Still checks"));
+  EXPECT_EQ(documented,
+            enumNames<protocol::StillCheck>([](auto c) { return std::string(protocol::stillCheckName(c)); }));
+  EXPECT_EQ(documented.size(), 4u);
+}
+
+namespace {
+
+// An ALLAN line with every field present: a table point with an interval and the
+// non-overlapping estimator (analyze's), and every noise term with its uncertainty.
+protocol::AllanReport fullAllan() {
+  protocol::AllanReport r;
+  r.window_s = 600.0;
+  r.span_s = 100.0;
+  r.samples = 5000;
+  r.tau0_s = 0.02;
+  r.confidence = 0.683;
+  r.tau_s = {0.02};
+  processing::AllanPoint p{0.02, 1, 0.1, 4998, 0.1, 4998, 0, 3000.0, 0.099, 0.101};
+  processing::NoiseTerms terms{1.0, 2.0, 3.0, 4.0, 5.0};
+  for (auto& axis : r.curves)
+    for (auto& curve : axis) {
+      curve.adev_dps = {0.1};
+      curve.points = {p};
+      curve.noise = terms;
+      curve.noise_uncertainty = terms;
+    }
+  return r;
+}
+
+}  // namespace
+
+TEST(ProtocolDoc, AllanFieldsAreTheOnesSent) {
+  const auto line = nlohmann::json::parse(protocol::allanLine(fullAllan()));
+  std::set<std::string> sent;
+  for (const auto& [key, value] : line.items()) sent.insert(key);
+  const std::string doc = readDoc();
+  // The reply's own fields: the tables of the section before its "Allan tables" subsection,
+  // less the noise-term table (checked below).
+  std::string reply = section(doc, "### ALLAN");
+  reply = reply.substr(0, reply.find("\n#### "));
+  std::set<std::string> documented = firstCellNames(reply);
+  const auto table_fields = firstCellNames(section(doc, "#### Allan tables"));
+  std::set<std::string> term_keys;
+  for (const auto t : processing::kAllNoiseTerms) term_keys.insert(std::string(processing::noiseTermKey(t)));
+  for (const auto& n : term_keys) documented.erase(n);
+  EXPECT_EQ(documented, sent);
+
+  // The noise-term table lists exactly the keys sent under noise and noise_uncertainty.
+  std::set<std::string> noise_keys, uncertainty_keys;
+  for (const auto& [key, v] : line["noise"]["x"]["raw"].items()) noise_keys.insert(key);
+  for (const auto& [key, v] : line["noise_uncertainty"]["x"]["raw"].items()) uncertainty_keys.insert(key);
+  EXPECT_EQ(noise_keys, term_keys);
+  EXPECT_EQ(uncertainty_keys, term_keys);
+
+  // The Allan-table fields are those of a full point, live (the reply) and offline alike.
+  std::set<std::string> point_keys;
+  for (const auto& [key, v] : line["table"]["z"]["kalman"][0].items()) point_keys.insert(key);
+  EXPECT_EQ(table_fields, point_keys);
 }

@@ -294,7 +294,7 @@ TEST(Calibration, FilterWithoutATempColumnTakesTheReferenceAndSaysSo) {
   // Without gz, the still detector cannot run: an error naming the column.
   const auto two = d.write("two.csv", "t,gx,gy\n0,1,2\n0.02,1,2\n0.04,1,2\n");
   const auto e = runGyroctl("filter " + two.string() + " -o " + out.string() + " --model " + model.string(), d.path());
-  EXPECT_EQ(e.exit_status, 2) << e.err;
+  EXPECT_EQ(e.exit_status, 65) << e.err;  // EX_DATAERR
   EXPECT_NE(e.err.find("'gz' is missing"), std::string::npos) << e.err;
 }
 

@@ -276,8 +276,8 @@ TEST(GyroctlFilter, BiasSubtractsConstantsInsteadOfDetrending) {
   const auto cols = parseCsv(readWholeFile(out), header);
   EXPECT_EQ(cols[1], (std::vector<double>{0.25, 0.5, 0.75}));
   EXPECT_EQ(cols[4], (std::vector<double>{0, 0, 0.5}));
-  EXPECT_EQ(runGyroctl("filter " + in.string() + " -o " + out.string() + " --bias 1", d.path()).exit_status, 2);
+  EXPECT_EQ(runGyroctl("filter " + in.string() + " -o " + out.string() + " --bias 1", d.path()).exit_status, 64);
   EXPECT_EQ(
       runGyroctl("filter " + in.string() + " -o " + out.string() + " --bias 1,2 --no-detrend", d.path()).exit_status,
-      2);
+      64);
 }

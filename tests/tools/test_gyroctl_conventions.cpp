@@ -57,7 +57,7 @@ TEST(GyroctlConventions, AnUnknownCommandIsNamedWithTheNearestOne) {
                                                                                      {"simulat", "simulate"},
                                                                                      {"Filter", "filter"}}) {
     const auto r = runGyroctl(typed + " x.csv", d.path());
-    EXPECT_EQ(r.exit_status, 2) << typed;
+    EXPECT_EQ(r.exit_status, 64) << typed;  // EX_USAGE
     EXPECT_NE(r.err.find("gyroctl: unknown command '" + typed + "'; did you mean '" + meant + "'?"), std::string::npos)
         << r.err;
     expectOneLine(r.err);
@@ -68,7 +68,7 @@ TEST(GyroctlConventions, AnUnknownCommandIsNamedWithTheNearestOne) {
 TEST(GyroctlConventions, AWordFarFromEveryCommandGetsNoSuggestionButTheList) {
   ScratchDir d;
   const auto r = runGyroctl("--json frobnicate", d.path());
-  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_EQ(r.exit_status, 64);
   EXPECT_EQ(r.err,
             "gyroctl: unknown command 'frobnicate' (commands: analyze, filter, import, simulate, watch, allan, "
             "status, model-check)\n");
@@ -78,10 +78,10 @@ TEST(GyroctlConventions, AKnownCommandStillParsesItsOwnOptions) {
   ScratchDir d;
   // "watch" is found although an option comes first in the subcommand's arguments.
   const auto r = runGyroctl("watch --decimate 0", d.path());
-  EXPECT_EQ(r.exit_status, 2) << r.err;
+  EXPECT_EQ(r.exit_status, 64) << r.err;
   EXPECT_EQ(r.err.find("unknown command"), std::string::npos) << r.err;
   const auto missing = runGyroctl("", d.path());
-  EXPECT_EQ(missing.exit_status, 2);
+  EXPECT_EQ(missing.exit_status, 64);
   EXPECT_NE(missing.err.find("subcommand"), std::string::npos) << missing.err;
 }
 
@@ -96,4 +96,35 @@ TEST(GyroctlConventions, HelpShowsTheProgramNameNotItsPath) {
   const auto sub = runGyroctl("analyze --help", d.path());
   EXPECT_NE(sub.out.find("gyroctl analyze"), std::string::npos) << sub.out;
   EXPECT_NE(runGyroctl("--help", d.path()).out.find("--version"), std::string::npos);
+}
+
+// One exit-code scheme (sysexits, as gyrod's), README "Exit statuses" and gyroctl(1): each
+// kind of failure has its own status, so a script can tell them apart.
+TEST(GyroctlConventions, ExitStatusesFollowSysexits) {
+  ScratchDir d;
+  std::string rows = "t,gx\n";
+  for (int i = 0; i < 200; ++i) rows += std::to_string(i * 0.02) + "," + std::to_string((i * 7919) % 13 * 0.01) + "\n";
+  const auto good = d.write("good.csv", rows);
+  const auto bad = d.write("bad.csv", "t,gx\n0,1\n0.02,oops\n");
+  const auto gappy = d.write("gappy.csv", rows + "10,0.1\n10.02,0.2\n");
+  struct Case {
+    std::string args;
+    int status;
+  };
+  const std::vector<Case> cases = {
+      {"analyze " + good.string() + " --taus 0", 64},                // EX_USAGE: bad option value
+      {"analyze " + good.string() + " --no-such-option", 64},        // EX_USAGE
+      {"analyze " + bad.string(), 65},                               // EX_DATAERR: malformed input
+      {"analyze " + gappy.string() + " --strict-timing", 65},        // EX_DATAERR: --strict-timing
+      {"analyze " + (d.path() / "none.csv").string(), 66},           // EX_NOINPUT
+      {"analyze " + d.path().string(), 66},                          // EX_NOINPUT: a directory
+      {"filter " + good.string() + " -o " + d.path().string(), 73},  // EX_CANTCREAT: a directory
+      {"status --socket " + (d.path() / "none.sock").string(), 69},  // EX_UNAVAILABLE
+  };
+  for (const Case& c : cases) {
+    const auto r = runGyroctl(c.args, d.path());
+    EXPECT_EQ(r.exit_status, c.status) << c.args << "\n" << r.err;
+    // One line, but for CLI11's own "Run with --help" under an option it does not know.
+    if (c.args.find("--no-such-option") == std::string::npos) expectOneLine(r.err);
+  }
 }

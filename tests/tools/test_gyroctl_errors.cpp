@@ -29,8 +29,10 @@ std::string whiteNoiseCsv(std::size_t n, double rate_hz, unsigned seed) {
   return s;
 }
 
-void expectOneLineError(const gyrod::test::CommandResult& r, const std::string& must_contain) {
-  EXPECT_EQ(r.exit_status, 2) << r.err;
+// Bad input is EX_DATAERR (65) unless said otherwise: 66 for a file that cannot be opened, 64
+// for a bad option value (README "Exit statuses").
+void expectOneLineError(const gyrod::test::CommandResult& r, const std::string& must_contain, int status = 65) {
+  EXPECT_EQ(r.exit_status, status) << r.err;
   EXPECT_NE(r.err.find(must_contain), std::string::npos) << "stderr was: " << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "stderr was: " << r.err;
   EXPECT_TRUE(r.out.empty()) << r.out;
@@ -41,7 +43,8 @@ void expectOneLineError(const gyrod::test::CommandResult& r, const std::string& 
 TEST(GyroctlErrors, MissingFile) {
   ScratchDir d;
   const auto missing = (d.path() / "nope.csv").string();
-  expectOneLineError(runGyroctl("analyze " + missing, d.path()), missing + ": cannot open: No such file or directory");
+  expectOneLineError(runGyroctl("analyze " + missing, d.path()), missing + ": cannot open: No such file or directory",
+                     66);
 }
 
 TEST(GyroctlErrors, EmptyFile) {
@@ -144,22 +147,22 @@ TEST(GyroctlErrors, TauThatIsNotAWholeNumberOfSamples) {
   ScratchDir d;
   const auto f = d.write("w.csv", whiteNoiseCsv(2000, 50.0, 4));
   const auto r = runGyroctl("analyze " + f.string() + " --taus 0.1,0.03", d.path());
-  expectOneLineError(r, "--taus");
+  expectOneLineError(r, "--taus", 64);
   EXPECT_NE(r.err.find("0.03"), std::string::npos) << r.err;
   expectOneLineError(runGyroctl("analyze " + f.string() + " --taus 1,x", d.path()),
-                     "--taus: 'x' is not a positive number");
+                     "--taus: 'x' is not a positive number", 64);
 }
 
-TEST(GyroctlErrors, BadOptionValuesExitTwo) {
+TEST(GyroctlErrors, BadOptionValuesExitWithUsage64) {
   ScratchDir d;
   const auto f = d.write("w.csv", whiteNoiseCsv(500, 50.0, 5));
-  EXPECT_EQ(runGyroctl("analyze " + f.string() + " --mean-window 0", d.path()).exit_status, 2);
-  EXPECT_EQ(runGyroctl("analyze " + f.string() + " --rate -3", d.path()).exit_status, 2);
-  EXPECT_EQ(runGyroctl("analyze " + f.string() + " --bogus", d.path()).exit_status, 2);
-  EXPECT_EQ(runGyroctl("frobnicate", d.path()).exit_status, 2);
+  EXPECT_EQ(runGyroctl("analyze " + f.string() + " --mean-window 0", d.path()).exit_status, 64);
+  EXPECT_EQ(runGyroctl("analyze " + f.string() + " --rate -3", d.path()).exit_status, 64);
+  EXPECT_EQ(runGyroctl("analyze " + f.string() + " --bogus", d.path()).exit_status, 64);
+  EXPECT_EQ(runGyroctl("frobnicate", d.path()).exit_status, 64);
   EXPECT_EQ(runGyroctl("filter " + f.string() + " -o " + (d.path() / "o.csv").string() + " --kalman-r -1", d.path())
                 .exit_status,
-            2);
+            64);
 }
 
 TEST(GyroctlErrors, FailedFilterLeavesAnExistingOutputUntouched) {
@@ -167,7 +170,7 @@ TEST(GyroctlErrors, FailedFilterLeavesAnExistingOutputUntouched) {
   const auto out = d.write("out.csv", "precious\n");
   const auto bad = d.write("bad.csv", "t,gx\n0,1\n0.02,oops\n");
   const auto r = runGyroctl("filter " + bad.string() + " -o " + out.string(), d.path());
-  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_EQ(r.exit_status, 65);  // EX_DATAERR
   EXPECT_EQ(gyrod::test::readWholeFile(out), "precious\n");
 }
 
@@ -235,7 +238,7 @@ TEST(GyroctlErrors, ADirectoryIsNamedAsOne) {
        {std::string("analyze "), std::string("filter "), std::string("model-check "), std::string("import ")}) {
     const std::string o = command == "filter " || command == "import " ? out : "";
     expectOneLineError(runGyroctl(command + dir.string() + o, d.path()),
-                       dir.string() + ": cannot read: it is a directory, not a file");
+                       dir.string() + ": cannot read: it is a directory, not a file", 66);
   }
 }
 

@@ -84,12 +84,12 @@ TEST(GyroctlModelCheck, TooShortOrMissingFilesAreUsageErrors) {
   ScratchDir d;
   const auto csv = d.write("short.csv", "t,gx\n0,0.1\n0.02,0.2\n0.04,0.1\n");
   auto r = runGyroctl("model-check " + csv.string(), d.path());
-  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_EQ(r.exit_status, 65);  // EX_DATAERR
   EXPECT_NE(r.err.find("too few"), std::string::npos) << r.err;
   r = runGyroctl("model-check " + (d.path() / "missing.csv").string(), d.path());
-  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_EQ(r.exit_status, 66);  // EX_NOINPUT
   r = runGyroctl("model-check " + csv.string() + " --replicas 2", d.path());
-  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_EQ(r.exit_status, 64);  // EX_USAGE
 }
 
 // ---- the model file's optional [x.extra] tables ------------------------------------------
@@ -250,11 +250,11 @@ TEST(GyroctlModelCheckWriteModel, UnwritablePathFailsBeforeTheCheckAndKeepsAnExi
   ScratchDir d;
   const auto g = gyrod::processing::HiddenEffectGenerator(5).generate(100.0, 50.0, {});
   const auto csv = d.write("rec.csv", recordingCsv(g));
-  // A missing folder: exit 1 as for every output that cannot be written (analyze, simulate),
+  // A missing folder: exit 73 (EX_CANTCREAT) as for every output that cannot be created,
   // one line naming the path, and no check output (it failed before the check ran).
   const auto missing = d.path() / "no-such-folder" / "m.toml";
   auto r = runGyroctl("model-check " + csv.string() + " --replicas 8 --write-model " + missing.string(), d.path());
-  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_EQ(r.exit_status, 73);
   EXPECT_NE(r.err.find(missing.string() + ": cannot write the model: " + missing.parent_path().string() +
                        ": folder does not exist"),
             std::string::npos)
@@ -263,12 +263,12 @@ TEST(GyroctlModelCheckWriteModel, UnwritablePathFailsBeforeTheCheckAndKeepsAnExi
   EXPECT_EQ(r.out.find("checked in"), std::string::npos) << r.out;
   // A folder in the way.
   r = runGyroctl("model-check " + csv.string() + " --replicas 8 --write-model " + d.path().string(), d.path());
-  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_EQ(r.exit_status, 73);
   EXPECT_NE(r.err.find("it is a folder"), std::string::npos) << r.err;
   // A check that fails (too short a recording) leaves an existing model file as it was.
   const auto existing = d.write("keep.toml", "precious\n");
   const auto short_csv = d.write("short.csv", "t,gx\n0,0.1\n0.02,0.2\n0.04,0.1\n");
   r = runGyroctl("model-check " + short_csv.string() + " --write-model " + existing.string(), d.path());
-  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_EQ(r.exit_status, 65);
   EXPECT_EQ(readWholeFile(existing), "precious\n");
 }

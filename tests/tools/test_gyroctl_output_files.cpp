@@ -283,7 +283,7 @@ TEST(GyroctlOutputFiles, SimulateRefusesWhatCannotFit) {
   // Within the documented maximum duration, but 8e10 lines (up to 10 TB): more than the
   // test folder's filesystem has free.
   auto r = runGyroctl("simulate --arw 1 --rate 8000 --duration 1e7 -o " + out.string(), d.path());
-  EXPECT_EQ(r.exit_status, 2) << r.err;
+  EXPECT_EQ(r.exit_status, 73) << r.err;  // EX_CANTCREAT: no room
   EXPECT_NE(
       r.err.find(out.string() + ": 80000000000 samples need up to 10 TB (125 bytes a line) but its filesystem has "),
       std::string::npos)
@@ -294,7 +294,7 @@ TEST(GyroctlOutputFiles, SimulateRefusesWhatCannotFit) {
   // Beyond the maximum duration (the 1e9 of issue 16 and more).
   for (const char* duration : {"1e9", "1e12"}) {
     r = runGyroctl(std::string("simulate --arw 1 --duration ") + duration + " -o " + out.string(), d.path());
-    EXPECT_EQ(r.exit_status, 2) << r.err;
+    EXPECT_EQ(r.exit_status, 64) << r.err;  // EX_USAGE
     EXPECT_NE(r.err.find("is longer than simulate writes (at most 1e+07 s)"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out));
   }
@@ -310,7 +310,7 @@ TEST(GyroctlInputMessages, ADirectoryAsTheInputIsCalledADirectory) {
        {"analyze " + folder.string(), "filter " + folder.string() + " -o " + (d.path() / "o.csv").string(),
         "import " + folder.string() + " -o " + (d.path() / "o.csv").string(), "model-check " + folder.string()}) {
     const auto r = runGyroctl(cmd, d.path());
-    EXPECT_EQ(r.exit_status, 2) << cmd;
+    EXPECT_EQ(r.exit_status, 66) << cmd;  // EX_NOINPUT
     EXPECT_NE(r.err.find(folder.string() + ": cannot read: it is a directory"), std::string::npos) << cmd << r.err;
     EXPECT_EQ(r.err.find("empty file"), std::string::npos) << cmd << r.err;
   }
@@ -320,7 +320,7 @@ TEST(GyroctlInputMessages, ImportOfAMissingFileSaysWhy) {
   ScratchDir d;
   const auto missing = (d.path() / "nope.txt").string();
   const auto r = runGyroctl("import " + missing + " -o " + (d.path() / "o.csv").string(), d.path());
-  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_EQ(r.exit_status, 66);  // EX_NOINPUT
   EXPECT_NE(r.err.find(missing + ": cannot open: No such file or directory"), std::string::npos) << r.err;
 }
 
@@ -329,14 +329,14 @@ TEST(GyroctlInputMessages, FilterNeedsEnoughSamplesToIdentifyTheFilter) {
   const auto few = d.write("few.csv", "t,gx\n0,1\n0.02,1.5\n0.04,1.25\n");
   const auto out = d.path() / "o.csv";
   auto r = runGyroctl("filter " + few.string() + " -o " + out.string(), d.path());
-  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_EQ(r.exit_status, 65);  // EX_DATAERR
   EXPECT_NE(r.err.find(few.string() + ": 3 samples are too few to identify the filter (need at least 100"),
             std::string::npos)
       << r.err;
   EXPECT_FALSE(fs::exists(out));
   // One parameter given is not enough: the others are still identified.
   r = runGyroctl("filter " + few.string() + " -o " + out.string() + " --ar-phi 0.5", d.path());
-  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_EQ(r.exit_status, 65);
   // All three given: nothing is identified, any length runs (as gyrod runs sample by sample).
   r = runGyroctl("filter " + few.string() + " -o " + out.string() + " --ar-phi 0.5 --kalman-q 1 --kalman-r 1",
                  d.path());
@@ -356,7 +356,7 @@ TEST(GyroctlOutputFiles, SimulateOnASmallFilesystem) {
   const auto out = tiny / "sim.csv";
   // 100 s at 50 Hz: 5000 lines, up to 625 kB, on 64 KiB.
   auto r = runGyroctl("simulate --arw 1 --duration 100 -o " + out.string(), d.path());
-  EXPECT_EQ(r.exit_status, 2) << r.err;
+  EXPECT_EQ(r.exit_status, 73) << r.err;  // EX_CANTCREAT
   EXPECT_NE(r.err.find(out.string() + ": 5000 samples need up to 625 kB (125 bytes a line) but its filesystem has "),
             std::string::npos)
       << r.err;

@@ -82,17 +82,17 @@ TEST(GyroctlSimulate, ErrorsAreOneLineAndLeaveNoOutput) {
   const std::string out = (d.path() / "o.csv").string(), model = (d.path() / "bad.toml").string();
   std::ofstream(model) << "rate_hz = 50\n[x]\narw = 1\n";
   auto r = runGyroctl("simulate --model " + model + " --duration 1 -o " + out, d.path());
-  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_EQ(r.exit_status, 65);  // EX_DATAERR: a bad model file
   EXPECT_NE(r.err.find(model + ":3: unknown key 'arw' in [x]"), std::string::npos) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   r = runGyroctl("simulate --arw 1 --duration 1 --rate 300 --dlpf 3 -o " + out, d.path());
-  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_EQ(r.exit_status, 64);  // EX_USAGE
   EXPECT_NE(r.err.find("rate_hz 300 is not possible with DLPF_CFG 3"), std::string::npos) << r.err;
   r = runGyroctl("simulate --arw -1 --duration 1 -o " + out, d.path());
-  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_EQ(r.exit_status, 64);
   EXPECT_NE(r.err.find("arw_deg_per_sqrt_h must be finite and >= 0, got -1"), std::string::npos) << r.err;
   r = runGyroctl("simulate --model " + model + " --arw 1 --duration 1 -o " + out, d.path());
-  EXPECT_EQ(r.exit_status, 2);  // --model excludes the term options
+  EXPECT_EQ(r.exit_status, 64);  // --model excludes the term options
   EXPECT_FALSE(std::filesystem::exists(out));
   EXPECT_FALSE(std::filesystem::exists(out + ".tmp-gyroctl"));
 }

@@ -75,7 +75,7 @@ TEST(GyroctlSimulateWarmUp, BadValuesExitTwoNamingThem) {
                         Case{"--warm-up 15,abc", "'abc' is not a finite number"},
                         Case{"--temperature-coefficient 0.1,0.2", "--temperature-coefficient: expected one value"}}) {
     const auto r = runGyroctl("simulate --duration 10 " + c.options + out, d.path());
-    EXPECT_EQ(r.exit_status, 2) << c.options;
+    EXPECT_EQ(r.exit_status, 64) << c.options;  // EX_USAGE
     EXPECT_NE(r.err.find(c.expected), std::string::npos) << c.options << ": " << r.err;
   }
 }

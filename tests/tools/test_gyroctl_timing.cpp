@@ -123,7 +123,7 @@ TEST(GyroctlTiming, FourSecondGapIsWarnedReportedAndStrictlyRefused) {
   for (const std::string& command :
        std::vector<std::string>{"analyze", "model-check --replicas 8", "filter -o " + (d.path() / "o.csv").string()}) {
     const auto strict = runGyroctl(command + " " + f.string() + " --strict-timing", d.path());
-    EXPECT_EQ(strict.exit_status, 2) << command << ": " << strict.err;
+    EXPECT_EQ(strict.exit_status, 65) << command << ": " << strict.err;
     EXPECT_EQ(strict.err,
               "gyroctl: " + f.string() +
                   ":1002: irregular timing (--strict-timing): a gap of 4.02 s after t = 19.98 s (over 1.5 x "
@@ -166,7 +166,7 @@ TEST(GyroctlTiming, JitterIsCountedWithItsLargestDeviation) {
 
   const auto strict = runGyroctl(
       "filter " + f.string() + " --rate 10 -o " + (d.path() / "o.csv").string() + " --strict-timing", d.path());
-  EXPECT_EQ(strict.exit_status, 2) << strict.err;
+  EXPECT_EQ(strict.exit_status, 65) << strict.err;
   EXPECT_EQ(strict.err.rfind("gyroctl: " + f.string() + ":" + std::to_string(first_line) +
                                  ": irregular timing (--strict-timing): t = ",
                              0),
@@ -198,7 +198,7 @@ TEST(GyroctlTiming, GapAndDroppedRecordsAreReported) {
       << filtered.err;
 
   const auto strict = runGyroctl("analyze " + f.string() + " --strict-timing", d.path());
-  EXPECT_EQ(strict.exit_status, 2);
+  EXPECT_EQ(strict.exit_status, 65);
   EXPECT_EQ(strict.err,
             "gyroctl: " + f.string() +
                 ":502: irregular timing (--strict-timing): a '# DROPPED' record: 7 samples lost (ring_full)\n");

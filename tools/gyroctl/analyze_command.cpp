@@ -21,6 +21,7 @@
 #include "processing/noise_units.hpp"
 #include "processing/warm_up_fit.hpp"
 #include "tools/gyroctl/analyze_imu.hpp"
+#include "protocol/allan_table.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
 #include "tools/gyroctl/series_checks.hpp"
@@ -118,19 +119,8 @@ json noiseTermsJson(const NoiseTerms& t, SensorKind sensor) {
   return j;
 }
 
-json allanJson(const std::vector<AllanPoint>& curve) {
-  json a = json::array();
-  for (const auto& p : curve) {
-    json j = {{"tau_s", p.tau_s},       {"m", p.m},
-              {"adev", p.adev},         {"oadev", p.oadev},
-              {"oadev_lo", p.oadev_lo}, {"oadev_hi", p.oadev_hi},
-              {"n", p.oadev_terms},     {"adev_n", p.adev_terms},
-              {"edf", p.edf},           {"noise_alpha", p.noise_alpha}};
-    if (!std::isfinite(p.adev)) j.erase("adev");  // fewer than two clusters: omitted, not null
-    a.push_back(j);
-  }
-  return a;
-}
+// The shared shape of an Allan table (protocol/allan_table.hpp), as the ALLAN reply sends it.
+json allanJson(const std::vector<AllanPoint>& curve) { return json(protocol::allanTableJson(curve)); }
 
 json axisJson(const AxisAnalysis& a, SensorKind sensor) {
   const std::string unit = unitKey(sensor);
@@ -185,6 +175,16 @@ std::string format(const char* fmt, double v) {
   return buf;
 }
 
+// A noise term is never shown without its uncertainty: "value +- 1 sigma", or a mark.
+std::string termWithUncertainty(double value, double sigma) {
+  char text[64];
+  if (!std::isfinite(value) || !std::isfinite(sigma))
+    std::snprintf(text, sizeof text, "%27s", "not enough data");
+  else
+    std::snprintf(text, sizeof text, "%12.5g +- %-11.3g", value, sigma);
+  return text;
+}
+
 // Table 2 (or 4) lines of one term: one per figure (the paper's units, then SI).
 void printTermLines(std::ostream& o, NoiseTerm t, SensorKind sensor, const AxisAnalysis& a) {
   char line[256];
@@ -192,8 +192,8 @@ void printTermLines(std::ostream& o, NoiseTerm t, SensorKind sensor, const AxisA
   const auto sigmas = noiseFigures(t, a.noise.uncertainty.get(t), sensor);
   const auto slopes = noiseFigures(t, a.noise_from_slopes.get(t), sensor);
   for (std::size_t f = 0; f < values.size(); ++f) {
-    std::snprintf(line, sizeof line, "  %-42s %12.5g +- %-11.3g | %12.5g\n", std::string(values[f].label).c_str(),
-                  values[f].value, sigmas[f].value, slopes[f].value);
+    std::snprintf(line, sizeof line, "  %-42s %s | %12.5g\n", std::string(values[f].label).c_str(),
+                  termWithUncertainty(values[f].value, sigmas[f].value).c_str(), slopes[f].value);
     o << line;
   }
 }
@@ -230,7 +230,7 @@ void printAxisText(std::ostream& o, const std::string& name, const AxisAnalysis&
     o << line;
   }
 
-  o << "\nTable 2: noise terms (weighted fit +- 1 sigma | slope-line reading)\n";
+  o << "\nTable 2: noise terms (weighted fit +- 1 sigma | slope-line reading, a cross-check without uncertainty)\n";
   for (NoiseTerm t : kAllNoiseTerms) printTermLines(o, t, sensor, a);
 
   o << "\nTable 3: AR models of the mean-filtered series (Yule-Walker)\n";
@@ -262,12 +262,15 @@ void printAxisText(std::ostream& o, const std::string& name, const AxisAnalysis&
   std::snprintf(line, sizeof line, "Peak after Kalman: %.1f %% of before\n", 100.0 * a.peak_ratio);
   o << line;
 
-  o << "\nTable 4: noise terms before and after Kalman\n";
+  o << "\nTable 4: noise terms before and after Kalman (+- 1 sigma)\n";
   for (NoiseTerm t : kAllNoiseTerms) {
     const auto before_figure = noiseFigures(t, a.noise.value.get(t), sensor).front();
     const double before = before_figure.value;
     const double after = noiseFigures(t, a.noise_after_kalman.value.get(t), sensor).front().value;
-    std::snprintf(line, sizeof line, "  %-42s %12.5g %12.5g", std::string(before_figure.label).c_str(), before, after);
+    const double before_sigma = noiseFigures(t, a.noise.uncertainty.get(t), sensor).front().value;
+    const double after_sigma = noiseFigures(t, a.noise_after_kalman.uncertainty.get(t), sensor).front().value;
+    std::snprintf(line, sizeof line, "  %-42s %s %s", std::string(before_figure.label).c_str(),
+                  termWithUncertainty(before, before_sigma).c_str(), termWithUncertainty(after, after_sigma).c_str());
     o << line;
     if (before > 0.0) o << format("  %+7.1f %%", 100.0 * (after - before) / before);
     o << '\n';

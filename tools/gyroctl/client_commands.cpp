@@ -2,6 +2,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -13,6 +14,7 @@
 #include <variant>
 #include <vector>
 
+#include "processing/allan.hpp"
 #include "processing/noise_terms.hpp"
 #include "protocol/protocol.hpp"
 #include "protocol/socket_path.hpp"
@@ -130,7 +132,10 @@ struct AllanOptions {
 
 struct Curve {
   std::string label;  // "x raw"
+  std::size_t axis = 0, stream = 0;
   std::vector<double> adev;
+  std::vector<processing::AllanPoint> points;  // with intervals where gyrod identified the noise type
+  std::optional<processing::NoiseTerms> noise;
 };
 
 // The computed curves in axis-then-stream order (the parser has checked their lengths).
@@ -138,42 +143,74 @@ std::vector<Curve> curvesOf(const protocol::AllanReport& report) {
   std::vector<Curve> curves;
   for (std::size_t a = 0; a < protocol::kAxisNames.size(); ++a)
     for (std::size_t s = 0; s < protocol::kStreamNames.size(); ++s) {
-      const auto& adev = report.curves[a][s].adev_dps;
-      if (adev.empty()) continue;
-      curves.push_back({std::string(protocol::kAxisNames[a]) + " " + std::string(protocol::kStreamNames[s]), adev});
+      const auto& c = report.curves[a][s];
+      if (c.adev_dps.empty()) continue;
+      curves.push_back({std::string(protocol::kAxisNames[a]) + " " + std::string(protocol::kStreamNames[s]), a, s,
+                        c.adev_dps, c.points, c.noise});
     }
   return curves;
 }
 
+// Every term of a fitted curve: its value with its 1 σ, or "not enough data" — never a bare
+// number (a gyrod older than protocol 1.3 sends no uncertainties, and says so).
 void printNoiseTerms(const protocol::AllanReport& report) {
   bool any = false;
   for (const auto& axis : report.curves)
     for (const auto& curve : axis) any = any || curve.noise.has_value();
   if (!any) return;
-  std::printf("\nnoise terms (IEEE Std 952)\n");
+  std::printf("\nnoise terms (IEEE Std 952, +- 1 sigma)\n");
   for (std::size_t a = 0; a < protocol::kAxisNames.size(); ++a)
     for (std::size_t s = 0; s < protocol::kStreamNames.size(); ++s) {
-      const auto& noise = report.curves[a][s].noise;
-      if (!noise) continue;
-      std::printf("  %s %s:", std::string(protocol::kAxisNames[a]).c_str(),
+      const auto& c = report.curves[a][s];
+      if (!c.noise) continue;
+      std::printf("  %s %s:\n", std::string(protocol::kAxisNames[a]).c_str(),
                   std::string(protocol::kStreamNames[s]).c_str());
-      const char* sep = " ";
       for (const auto t : processing::kAllNoiseTerms) {
-        const double v = noise->get(t);
-        if (!std::isfinite(v)) continue;  // not estimated: left out of the line
-        std::printf("%s%s = %.4g", sep, std::string(processing::noiseTermLabel(t)).c_str(), v);
-        sep = ", ";
+        const double v = c.noise->get(t);
+        const double u = c.noise_uncertainty ? c.noise_uncertainty->get(t) : std::nan("");
+        const std::string label(processing::noiseTermLabel(t));
+        if (!std::isfinite(v))
+          std::printf("    %-36s not enough data\n", label.c_str());
+        else if (std::isfinite(u))
+          std::printf("    %-36s = %.4g +- %.2g\n", label.c_str(), v, u);
+        else
+          std::printf("    %-36s = %.4g (no uncertainty: gyrod sent none)\n", label.c_str(), v);
       }
-      std::printf("\n");
     }
+}
+
+// Per curve: the deviation with its confidence interval at each τ, or why there is none yet.
+void printIntervals(const protocol::AllanReport& report, const std::vector<Curve>& curves) {
+  bool any = false;
+  for (const auto& c : curves) any = any || !c.points.empty();
+  if (!any) return;
+  std::printf("\n");
+  if (std::isfinite(report.confidence))
+    std::printf("%.1f %% chi2 confidence intervals (edf for the noise type gyrod identified at its last refit)\n",
+                100.0 * report.confidence);
+  for (const auto& c : curves) {
+    if (c.points.empty()) continue;
+    std::printf("  %s\n  %11s %11s %11s %11s %10s %8s %5s\n", c.label.c_str(), "tau [s]", "oadev", "oadev_lo",
+                "oadev_hi", "terms", "edf", "alpha");
+    for (const auto& p : c.points) {
+      if (std::isfinite(p.oadev_lo) && std::isfinite(p.oadev_hi))
+        std::printf("  %11.6g %11.4e %11.4e %11.4e %10zu %8.3g %5d\n", p.tau_s, p.oadev, p.oadev_lo, p.oadev_hi,
+                    p.oadev_terms, p.edf, p.noise_alpha);
+      else
+        std::printf("  %11.6g %11.4e %23s %10zu  (no interval until the next refit)\n", p.tau_s, p.oadev,
+                    "not enough data", p.oadev_terms);
+    }
+  }
 }
 
 void printAllanTable(const protocol::AllanReport& report, const std::vector<Curve>& curves) {
   const std::vector<double>& tau = report.tau_s;
-  std::printf("Allan deviation [deg/s]");
-  if (std::isfinite(report.window_s)) std::printf(", window %.6g s", report.window_s);
-  std::printf(" (%llu samples", static_cast<unsigned long long>(report.samples));
-  if (std::isfinite(report.tau0_s)) std::printf(", tau0 %.6g s", report.tau0_s);
+  // How much data: the samples and the time they cover, then what the window could hold.
+  std::printf("Allan deviation [deg/s] of %llu samples", static_cast<unsigned long long>(report.samples));
+  if (std::isfinite(report.span_s)) std::printf(" covering %.6g s", report.span_s);
+  std::printf(" (");
+  if (std::isfinite(report.window_s)) std::printf("window up to %.6g s, ", report.window_s);
+  if (std::isfinite(report.tau0_s)) std::printf("tau0 %.6g s", report.tau0_s);
   std::printf(")\n");
   if (tau.empty()) {
     std::printf("not enough samples in the window for an Allan deviation yet\n");
@@ -187,6 +224,7 @@ void printAllanTable(const protocol::AllanReport& report, const std::vector<Curv
     for (const auto& c : curves) std::printf(" %11.4e", c.adev[i]);
     std::printf("\n");
   }
+  printIntervals(report, curves);
   printNoiseTerms(report);
 }
 
@@ -208,8 +246,8 @@ std::optional<std::string> findOnPath(const std::string& program) {
 // gnuplot terminal for the plot file's extension; std::invalid_argument for others.
 std::string gnuplotTerminal(const std::string& file) {
   const std::string ext = std::filesystem::path(file).extension().string();
-  if (ext == ".png") return "pngcairo size 1000,700 enhanced";
-  if (ext == ".svg") return "svg size 1000,700 enhanced";
+  if (ext == ".png") return "pngcairo size 1200,800 enhanced";
+  if (ext == ".svg") return "svg size 1200,800 enhanced";
   if (ext == ".pdf") return "pdfcairo size 7in,5in enhanced";
   throw std::invalid_argument("--plot: '" + file + "' must end in .png, .svg or .pdf");
 }
@@ -221,33 +259,85 @@ std::string gnuplotQuoted(const std::string& s) {
   return q + "'";
 }
 
+// Colours that read on white (Okabe & Ito's palette without its yellow), one per axis; the
+// streams differ by point and dash type.
+constexpr std::array<const char*, 3> kAxisColours = {"#0072B2", "#D55E00", "#009E73"};
+constexpr std::array<int, 3> kStreamPointTypes = {7, 5, 9};  // filled circle, square, triangle
+// One dash pattern per IEEE 952 term (Q, N, B, K, R); the measured curves are solid.
+constexpr std::array<const char*, 5> kTermDashes = {"(3,4)", "(14,6)", "(14,5,3,5)", "(22,6,3,6,3,6)", "(6,6)"};
+
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+// One inline data block per curve: τ, σ, and the interval (σ itself where there is none, so
+// the bar has no length).
+std::string curveBlock(std::size_t k, const Curve& c, const std::vector<double>& tau) {
+  std::string block = "$c" + std::to_string(k) + " << EOD\n";
+  if (c.points.empty()) {
+    for (std::size_t i = 0; i < tau.size(); ++i)
+      block += number(tau[i]) + " " + number(c.adev[i]) + " " + number(c.adev[i]) + " " + number(c.adev[i]) + "\n";
+  }
+  for (const auto& p : c.points) {
+    const bool bar = std::isfinite(p.oadev_lo) && std::isfinite(p.oadev_hi);
+    block += number(p.tau_s) + " " + number(p.oadev) + " " + number(bar ? p.oadev_lo : p.oadev) + " " +
+             number(bar ? p.oadev_hi : p.oadev) + "\n";
+  }
+  return block + "EOD\n";
+}
+
+// The fitted terms of a curve as gnuplot functions of τ, each its own IEEE 952 line
+// σ(τ) = √(c·τ^p), dashed in the curve's colour; none for a term fitted to 0 or not estimated.
+std::string termLines(const Curve& c, const std::vector<double>& tau) {
+  if (!c.noise) return {};
+  std::string plot;
+  for (const auto t : processing::kAllNoiseTerms) {
+    const double v = c.noise->get(t);
+    if (!(std::isfinite(v) && v > 0.0)) continue;
+    const double coefficient = processing::allanVarianceCoefficient(t, v);
+    const std::string power = std::to_string(processing::noiseTermVariancePower(t));
+    const std::string range = "[" + number(tau.front()) + ":" + number(tau.back()) + "]";
+    std::string name(processing::noiseTermLabel(t));
+    name = name.substr(0, name.find(" ["));
+    plot += ", " + range + " sqrt(" + number(coefficient) + "*x**(" + power + ")) with lines dashtype " +
+            kTermDashes[static_cast<std::size_t>(t)] + " linewidth 1.5 linecolor rgb '" + kAxisColours[c.axis] +
+            "' title " + gnuplotQuoted(c.label + " fit: " + name);
+  }
+  return plot;
+}
+
+std::string allanPlotScript(const std::string& file, const std::vector<double>& tau, const std::vector<Curve>& curves) {
+  std::string script =
+      "set terminal " + gnuplotTerminal(file) + " background rgb 'white'\nset output " + gnuplotQuoted(file) + "\n";
+  script +=
+      "set logscale xy\nset grid xtics ytics mxtics mytics linecolor rgb '#c0c0c0'\nset format x '10^{%L}'\n"
+      "set format y '10^{%L}'\nset xlabel 'averaging time {/Symbol t} [s]'\nset ylabel 'Allan deviation [deg/s]'\n"
+      "set title \"gyrod: overlapping Allan deviation of the rolling window\\nbars: confidence interval of each "
+      "point; dashed: the fitted IEEE 952 noise terms\"\nset key outside right top font ',9'\nset samples 200\n";
+  for (std::size_t k = 0; k < curves.size(); ++k) script += curveBlock(k, curves[k], tau);
+  script += "plot ";
+  for (std::size_t k = 0; k < curves.size(); ++k) {
+    const Curve& c = curves[k];
+    const std::size_t stream = c.stream;
+    const std::string colour = std::string("linecolor rgb '") + kAxisColours[c.axis] + "'";
+    const std::string data = "$c" + std::to_string(k);
+    script += (k ? ", " : "") + data + " using 1:2:3:4 with yerrorbars pointtype " +
+              std::to_string(kStreamPointTypes[stream]) + " pointsize 0.8 " + colour + " title " +
+              gnuplotQuoted(c.label) + ", " + data + " using 1:2 with lines linewidth 1.2 " + colour + " notitle";
+    script += termLines(c, tau);
+  }
+  return script + "\n";
+}
+
 void plotAllan(const std::string& file, const std::vector<double>& tau, const std::vector<Curve>& curves) {
   const auto gnuplot = findOnPath("gnuplot");
   if (!gnuplot)
     throw std::runtime_error(
         "--plot: gnuplot is not installed (apt-get install gnuplot-nox); the table above was printed, no plot was drawn");
   if (tau.empty()) throw std::runtime_error("--plot: no Allan deviation to plot yet");
-  std::string script = "set terminal " + gnuplotTerminal(file) + "\nset output " + gnuplotQuoted(file) + "\n";
-  script +=
-      "set logscale xy\nset grid xtics ytics mxtics mytics\nset format x '10^{%L}'\nset format y '10^{%L}'\n"
-      "set xlabel 'averaging time {/Symbol t} [s]'\nset ylabel 'Allan deviation [deg/s]'\n"
-      "set title 'gyrod: Allan deviation of the rolling window'\nset key outside right\n$adev << EOD\n";
-  char buf[64];
-  for (std::size_t i = 0; i < tau.size(); ++i) {
-    std::snprintf(buf, sizeof buf, "%.17g", tau[i]);
-    script += buf;
-    for (const auto& c : curves) {
-      std::snprintf(buf, sizeof buf, " %.17g", c.adev[i]);
-      script += buf;
-    }
-    script += '\n';
-  }
-  script += "EOD\nplot ";
-  for (std::size_t k = 0; k < curves.size(); ++k) {
-    script += (k ? ", " : "") + std::string("$adev using 1:") + std::to_string(k + 2) + " with linespoints title " +
-              gnuplotQuoted(curves[k].label);
-  }
-  script += "\n";
+  const std::string script = allanPlotScript(file, tau, curves);
   const std::string command = "'" + *gnuplot + "'";
   FILE* pipe = ::popen(command.c_str(), "w");
   if (pipe == nullptr) throw std::runtime_error("--plot: cannot start gnuplot");
@@ -314,6 +404,8 @@ void printStatus(const protocol::StatusReply& status) {
   printField("bus_errors", count(d.bus_errors));
   printField("resets", count(d.resets));
   printField("bias_source", d.bias_source);
+  printField("still_check", d.still_check);
+  printField("still_check_detail", d.still_check_detail);
   printField("rate_model", d.rate_model);
   printField("recording", d.recording);
   if (const auto& r = d.recorder)

@@ -5,14 +5,16 @@
 #include <CLI/CLI.hpp>
 #include <functional>
 
+#include "tools/gyroctl/exit_codes.hpp"
+
 namespace gyrod::gyroctl {
 
 using CommandRunner = std::function<int()>;
 
-// Exit statuses shared by all subcommands.
-inline constexpr int kExitOk = 0;
-inline constexpr int kExitUsage = 2;    // bad input file, bad option value
-inline constexpr int kExitFailure = 1;  // anything else
+// Exit statuses shared by all subcommands (the whole table: tools/gyroctl/exit_codes.hpp).
+inline constexpr int kExitOk = toInt(ExitCode::Ok);
+inline constexpr int kExitUsage = toInt(ExitCode::Usage);      // bad command line, bad option value
+inline constexpr int kExitFailure = toInt(ExitCode::Failure);  // anything else
 
 void addAnalyzeCommand(CLI::App& app, CommandRunner& run);
 void addFilterCommand(CLI::App& app, CommandRunner& run);

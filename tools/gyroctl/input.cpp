@@ -1,5 +1,7 @@
 #include "tools/gyroctl/input.hpp"
 
+#include "tools/gyroctl/exit_codes.hpp"
+
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -76,8 +78,10 @@ std::function<void(std::size_t, std::uint64_t)> readingProgress(const std::strin
 
 void requireNotADirectory(const std::string& path) {
   struct stat st {};
-  if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
-    throw recording::RecordingError(path + ": cannot read: it is a directory, not a file");
+  // A file that is not there or not readable is "no input" (66), not a malformed one (65).
+  if (::stat(path.c_str(), &st) != 0 || ::access(path.c_str(), R_OK) != 0)
+    throw ExitError(ExitCode::NoInput, path + ": cannot open: " + std::strerror(errno));
+  if (S_ISDIR(st.st_mode)) throw ExitError(ExitCode::NoInput, path + ": cannot read: it is a directory, not a file");
 }
 
 }  // namespace gyrod::gyroctl

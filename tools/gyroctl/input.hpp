@@ -32,7 +32,8 @@ bool stderrIsTerminal();
 std::function<void(std::size_t, std::uint64_t)> readingProgress(const std::string& path);
 
 // Refuses a directory as an input file, saying so (reading one would look like an empty
-// file). FIFOs and devices stay readable: `analyze /dev/stdin` works.
+// file), and a file that does not exist or cannot be read: ExitError with ExitCode::NoInput.
+// FIFOs and devices stay readable: `analyze /dev/stdin` works.
 void requireNotADirectory(const std::string& path);
 
 }  // namespace gyrod::gyroctl

@@ -1,6 +1,7 @@
 // gyroctl: offline analysis of gyro recordings and the gyrod client.
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cctype>
 #include <exception>
 #include <iostream>
 #include <optional>
@@ -9,8 +10,12 @@
 #include <vector>
 
 #include "formats/edit_distance.hpp"
+#include "formats/output_file.hpp"
 #include "formats/recording_csv.hpp"
+#include "formats/toml_document.hpp"
 #include "tools/gyroctl/commands.hpp"
+#include "tools/gyroctl/daemon_client.hpp"
+#include "tools/gyroctl/exit_codes.hpp"
 
 #ifndef GYROD_VERSION
 #define GYROD_VERSION "unknown"
@@ -45,6 +50,48 @@ std::optional<std::string> unknownCommandMessage(CLI::App& app, int argc, char**
   return std::nullopt;
 }
 
+// A message from the library may start with the function that threw it ("fitLinearTrend: ",
+// "RollingOverlappingAllan::push: "): a name for a programmer, not for the person reading.
+// Only such names are removed: a camelCase word or a qualified name before ": ".
+std::string withoutInternalName(const std::string& message) {
+  const auto colon = message.find(": ");
+  if (colon == std::string::npos || colon == 0) return message;
+  const std::string prefix = message.substr(0, colon);
+  bool identifier = true, camel = false;
+  for (std::size_t i = 0; i < prefix.size(); ++i) {
+    const unsigned char c = static_cast<unsigned char>(prefix[i]);
+    identifier = identifier && (std::isalnum(c) || c == '_' || c == ':');
+    camel = camel || (i > 0 && std::isupper(c) && std::islower(static_cast<unsigned char>(prefix[i - 1])));
+  }
+  const bool internal = identifier && (camel || prefix.find("::") != std::string::npos);
+  return internal ? message.substr(colon + 2) : message;
+}
+
+// Prints the error in flight and returns its exit status (tools/gyroctl/exit_codes.hpp).
+int reportError() {
+  auto fail = [](ExitCode code, const std::exception& e) {
+    std::cerr << "gyroctl: " << withoutInternalName(e.what()) << '\n';
+    return toInt(code);
+  };
+  try {
+    throw;
+  } catch (const ExitError& e) {
+    return fail(e.code(), e);
+  } catch (const gyrod::recording::RecordingError& e) {  // a recording that cannot be used
+    return fail(ExitCode::DataError, e);
+  } catch (const gyrod::formats::TomlError& e) {  // a model or motion file that cannot be used
+    return fail(ExitCode::DataError, e);
+  } catch (const gyrod::formats::OutputTargetError& e) {
+    return fail(ExitCode::CantCreate, e);
+  } catch (const DaemonConnectionError& e) {
+    return fail(ExitCode::Unavailable, e);
+  } catch (const std::invalid_argument& e) {  // an option value the command cannot use
+    return fail(ExitCode::Usage, e);
+  } catch (const std::exception& e) {
+    return fail(ExitCode::Failure, e);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -70,14 +117,7 @@ int main(int argc, char** argv) {
   }
   try {
     return run ? run() : kExitUsage;
-  } catch (const gyrod::recording::RecordingError& e) {
-    std::cerr << "gyroctl: " << e.what() << '\n';
-    return kExitUsage;
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "gyroctl: " << e.what() << '\n';
-    return kExitUsage;
-  } catch (const std::exception& e) {
-    std::cerr << "gyroctl: " << e.what() << '\n';
-    return kExitFailure;
+  } catch (...) {
+    return reportError();
   }
 }

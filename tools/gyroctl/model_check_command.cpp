@@ -350,14 +350,17 @@ void writeReport(const std::string& dir_text, const ModelCheckCliOptions& opt, c
 void requireWritableTarget(const std::string& path, const std::string& input) {
   const std::filesystem::path p(path);
   std::error_code ec;
-  if (std::filesystem::is_directory(p, ec)) throw std::runtime_error(path + ": cannot write the model: it is a folder");
+  if (std::filesystem::is_directory(p, ec))
+    throw ExitError(ExitCode::CantCreate, path + ": cannot write the model: it is a folder");
   const std::filesystem::path folder = p.parent_path().empty() ? std::filesystem::path(".") : p.parent_path();
   if (!std::filesystem::is_directory(folder, ec))
-    throw std::runtime_error(path + ": cannot write the model: " + folder.string() +
-                             (std::filesystem::exists(folder, ec) ? " is not a folder" : ": folder does not exist"));
+    throw ExitError(ExitCode::CantCreate,
+                    path + ": cannot write the model: " + folder.string() +
+                        (std::filesystem::exists(folder, ec) ? " is not a folder" : ": folder does not exist"));
   formats::checkOutputTarget(path, {input});  // a FIFO, a device, the input itself
   if (::access(folder.c_str(), W_OK) != 0)
-    throw std::runtime_error(path + ": cannot write the model in " + folder.string() + ": " + std::strerror(errno));
+    throw ExitError(ExitCode::CantCreate,
+                    path + ": cannot write the model in " + folder.string() + ": " + std::strerror(errno));
 }
 
 // The model axis of a checked column: gx, gy, gz (docs/model-check.md). The column of a

@@ -83,10 +83,10 @@ void requireRoomFor(std::size_t samples, std::uint64_t line_bytes, const formats
   const double needed = static_cast<double>(samples) * static_cast<double>(line_bytes) + 64.0;
   const std::uint64_t available = out.availableBytes();
   if (needed > static_cast<double>(available))
-    throw std::invalid_argument(out.target() + ": " + std::to_string(samples) + " samples need up to " +
-                                byteCount(needed) + " (" + std::to_string(line_bytes) +
-                                " bytes a line) but its filesystem has " + byteCount(static_cast<double>(available)) +
-                                " free");
+    throw ExitError(ExitCode::CantCreate, out.target() + ": " + std::to_string(samples) + " samples need up to " +
+                                              byteCount(needed) + " (" + std::to_string(line_bytes) +
+                                              " bytes a line) but its filesystem has " +
+                                              byteCount(static_cast<double>(available)) + " free");
 }
 
 int runSimulate(const SimulateOptions& opt) {
