@@ -6,6 +6,28 @@
 #include <string>
 
 namespace gyrod::driver {
+namespace {
+
+std::int64_t readNs(clockid_t clock) {
+  timespec ts{};
+  clock_gettime(clock, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * kNsPerSecond + ts.tv_nsec;
+}
+
+}  // namespace
+
+std::int64_t measureRealtimeOffsetNs(std::int64_t* uncertainty_ns) {
+  const std::int64_t before = readNs(CLOCK_MONOTONIC);
+  const std::int64_t real = readNs(CLOCK_REALTIME);
+  const std::int64_t after = readNs(CLOCK_MONOTONIC);
+  if (uncertainty_ns) *uncertainty_ns = (after - before + 1) / 2;
+  return real - (before + (after - before) / 2);
+}
+
+std::int64_t Clock::realtimeOffsetNs() const { return measureRealtimeOffsetNs(); }
+
+VirtualClock::VirtualClock(std::int64_t start_ns)
+    : now_ns_(start_ns), realtime_offset_ns_(readNs(CLOCK_REALTIME) - start_ns) {}
 
 void VirtualClock::advanceNs(std::int64_t delta_ns) {
   if (delta_ns < 0) {
@@ -22,10 +44,6 @@ void VirtualClock::setNs(std::int64_t t_ns) {
   now_ns_ = t_ns;
 }
 
-std::int64_t MonotonicClock::nowNs() const {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * kNsPerSecond + ts.tv_nsec;
-}
+std::int64_t MonotonicClock::nowNs() const { return readNs(CLOCK_MONOTONIC); }
 
 }  // namespace gyrod::driver

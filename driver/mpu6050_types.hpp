@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
 #include <string_view>
 
@@ -24,6 +25,12 @@ struct GyroSample {
   double temp_c = 0.0;                     // die temperature, °C
   std::array<std::int16_t, 3> raw_gyro{};  // the frame's words, for recording and tests
   std::int16_t raw_temp = 0;
+  // x, y, z specific force [g] from the same FIFO frame; NaN when the FIFO carries no accel.
+  std::array<double, 3> accel_g{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
+                                std::numeric_limits<double>::quiet_NaN()};
+  std::array<std::int16_t, 3> raw_accel{};
+  // CLOCK_REALTIME ns at the same data-ready edge as t_ns; 0 when unknown.
+  std::int64_t wall_ns = 0;
 };
 
 enum class GapCause : std::uint8_t {

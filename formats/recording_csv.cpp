@@ -9,6 +9,7 @@
 #include <cstring>
 #include <istream>
 #include <iterator>
+#include <limits>
 #include <memory>
 #include <span>
 #include <sstream>
@@ -23,6 +24,16 @@ namespace gyrod::recording {
 namespace {
 
 constexpr std::array<std::string_view, 8> kKnownColumns = {"t", "gx", "gy", "gz", "temp", "wx", "wy", "wz"};
+// gyrod's columns a sample may leave empty (recording_format.hpp): read as NaN then.
+constexpr std::array<std::string_view, 8> kStreamColumns = {"time",    "gx_rate", "gy_rate", "gz_rate",
+                                                            "gx_bias", "gy_bias", "gz_bias", "still"};
+
+std::vector<double>* streamColumn(Recording& rec, std::size_t index) {
+  if (index == 0) return &rec.time;
+  if (index <= 3) return &rec.rate[index - 1];
+  if (index <= 6) return &rec.bias[index - 4];
+  return &rec.still;
+}
 
 [[noreturn]] void fail(const std::string& path, std::size_t line, const std::string& cause) {
   std::ostringstream s;
@@ -115,7 +126,7 @@ std::size_t expectedLines(std::FILE* file, std::size_t line_bytes) {
   return static_cast<std::size_t>(st.st_size) / std::max<std::size_t>(line_bytes, 1) * 3 / 2 + 16;
 }
 
-enum class Role { T, Axis, Temp, Truth };
+enum class Role { T, Axis, Temp, Truth, Stream };
 using ColumnRole = std::pair<Role, std::size_t>;  // what a column feeds, and which axis
 
 // The columns of a header line; fills rec.axis_names and sizes rec.axes.
@@ -128,12 +139,16 @@ std::vector<ColumnRole> headerRoles(const std::string& path, std::size_t line_no
     fail(path, line_no,
          formats::quotedValue(names[0]) + " is neither a number nor a header of columns t,gx,gy,gz,temp");
   for (auto name : names) {
-    if (std::find(kKnownColumns.begin(), kKnownColumns.end(), name) == kKnownColumns.end())
+    const auto stream = std::find(kStreamColumns.begin(), kStreamColumns.end(), name);
+    if (stream == kStreamColumns.end() &&
+        std::find(kKnownColumns.begin(), kKnownColumns.end(), name) == kKnownColumns.end())
       fail(path, line_no,
            "unknown column " + formats::quotedValue(name) + " (expected any of t,gx,gy,gz,temp,wx,wy,wz)");
     for (std::size_t j = 0; j < roles.size(); ++j)
       if (names[j] == name) fail(path, line_no, "column '" + std::string(name) + "' appears twice");
-    if (name == "t") {
+    if (stream != kStreamColumns.end()) {
+      roles.push_back({Role::Stream, static_cast<std::size_t>(stream - kStreamColumns.begin())});
+    } else if (name == "t") {
       roles.push_back({Role::T, 0});
     } else if (name == "temp") {
       roles.push_back({Role::Temp, 0});
@@ -228,22 +243,24 @@ Recording parseRecordingFile(std::FILE* file, const std::string& path, const Rea
   std::vector<std::vector<double>*> targets;
   targets.reserve(roles.size());
   for (const auto& [role, index] : roles) {
-    targets.push_back(role == Role::T      ? &rec.t
-                      : role == Role::Temp ? &rec.temp
-                      : role == Role::Axis ? &rec.axes[index]
-                                           : &rec.true_rate[index]);
+    targets.push_back(role == Role::T        ? &rec.t
+                      : role == Role::Temp   ? &rec.temp
+                      : role == Role::Axis   ? &rec.axes[index]
+                      : role == Role::Stream ? streamColumn(rec, index)
+                                             : &rec.true_rate[index]);
   }
   const auto columnName = [&](std::size_t c) {
     const auto [role, index] = roles[c];
-    return bare_numbers          ? std::string("value")
-           : role == Role::T     ? std::string("t")
-           : role == Role::Temp  ? std::string("temp")
-           : role == Role::Truth ? std::string(kTruthColumns[index])
-                                 : rec.axis_names[index];
+    return bare_numbers           ? std::string("value")
+           : role == Role::T      ? std::string("t")
+           : role == Role::Temp   ? std::string("temp")
+           : role == Role::Truth  ? std::string(kTruthColumns[index])
+           : role == Role::Stream ? std::string(kStreamColumns[index])
+                                  : rec.axis_names[index];
   };
 
   bool reserved = false;
-  std::array<std::string_view, kKnownColumns.size()> fields;
+  std::array<std::string_view, kKnownColumns.size() + kStreamColumns.size()> fields;
   auto consume = [&](std::string_view line) {
     if (!reserved) {
       reserved = true;
@@ -263,6 +280,10 @@ Recording parseRecordingFile(std::FILE* file, const std::string& path, const Rea
         rec.line_runs.back().first_line + (sample - rec.line_runs.back().first_sample) != line_no)
       rec.line_runs.push_back({sample, line_no});
     for (std::size_t c = 0; c < count; ++c) {
+      if (fields[c].empty() && roles[c].first == Role::Stream) {  // a value the sample did not have
+        targets[c]->push_back(std::numeric_limits<double>::quiet_NaN());
+        continue;
+      }
       const auto value = parseNumber(fields[c]);
       if (!value)
         fail(path, line_no, "column '" + columnName(c) + "': " + formats::quotedValue(fields[c]) + " is not a number");

@@ -9,6 +9,7 @@ inline constexpr double kSecondsPerHour = 3600.0;
 inline constexpr double kSqrtSecondsPerSqrtHour = 60.0;  // √3600
 inline constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 inline constexpr double kRadPerDeg = std::numbers::pi / 180.0;
+inline constexpr double kStandardGravity = 9.80665;  // m/s² per g (CGPM 1901)
 
 inline constexpr double degPerHourToDegPerSecond(double v) { return v / kSecondsPerHour; }
 inline constexpr double degPerSecondToDegPerHour(double v) { return v * kSecondsPerHour; }
