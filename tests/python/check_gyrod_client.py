@@ -52,7 +52,7 @@ def rate_table_fields():
     with open(doc, encoding="utf-8") as f:
         text = f.read()
     table = text.split("### RATE", 1)[1].split("\n\n", 2)[1]
-    return [m.group(1) for m in re.finditer(r"^\| `([a-z_]+)` \|", table, re.MULTILINE) if m.group(1) != "class"]
+    return [m.group(1) for m in re.finditer(r"^\| `([a-z0-9_]+)` \|", table, re.MULTILINE) if m.group(1) != "class"]
 
 
 def check_rate_fields_are_the_documented_ones():
