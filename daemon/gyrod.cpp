@@ -66,6 +66,22 @@ Vec3 modelBias(const std::string& path) {
   return {model.axes[0].bias_dps, model.axes[1].bias_dps, model.axes[2].bias_dps};
 }
 
+// A published sample as the recording holds it: the same values, so the file is the stream.
+recording::SampleValues recordedSample(const RateSample& r, std::int64_t wall_ns) {
+  recording::SampleValues v;
+  v.t_s = r.t_s;
+  v.gx_dps = r.raw_dps[0];
+  v.gy_dps = r.raw_dps[1];
+  v.gz_dps = r.raw_dps[2];
+  v.temp_c = r.temp_c;
+  v.wall_ns = wall_ns;
+  v.accel_g = r.accel_g;
+  v.rate_dps = r.rate_dps;
+  v.bias_dps = r.bias_dps;
+  v.still = r.still ? static_cast<std::int8_t>(*r.still) : std::int8_t{-1};
+  return v;
+}
+
 }  // namespace
 
 // The rate stream's parameters from filter.model, exactly as `gyroctl filter --model` builds
@@ -149,10 +165,15 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
     RecorderOptions options = recorderOptions(config_.record, recordedSamplesPerSecond(config_));
     options.header_comments.push_back("gyrod " + std::string(GYROD_RELEASE) + " recording of " + device_.description);
     options.header_comments.push_back(
-        "raw rates as read from the chip (bias not removed); GAP lines mark lost samples");
+        "gx,gy,gz: raw rates as read from the chip (bias not removed); t: CLOCK_MONOTONIC s of the data-ready edge; "
+        "time: the same edge in UTC epoch s; GAP lines mark lost samples");
+    options.header_comments.push_back(
+        "gx_rate..still: the RATE stream's rate, bias and still as published (docs/recording-format.md)");
     if (rate_model_.params)  // the recording holds what the rate stream was fed, at full precision
-      options.header_comments.push_back("the RATE stream's rate, bias and still: gyroctl filter FILE --model " +
-                                        config_.filter.model + " --rate " + formats::shortest(config_.device.rate_hz));
+      options.header_comments.push_back("recompute them: gyroctl filter FILE --model " + config_.filter.model +
+                                        " --rate " + formats::shortest(config_.device.rate_hz));
+    options.columns.time = true;
+    options.columns.rate = true;
     recorder_ = std::make_unique<Recorder>(options);
   }
 
@@ -305,8 +326,10 @@ void Gyrod::onSample(const driver::GyroSample& s) {
     r.bias_dps = {kNaN, kNaN, kNaN};
   }
   r.still = out.still;
+  r.time_s = s.wall_ns != 0 ? static_cast<double>(s.wall_ns) * 1e-9 : kNaN;
+  r.accel_g = s.accel_g;
   server_->publishRate(r);
-  if (recorder_) recorder_->pushSample(r.t_s, r.raw_dps[0], r.raw_dps[1], r.raw_dps[2], r.temp_c);
+  if (recorder_) recorder_->pushSample(recordedSample(r, s.wall_ns));
   ++samples_published_;
   last_temp_c_ = r.temp_c;
   last_t_s_ = r.t_s;

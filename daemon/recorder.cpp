@@ -24,7 +24,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr std::size_t kMaxHeaderBytes = 2048;  // < any page size: the header is written in one write()
+// Header and a first line (RecordingLine, 512 bytes) fit in one page of any size (≥ 4096): written in one write().
+constexpr std::size_t kMaxHeaderBytes = 2048;
 
 std::int64_t steadyNowNs() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
@@ -84,7 +85,9 @@ Recorder::Recorder(RecorderOptions options) : options_(std::move(options)), ring
     throw std::invalid_argument("Recorder: flush_interval_s must be > 0 (got " +
                                 std::to_string(options_.flush_interval_s) + ")");
   if (!(options_.rotate_after_s >= 0.0)) throw std::invalid_argument("Recorder: rotate_after_s must be ≥ 0");
-  std::size_t header_bytes = recording::kColumnsLine.size() + 128;
+  recording::SampleColumns all_columns = options_.columns;
+  all_columns.accel = true;
+  std::size_t header_bytes = recording::columnsLine(all_columns).size() + 128;
   for (const auto& c : options_.header_comments) {
     if (c.find('\n') != std::string::npos) throw std::invalid_argument("Recorder: a header comment contains a newline");
     header_bytes += c.size() + 3;
@@ -110,22 +113,30 @@ Recorder::Recorder(RecorderOptions options) : options_(std::move(options)), ring
     throw RecorderError(options_.path + ": cannot create recording file in " + directory_ + ": " +
                         std::strerror(errno));
   }
+  columns_ = options_.columns;
+  columns_.accel = false;
   in_error_ = false;
   writer_ = std::thread([this] { writerLoop(); });
 }
 
 Recorder::~Recorder() { stop(); }
 
-bool Recorder::pushSample(double t_s, double gx_dps, double gy_dps, double gz_dps, double temp_c) noexcept {
+bool Recorder::pushSample(const recording::SampleValues& sample) noexcept {
   RecorderRecord r;
   r.kind = RecorderRecord::Kind::Sample;
   r.dropped_before = pending_drops_;
-  r.t_s = t_s;
-  r.gx_dps = gx_dps;
-  r.gy_dps = gy_dps;
-  r.gz_dps = gz_dps;
-  r.temp_c = temp_c;
+  r.sample = sample;
   return pushRecord(r);
+}
+
+bool Recorder::pushSample(double t_s, double gx_dps, double gy_dps, double gz_dps, double temp_c) noexcept {
+  recording::SampleValues v;
+  v.t_s = t_s;
+  v.gx_dps = gx_dps;
+  v.gy_dps = gy_dps;
+  v.gz_dps = gz_dps;
+  v.temp_c = temp_c;
+  return pushSample(v);
 }
 
 bool Recorder::pushRecord(const RecorderRecord& r) noexcept {
@@ -145,7 +156,7 @@ bool Recorder::pushGap(std::uint64_t seq, double t_s, std::uint32_t count, std::
   r.dropped_before = pending_drops_;
   r.gap_seq = seq;
   r.gap_count = count;
-  r.t_s = t_s;
+  r.sample.t_s = t_s;
   const std::size_t n = std::min(reason.size(), sizeof r.gap_reason - 1);
   for (std::size_t i = 0; i < n; ++i) r.gap_reason[i] = recording::reasonCharacter(reason[i]);
   r.gap_reason[n] = '\0';
@@ -258,16 +269,32 @@ void Recorder::flushOnce(bool final_flush) {
   };
   while (ring_.tryPop(r)) {
     if (r.dropped_before > 0) dropLine(r.dropped_before);
-    if (r.kind == RecorderRecord::Kind::Gap)
-      appendLine(recording::formatGapLine(line, r.gap_seq, r.t_s, r.gap_count, std::string_view(r.gap_reason)), true);
-    else
-      appendLine(recording::formatSampleLine(line, r.t_s, r.gx_dps, r.gy_dps, r.gz_dps, r.temp_c), true);
+    if (r.kind == RecorderRecord::Kind::Gap) {
+      appendLine(recording::formatGapLine(line, r.gap_seq, r.sample.t_s, r.gap_count, std::string_view(r.gap_reason)),
+                 true);
+      continue;
+    }
+    if (!columns_known_) {  // the first sample: does the device give accel?
+      const auto& a = r.sample.accel_g;
+      columns_.accel = std::isfinite(a[0]) && std::isfinite(a[1]) && std::isfinite(a[2]);
+      columns_known_ = true;
+    }
+    appendLine(recording::formatSampleLine(line, columns_, r.sample), true);
   }
   if (final_flush) {
     const auto unreported = dropped_.load(std::memory_order_relaxed) - drops_reported_;
     if (unreported > 0) dropLine(unreported);
+    columns_known_ = true;  // no sample came: the file says so with the columns it would have had
+  }
+  if (!columns_known_) {  // GAP/DROPPED lines before the first sample wait for the column line
+    flushes_.fetch_add(1, std::memory_order_release);
+    return;
   }
   writePending();
+  if (final_flush && fd_ >= 0 && file_bytes_ == 0) {  // a file without a sample still says what it is
+    page_ = headerText();
+    emitPage();
+  }
   if (options_.fsync_each_flush && fd_ >= 0 && ::fdatasync(fd_) != 0) reportError("fdatasync", errno);
   flushes_.fetch_add(1, std::memory_order_release);
 }
@@ -315,6 +342,9 @@ void Recorder::writePending() {
         continue;
       }
     }
+    // The header goes with the first lines of a file, in the same write (it is shorter than
+    // kMaxHeaderBytes, far less than a page, so header and line fit in page 0).
+    if (file_bytes_ == 0 && page_.empty()) page_ = headerText();
     // Keep every line inside one page of the file: pad the rest of the page if it does
     // not fit. Padding is a comment line ("#" and spaces) or, for one byte, an empty line.
     const std::size_t room = page_size_ - static_cast<std::size_t>((file_bytes_ + page_.size()) % page_size_);
@@ -398,20 +428,11 @@ bool Recorder::openNextFile(const std::string& previous_name) {
     errno = e;
     return false;
   }
-  std::string header = recording::recordingHeaderComments(now, previous_name, options_.header_comments);
-  header += recording::kColumnsLine;
-  // One write() of less than a page at offset 0: lands whole or not at all.
-  const ssize_t n = ::write(fd, header.data(), header.size());
-  if (n != static_cast<ssize_t>(header.size())) {
-    const int e = n < 0 ? errno : EIO;
-    ::close(fd);
-    ::unlink(path.c_str());
-    reportError("write header to " + path, e);
-    errno = e;
-    return false;
-  }
+  // The header is written with the file's first lines (writePending), when the columns are known.
   fd_ = fd;
-  file_bytes_ = header.size();
+  file_bytes_ = 0;
+  file_opened_unix_s_ = now;
+  previous_file_ = previous_name;
   file_records_ = 0;
   file_opened_ns_ = steadyNowNs();
   {
@@ -422,6 +443,12 @@ bool Recorder::openNextFile(const std::string& previous_name) {
   spdlog::info("recorder: writing {}", path);
   pruneOldFiles();
   return true;
+}
+
+// The column line first (genfromtxt's names=True reads the first line), then the comments.
+std::string Recorder::headerText() const {
+  return recording::columnsLine(columns_) +
+         recording::recordingHeaderComments(file_opened_unix_s_, previous_file_, options_.header_comments);
 }
 
 void Recorder::closeFile() {

@@ -1,8 +1,9 @@
 #pragma once
-// Recording of raw samples to CSV files that `gyroctl analyze` reads. The lines are
-// formats/recording_format.hpp's: a header "t,gx,gy,gz,temp" (s, °/s, °/s, °/s, °C), one
-// line per sample with every value in its shortest round-trip form (reads back bit-exact),
-// and '#' comment lines for everything else:
+// Recording of samples to CSV files that `gyroctl analyze` reads. The lines are
+// formats/recording_format.hpp's (docs/recording-format.md): the column line first,
+// "t,gx,gy,gz,temp" (s, °/s, °/s, °/s, °C) then the optional columns the options and the
+// samples ask for (time; ax,ay,az; the rate stream), one line per sample with every value in
+// its shortest round-trip form (reads back bit-exact), and '#' comment lines for the rest:
 //   # GAP seq=123 t=2.46 count=4 reason=fifo_overflow     samples the device lost
 //   # DROPPED count=7 reason=ring_full                     samples the recorder lost:
 //                                                          ring_full (the writer fell behind),
@@ -11,6 +12,11 @@
 // A loss to a failed write is announced by a DROPPED line at the next write that succeeds
 // (in the same file, or the next one after a rotation); while the disk stays full no line
 // can say so, and the counts (stats(), STATUS "recorder", the shutdown line) do.
+//
+// Whether a file has ax,ay,az is decided by the first sample pushed (accel or not: the
+// device's FIFO either carries it or not), so the column line, and with it the header, is
+// written with the first lines of the file, not when the file is created. Until a first
+// sample comes, GAP and DROPPED lines wait in memory.
 // This file owns the ring, the writer thread, the files and their rotation.
 //
 // The event loop pushes fixed-size records into a preallocated single-producer /
@@ -28,7 +34,9 @@
 //  - Files end with whole lines after a kill -9: a line never crosses a page boundary of
 //    the file (padding lines "#   ...   " fill the rest of a page when the next line does
 //    not fit), and each write() covers at most one page. Linux checks for a fatal signal
-//    only between the pages of a write, so each write() lands whole or not at all.
+//    only between the pages of a write, so each write() lands whole or not at all. The
+//    padding is an ordinary '#' comment (a lone '\n' when one byte is left), which numpy's
+//    genfromtxt(comments='#') and pandas' read_csv(comment='#') skip.
 #include <atomic>
 #include <condition_variable>
 #include <cstddef>
@@ -65,7 +73,10 @@ struct RecorderOptions {
   double flush_interval_s = 1.0;     // > 0
   bool fsync_each_flush = false;
   std::size_t keep = 0;                      // files of this base name to keep (oldest deleted); 0 = all
-  std::vector<std::string> header_comments;  // written as "# ..." lines at the top of each file
+  std::vector<std::string> header_comments;  // written as "# ..." lines after the column line of each file
+  // The `time` and rate-stream columns (formats/recording_format.hpp); `accel` is ignored:
+  // ax,ay,az are there when the first sample has accel.
+  recording::SampleColumns columns;
 };
 
 // Options for [record]: sizes converted, ring sized for 4 flush intervals at rate_hz
@@ -90,10 +101,8 @@ struct RecorderRecord {
   std::uint32_t gap_count = 0;       // Gap: samples missing
   std::uint64_t dropped_before = 0;  // records dropped (ring full) just before this one
   std::uint64_t gap_seq = 0;         // Gap: sequence number of the first missing sample
-  double t_s = 0.0;
-  double gx_dps = 0.0, gy_dps = 0.0, gz_dps = 0.0;
-  double temp_c = 0.0;
-  char gap_reason[24] = {};  // Gap: NUL-terminated (truncated) reason token
+  recording::SampleValues sample;    // Sample: its values; Gap: sample.t_s is the first missing sample's time
+  char gap_reason[24] = {};          // Gap: NUL-terminated (truncated) reason token
 };
 
 class Recorder {
@@ -108,14 +117,17 @@ class Recorder {
 
   // Producer side: call from one thread only (the event loop). Wait-free: no allocation,
   // no lock, no system call. False when the ring is full (counted in stats().dropped).
+  bool pushSample(const recording::SampleValues& sample) noexcept;
+  // A sample of t,gx,gy,gz,temp alone (no time, accel or rate values).
   bool pushSample(double t_s, double gx_dps, double gy_dps, double gz_dps, double temp_c) noexcept;
   // A gap of `count` samples starting at sequence number `seq` (time t_s of the first
   // missing sample); `reason` is a short token such as "fifo_overflow" (characters other
   // than [A-Za-z0-9_.-] become '_', longer than 23 characters is truncated).
   bool pushGap(std::uint64_t seq, double t_s, std::uint32_t count, std::string_view reason) noexcept;
 
-  // Blocks until the writer has written everything pushed before the call. Not for the
-  // event loop (it waits for disk I/O); for shutdown paths and tests.
+  // Blocks until the writer has written everything pushed before the call (GAP lines before
+  // the first sample excepted: they wait for it, see above). Not for the event loop (it waits
+  // for disk I/O); for shutdown paths and tests.
   void flush();
   // Writes what is left (and a final DROPPED line if records were dropped since the
   // last pushed record), fdatasyncs and closes the file, joins the writer. Idempotent.
@@ -140,6 +152,7 @@ class Recorder {
   void appendLine(std::string_view line, bool is_record, std::uint64_t announces_lost = 0,
                   std::uint64_t announces_drops = 0);
   void announceLosses(recording::RecordingLine& line);
+  std::string headerText() const;
   void writePending();
   void emitPage();
   void clearPage();
@@ -163,6 +176,11 @@ class Recorder {
   std::uint64_t file_records_ = 0;   // sample/gap lines in the current file
   std::int64_t file_opened_ns_ = 0;  // steady clock
   std::uint64_t next_index_ = 0;
+  std::int64_t file_opened_unix_s_ = 0;  // for the header's "opened" comment
+  std::string previous_file_;            // for the header's "continues" comment
+  // The file's columns: `accel` from the first sample; until then none is written.
+  recording::SampleColumns columns_;
+  bool columns_known_ = false;
   std::uint64_t drops_reported_ = 0;         // dropped records announced (or in lines on their way to a file)
   std::uint64_t drops_unwritten_ = 0;        // of those, announced in a page whose write failed: to announce again
   const char* loss_reason_ = "write_error";  // the cause of the last failed write (a DROPPED reason)

@@ -346,11 +346,13 @@ bool Mpu6050Driver::determineSegmentBase(std::optional<std::int64_t> observation
 void Mpu6050Driver::deliverFrames(std::size_t frames) {
   const FifoFrames burst(std::span<const std::uint8_t>(fifo_bytes_.data(), frames * frame_bytes_), frame_bytes_);
   GyroSample s;
+  const std::int64_t realtime_offset_ns = clock_.realtimeOffsetNs();  // once per burst (driver/clock.hpp)
   for (std::size_t i = 0; i < frames; ++i) {
     s.seq = segment_base_ + segment_frames_ + i;
     std::int64_t t = sample_clock_.timeOf(s.seq);
     if (t <= last_t_ns_) t = last_t_ns_ + 1;  // strictly increasing, even across a re-anchor
     s.t_ns = t;
+    s.wall_ns = t + realtime_offset_ns;
     last_t_ns_ = t;
     convertFifoFrame(burst[i], gyro_lsb_per_dps_, s, accel_lsb_per_g_);
     sink_.onSample(s);

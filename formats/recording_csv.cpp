@@ -9,6 +9,7 @@
 #include <cstring>
 #include <istream>
 #include <iterator>
+#include <limits>
 #include <memory>
 #include <span>
 #include <sstream>
@@ -25,6 +26,16 @@ namespace {
 
 constexpr std::array<std::string_view, 11> kKnownColumns = {"t",  "gx", "gy", "gz", "temp", "wx",
                                                             "wy", "wz", "ax", "ay", "az"};
+// gyrod's columns a sample may leave empty (recording_format.hpp): read as NaN then.
+constexpr std::array<std::string_view, 8> kStreamColumns = {"time",    "gx_rate", "gy_rate", "gz_rate",
+                                                            "gx_bias", "gy_bias", "gz_bias", "still"};
+
+std::vector<double>* streamColumn(Recording& rec, std::size_t index) {
+  if (index == 0) return &rec.time;
+  if (index <= 3) return &rec.rate[index - 1];
+  if (index <= 6) return &rec.bias[index - 4];
+  return &rec.still;
+}
 
 [[noreturn]] void fail(const std::string& path, std::size_t line, const std::string& cause) {
   std::ostringstream s;
@@ -146,7 +157,7 @@ std::size_t expectedLines(std::FILE* file, std::size_t line_bytes) {
   return static_cast<std::size_t>(st.st_size) / std::max<std::size_t>(line_bytes, 1) * 3 / 2 + 16;
 }
 
-enum class Role { T, Axis, Temp, Truth, Accel };
+enum class Role { T, Axis, Temp, Truth, Accel, Stream };
 using ColumnRole = std::pair<Role, std::size_t>;  // what a column feeds, and which axis
 
 // The columns of a header line; fills rec.axis_names and sizes rec.axes.
@@ -159,12 +170,16 @@ std::vector<ColumnRole> headerRoles(const std::string& path, std::size_t line_no
     fail(path, line_no,
          formats::quotedValue(names[0]) + " is neither a number nor a header of columns t,gx,gy,gz,temp");
   for (auto name : names) {
-    if (std::find(kKnownColumns.begin(), kKnownColumns.end(), name) == kKnownColumns.end())
+    const auto stream = std::find(kStreamColumns.begin(), kStreamColumns.end(), name);
+    if (stream == kStreamColumns.end() &&
+        std::find(kKnownColumns.begin(), kKnownColumns.end(), name) == kKnownColumns.end())
       fail(path, line_no,
            "unknown column " + formats::quotedValue(name) + " (expected any of t,gx,gy,gz,temp,wx,wy,wz,ax,ay,az)");
     for (std::size_t j = 0; j < roles.size(); ++j)
       if (names[j] == name) fail(path, line_no, "column '" + std::string(name) + "' appears twice");
-    if (name == "t") {
+    if (stream != kStreamColumns.end()) {
+      roles.push_back({Role::Stream, static_cast<std::size_t>(stream - kStreamColumns.begin())});
+    } else if (name == "t") {
       roles.push_back({Role::T, 0});
     } else if (name == "temp") {
       roles.push_back({Role::Temp, 0});
@@ -200,6 +215,7 @@ struct SliceResult {
 // GAP/DROPPED records, the line length limit, one column for bare numbers.
 struct SliceParser {
   std::vector<std::string> column_names;  // for messages ("value" for bare numbers)
+  std::vector<bool> may_be_empty;         // gyrod's stream columns: an empty field is NaN
   bool bare_numbers = false;
   bool line_numbers = false;
   std::size_t max_bytes = kMaxLineBytes;
@@ -208,7 +224,7 @@ struct SliceParser {
   // stopping at the first bad line.
   void parse(std::string_view text, SliceResult& out) const {
     out.columns.resize(column_names.size());
-    std::array<std::string_view, kKnownColumns.size()> fields;
+    std::array<std::string_view, kKnownColumns.size() + kStreamColumns.size()> fields;
     std::size_t start = 0;
     while (start < text.size()) {
       const auto nl = text.find('\n', start);
@@ -247,6 +263,10 @@ struct SliceParser {
       return false;
     }
     for (std::size_t c = 0; c < count; ++c) {
+      if (fields[c].empty() && may_be_empty[c]) {  // a value the sample did not have
+        out.columns[c].push_back(std::numeric_limits<double>::quiet_NaN());
+        continue;
+      }
       const auto value = parseNumber(fields[c]);
       if (!value) {
         out.error = "column '" + column_names[c] + "': " + formats::quotedValue(fields[c]) + " is not a number";
@@ -393,27 +413,32 @@ Recording parseRecordingFile(std::FILE* file, const std::string& path, const Rea
   std::vector<std::vector<double>*> targets;
   targets.reserve(roles.size());
   for (const auto& [role, index] : roles) {
-    targets.push_back(role == Role::T       ? &rec.t
-                      : role == Role::Temp  ? &rec.temp
-                      : role == Role::Axis  ? &rec.axes[index]
-                      : role == Role::Accel ? &rec.accel_g[index]
-                                            : &rec.true_rate[index]);
+    targets.push_back(role == Role::T        ? &rec.t
+                      : role == Role::Temp   ? &rec.temp
+                      : role == Role::Axis   ? &rec.axes[index]
+                      : role == Role::Accel  ? &rec.accel_g[index]
+                      : role == Role::Stream ? streamColumn(rec, index)
+                                             : &rec.true_rate[index]);
   }
   const auto columnName = [&](std::size_t c) {
     const auto [role, index] = roles[c];
-    return bare_numbers          ? std::string("value")
-           : role == Role::T     ? std::string("t")
-           : role == Role::Temp  ? std::string("temp")
-           : role == Role::Truth ? std::string(kTruthColumns[index])
-           : role == Role::Accel ? std::string(kAccelColumns[index])
-                                 : rec.axis_names[index];
+    return bare_numbers           ? std::string("value")
+           : role == Role::T      ? std::string("t")
+           : role == Role::Temp   ? std::string("temp")
+           : role == Role::Truth  ? std::string(kTruthColumns[index])
+           : role == Role::Accel  ? std::string(kAccelColumns[index])
+           : role == Role::Stream ? std::string(kStreamColumns[index])
+                                  : rec.axis_names[index];
   };
 
   SliceParser parser;
   parser.bare_numbers = bare_numbers;
   parser.line_numbers = options.line_numbers;
   parser.max_bytes = reader.maxBytes();
-  for (std::size_t c = 0; c < roles.size(); ++c) parser.column_names.push_back(columnName(c));
+  for (std::size_t c = 0; c < roles.size(); ++c) {
+    parser.column_names.push_back(columnName(c));
+    parser.may_be_empty.push_back(roles[c].first == Role::Stream);
+  }
   bool reserved = false;
   // Appends a parsed slice whose text starts at byte `text_start` of the file after line line_no.
   const auto append = [&](std::string_view text, std::uint64_t text_start, const SliceResult& slice) {

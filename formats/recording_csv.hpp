@@ -1,7 +1,10 @@
 #pragma once
 // Recording files: CSV with a header naming any of the columns t,gx,gy,gz,temp
 // (seconds, °/s, °/s, °/s, °C) and, in what `gyroctl simulate --motion` writes, the true
-// rates wx,wy,wz (°/s), and the accelerometer's ax,ay,az (g) when it was recorded, or a file of bare numbers (one column, one axis). Lines
+// rates wx,wy,wz (°/s), the accelerometer's ax,ay,az (g) when it was recorded, and in what
+// gyrod records, the wall clock `time` and the rate stream gx_rate..gz_rate, gx_bias..gz_bias,
+// still (recording_format.hpp, where an empty field is a value the sample did not have); or a
+// file of bare numbers (one column, one axis). Lines
 // starting with '#' are comments; the "# GAP" and "# DROPPED" lines gyrod writes
 // (recording_format.hpp) are returned as LostSamples records, and a line that only looks
 // like one (say "# GAP at 12 s") stays an ordinary comment, as every '#' line always was.
@@ -36,6 +39,12 @@ struct Recording {
   std::array<std::vector<double>, 3> true_rate;
   // Accelerometer ax, ay, az [g] per axis; empty when absent.
   std::array<std::vector<double>, 3> accel_g;
+  // gyrod's recordings: the wall clock [UTC epoch s] of each sample; empty when absent.
+  std::vector<double> time;
+  // gyrod's recordings: the rate stream as published, rate and bias [°/s] per axis and still
+  // (1 still, 0 moving), NaN where the field is empty; each empty when its column is absent.
+  std::array<std::vector<double>, 3> rate, bias;
+  std::vector<double> still;
   std::vector<std::size_t> line_numbers;  // file line of each sample (empty without ReadOptions::line_numbers)
   // The same lines, compactly: a run starts wherever a sample's line does not follow the
   // previous sample's (after the header, a comment, an empty line).

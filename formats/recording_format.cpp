@@ -7,6 +7,8 @@
 #include <ctime>
 #include <system_error>
 
+#include "formats/recording_csv.hpp"  // kAccelColumns
+
 namespace gyrod::recording {
 namespace {
 
@@ -29,6 +31,10 @@ class LineWriter {
   // The shortest decimal form that reads back as the same double.
   LineWriter& number(double v) {
     p_ = std::to_chars(p_, end(), v).ptr;
+    return *this;
+  }
+  LineWriter& fixed(double v, int decimals) {
+    p_ = std::to_chars(p_, end(), v, std::chars_format::fixed, decimals).ptr;
     return *this;
   }
   LineWriter& number(std::uint64_t v) {
@@ -106,17 +112,59 @@ std::string recordingHeaderComments(std::int64_t opened_unix_seconds, std::strin
   return header;
 }
 
-std::string_view formatSampleLine(RecordingLine& line, double t_s, double gx_dps, double gy_dps, double gz_dps,
-                                  double temp_c) {
+std::string columnsLine(const SampleColumns& columns) {
+  std::string line(kColumnsLine.substr(0, kColumnsLine.size() - 1));
+  const auto add = [&](std::string_view name) { line.append(",").append(name); };
+  if (columns.time) add(kTimeColumn);
+  if (columns.accel)
+    for (const auto name : kAccelColumns) add(name);
+  if (columns.rate) {
+    for (const auto name : kRateColumns) add(name);
+    for (const auto name : kBiasColumns) add(name);
+    add(kStillColumn);
+  }
+  return line + "\n";
+}
+
+std::string_view formatSampleLine(RecordingLine& line, const SampleColumns& columns, const SampleValues& v) {
   LineWriter w(line);
-  const bool finite = std::isfinite(t_s) && std::isfinite(gx_dps) && std::isfinite(gy_dps) && std::isfinite(gz_dps) &&
-                      std::isfinite(temp_c);
+  const bool finite = std::isfinite(v.t_s) && std::isfinite(v.gx_dps) && std::isfinite(v.gy_dps) &&
+                      std::isfinite(v.gz_dps) && std::isfinite(v.temp_c);
   if (!finite) w.text("# NONFINITE ");
-  for (double v : {t_s, gx_dps, gy_dps, gz_dps, temp_c}) {
+  for (double x : {v.t_s, v.gx_dps, v.gy_dps, v.gz_dps, v.temp_c}) {
     if (!w.empty() && w.last() != ' ') w.character(',');
-    w.number(v);
+    w.number(x);
+  }
+  // An optional value: empty when the sample does not have it (NaN), never "nan".
+  const auto optional = [&](double x) {
+    w.character(',');
+    if (std::isfinite(x)) w.number(x);
+  };
+  if (columns.time) {
+    w.character(',');
+    // As RATE's "time": the double of the epoch seconds, with µs decimals.
+    if (v.wall_ns != 0) w.fixed(static_cast<double>(v.wall_ns) * 1e-9, kTimeDecimals);
+  }
+  if (columns.accel)
+    for (double x : v.accel_g) optional(x);
+  if (columns.rate) {
+    for (double x : v.rate_dps) optional(x);
+    for (double x : v.bias_dps) optional(x);
+    w.character(',');
+    if (v.still >= 0) w.character(v.still ? '1' : '0');
   }
   return w.finish();
+}
+
+std::string_view formatSampleLine(RecordingLine& line, double t_s, double gx_dps, double gy_dps, double gz_dps,
+                                  double temp_c) {
+  SampleValues v;
+  v.t_s = t_s;
+  v.gx_dps = gx_dps;
+  v.gy_dps = gy_dps;
+  v.gz_dps = gz_dps;
+  v.temp_c = temp_c;
+  return formatSampleLine(line, SampleColumns{}, v);
 }
 
 std::string_view formatGapLine(RecordingLine& line, std::uint64_t seq, double t_s, std::uint64_t count,

@@ -84,6 +84,8 @@ RateSample rateOf(const json& j) {
   r.rate_dps = triple(j, "rate");
   r.bias_dps = triple(j, "bias");
   r.still = optionalFlag(j, "RATE", "still");
+  r.time_s = realOr(j, "RATE", "time", kNaN);
+  r.accel_g = triple(j, "accel");  // "accel_ms2" is the same values × standard gravity
   return r;
 }
 

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "processing/units.hpp"
+
 namespace gyrod::protocol {
 namespace {
 
@@ -39,6 +41,16 @@ class FixedWriter {
       return;
     }
     const auto r = std::to_chars(p_, end_, v);
+    if (r.ec == std::errc()) p_ = r.ptr;
+  }
+  // Fixed notation with `decimals` digits after the point (a finite value); beyond 1e15 (a
+  // time 31 million years away) the shortest form, so the line stays within its bound.
+  void fixed(double v, int decimals) noexcept {
+    if (!(std::fabs(v) < 1e15)) {
+      number(v);
+      return;
+    }
+    const auto r = std::to_chars(p_, end_, v, std::chars_format::fixed, decimals);
     if (r.ec == std::errc()) p_ = r.ptr;
   }
   void triple(std::string_view key, const std::array<double, 3>& v) noexcept {
@@ -96,6 +108,14 @@ std::size_t formatRateLine(const RateSample& s, std::span<char, kMaxRateLineByte
   w.triple(R"(,"rate":[)", s.rate_dps);
   w.triple(R"(,"bias":[)", s.bias_dps);
   if (s.still) w.text(*s.still ? R"(,"still":true)" : R"(,"still":false)");
+  if (std::isfinite(s.time_s)) {
+    w.text(R"(,"time":)");
+    w.fixed(s.time_s, kRateTimeDecimals);
+  }
+  w.triple(R"(,"accel":[)", s.accel_g);
+  const auto& a = s.accel_g;
+  w.triple(R"(,"accel_ms2":[)",
+           {a[0] * units::kStandardGravity, a[1] * units::kStandardGravity, a[2] * units::kStandardGravity});
   w.text("}");
   const std::size_t n = w.size();
   out[n] = '\n';

@@ -49,6 +49,9 @@ struct RateSample {
   std::array<double, 3> rate_dps{kUnset, kUnset, kUnset};  // raw − bias_dps (then the optional low-pass) [°/s]
   std::array<double, 3> bias_dps{kUnset, kUnset, kUnset};  // b̂: the bias subtracted for rate [°/s]
   std::optional<bool> still;                               // the still detector's verdict; none = no detector
+  // Appended by issue 12 (protocol 1.3).
+  double time_s = kUnset;                                 // wall clock, UTC epoch seconds
+  std::array<double, 3> accel_g{kUnset, kUnset, kUnset};  // [g]
 };
 
 // Samples that will never come: seq, seq+1, ..., seq+count−1.
@@ -60,9 +63,12 @@ struct GapEvent {
 };
 inline constexpr std::size_t kMaxGapReasonBytes = 48;
 
-// Longest possible RATE line: 17 doubles of ≤ 24 characters in shortest round-trip form
-// (408), a 20-digit seq, the keys and punctuation (about 170) and the newline, rounded up.
-inline constexpr std::size_t kMaxRateLineBytes = 768;
+// Longest possible RATE line: 23 doubles of ≤ 24 characters in shortest round-trip form
+// (552), "time" (≤ 24: fixed with 6 decimals below 1e15, else shortest), a 20-digit seq,
+// the keys and punctuation (about 220) and the newline, rounded up.
+inline constexpr std::size_t kMaxRateLineBytes = 1024;
+// "time" is written with this many decimals: µs resolution (docs/protocol.md).
+inline constexpr int kRateTimeDecimals = 6;
 inline constexpr std::size_t kMaxGapLineBytes = 160;
 
 // Writes {"class":"RATE",...}\n into `out` and returns its length (newline included).

@@ -8,6 +8,7 @@ packages=(
   libspdlog-dev libi2c-dev libgpiod-dev libsystemd-dev
   libgtest-dev libbenchmark-dev
   gnuplot-nox systemd python3
+  python3-numpy python3-pandas
   clang-format clang-tidy
 )
 missing=()

@@ -33,7 +33,9 @@ class ProtocolError(Exception):
 
 @dataclass
 class Rate:
-    """One RATE line: angular rates in deg/s per axis [x, y, z], `t` on CLOCK_MONOTONIC (s)."""
+    """One RATE line: angular rates in deg/s per axis [x, y, z]; `t` is the sample's data-ready
+    edge on CLOCK_MONOTONIC (s, for intervals), `time` the same instant in UTC epoch seconds
+    (us resolution, for lining up with other machines); `accel` in g, `accel_ms2` in m/s^2."""
 
     seq: int
     t: float
@@ -44,6 +46,9 @@ class Rate:
     rate: Vector = None
     bias: Vector = None
     still: Optional[bool] = None
+    time: Optional[float] = None
+    accel: Vector = None
+    accel_ms2: Vector = None
     # Every field of the line, including those added by later protocol minor versions.
     fields: dict = field(default_factory=dict, repr=False)
 
@@ -58,8 +63,8 @@ class Gap:
     fields: dict = field(default_factory=dict, repr=False)
 
 
-_REAL_FIELDS = ("t", "temp")
-_VECTOR_FIELDS = ("raw", "mean", "kalman", "rate", "bias")
+_REAL_FIELDS = ("t", "temp", "time")
+_VECTOR_FIELDS = ("raw", "mean", "kalman", "rate", "bias", "accel", "accel_ms2")
 
 
 def _as_real(value):
@@ -180,6 +185,15 @@ def _format_vector(v: Vector) -> str:
     return " ".join("%9.4f" % x for x in v) if v else "%29s" % "-"
 
 
+def _format_time(time: Optional[float]) -> str:
+    if time is None:
+        return "%27s" % "-"
+    import datetime
+
+    utc = datetime.datetime.fromtimestamp(time, tz=datetime.timezone.utc)
+    return utc.strftime("%Y-%m-%dT%H:%M:%S.%fZ")
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     import argparse
 
@@ -191,13 +205,15 @@ def main(argv: Optional[List[str]] = None) -> int:
     args = parser.parse_args(argv)
     try:
         with Client(args.socket, timeout=None) as gyro:
-            print("# t: CLOCK_MONOTONIC seconds; rate = raw - bias, deg/s x y z", flush=True)
+            print("# t: CLOCK_MONOTONIC s of the data-ready edge; time: UTC; rate = raw - bias, deg/s x y z",
+                  flush=True)
             printed = 0
             for item in gyro.watch(args.decimate):
                 if isinstance(item, Gap):
                     print("# GAP seq %d count %d %s" % (item.seq, item.count, item.reason), flush=True)
                     continue
-                print("%8d %14.6f %s" % (item.seq, item.t, _format_vector(item.rate)), flush=True)
+                print("%8d %14.6f %s %s" % (item.seq, item.t, _format_time(item.time), _format_vector(item.rate)),
+                      flush=True)
                 printed += 1
                 if args.count and printed >= args.count:
                     return 0

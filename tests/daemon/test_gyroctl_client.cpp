@@ -192,6 +192,29 @@ TEST_F(GyroctlTest, WatchShowsRateFirstThenRawAndKalmanAndStillWhenGyrodSendsRat
   }
 }
 
+TEST_F(GyroctlTest, WatchHeaderSaysWhatTIsAndMapsItToUtc) {
+  const auto withTime = [](std::uint64_t k) {
+    protocol::RateSample s = syntheticSample(k);
+    s.time_s = 1795000000.25 + static_cast<double>(k) / 50.0;  // 2026-11-18T11:06:40.25Z
+    s.accel_g = {0.0, 0.0, 1.0};
+    return s;
+  };
+  startServer();
+  auto next = std::make_shared<std::uint64_t>(0);
+  loop_.addPeriodicTimer(200us, [this, next, withTime](std::uint64_t) {
+    if (server_->watcherCount() == 0) return;
+    server_->publishRate(withTime((*next)++));
+  });
+  const CommandResult r = run({"watch", "--socket", socketPath(), "--count", "1"});
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const auto lines = splitLines(r.out);
+  ASSERT_EQ(lines.size(), 2u) << r.out;
+  EXPECT_NE(lines[0].find("t: CLOCK_MONOTONIC s of the data-ready edge; time: UTC, t 12345.678 = "
+                          "2026-11-18T11:06:40.250000Z"),
+            std::string::npos)
+      << lines[0];
+}
+
 TEST_F(GyroctlTest, StatusHumanAndJson) {
   content_.status.device_state = "streaming";
   content_.status.samples = 1234;

@@ -100,7 +100,9 @@ TEST(Recorder, SamplesReadBackBitExactThroughTheRecordingReader) {
   EXPECT_TRUE(std::signbit(rec.axes[1].back()));  // -0 survives
   const auto text = readText(names[0]);
   EXPECT_NE(text.find("# device mock, rate_hz 50\n"), std::string::npos);
-  EXPECT_EQ(linesOf(text)[0].rfind("# gyrod recording, opened ", 0), 0u);
+  // The column line first (numpy's genfromtxt(names=True) takes the first line), then the comments.
+  EXPECT_EQ(linesOf(text)[0], "t,gx,gy,gz,temp");
+  EXPECT_EQ(linesOf(text)[1].rfind("# gyrod recording, opened ", 0), 0u);
 }
 
 TEST(Recorder, GapsAreCommentLinesInStreamOrder) {
@@ -434,4 +436,108 @@ TEST(RecorderCrash, KillNineLeavesWholeLinesAndEverythingFlushedBeforeIt) {
     std::cout << "kill after " << flushes_before_kill << " flushes: " << last_reported << " reported written, "
               << rec.size() << " in the file\n";
   }
+}
+
+namespace {
+
+gyrod::recording::SampleValues gyrodSample(int i, bool accel) {
+  gyrod::recording::SampleValues v;
+  v.t_s = i * 0.02;
+  v.gx_dps = 0.01 * i;
+  v.gy_dps = -1.0 / (i + 3);
+  v.gz_dps = 0.5;
+  v.temp_c = 25.0 + 0.001 * i;
+  v.wall_ns = 1'795'000'000'000'000'000 + std::int64_t{20'000'000} * i;
+  if (accel) v.accel_g = {0.001 * i, -0.002, 1.0};
+  if (i >= 5) {  // before: the start-up estimation (no rate yet)
+    v.rate_dps = {v.gx_dps + 3.34, v.gy_dps - 1.09, 1.0};
+    v.bias_dps = {-3.34, 1.09, -0.5};
+    v.still = static_cast<std::int8_t>(i % 2);
+  }
+  return v;
+}
+
+RecorderOptions gyrodOptions(const std::string& path) {
+  auto o = options(path);
+  o.columns.time = true;
+  o.columns.rate = true;
+  return o;
+}
+
+}  // namespace
+
+TEST(RecorderColumns, TheRateStreamAndTheWallClockAreRecordedAndReadBack) {
+  TempDir d;
+  std::string file;
+  {
+    Recorder rec(gyrodOptions(d.path("gyro.csv")));
+    file = rec.currentFile();
+    for (int i = 0; i < 20; ++i) ASSERT_TRUE(rec.pushSample(gyrodSample(i, false)));
+  }
+  const auto lines = linesOf(readText(file));
+  EXPECT_EQ(lines[0], "t,gx,gy,gz,temp,time,gx_rate,gy_rate,gz_rate,gx_bias,gy_bias,gz_bias,still");
+  EXPECT_EQ(lines[2], "0,0,-0.3333333333333333,0.5,25,1795000000.000000,,,,,,,");
+  const auto rec = readRecordingCsv(file);
+  ASSERT_EQ(rec.size(), 20u);
+  for (int i = 0; i < 20; ++i) {
+    const auto v = gyrodSample(i, false);
+    EXPECT_EQ(rec.t[i], v.t_s);
+    EXPECT_EQ(rec.axes[1][i], v.gy_dps);
+    EXPECT_NEAR(rec.time[i], 1795000000.0 + 0.02 * i, 1e-6) << i;
+    for (int a = 0; a < 3; ++a) {
+      if (i < 5) {
+        EXPECT_TRUE(std::isnan(rec.rate[a][i]) && std::isnan(rec.bias[a][i])) << i;
+      } else {
+        EXPECT_EQ(rec.rate[a][i], v.rate_dps[a]) << i;  // bit for bit
+        EXPECT_EQ(rec.bias[a][i], v.bias_dps[a]) << i;
+      }
+    }
+    if (i < 5)
+      EXPECT_TRUE(std::isnan(rec.still[i]));
+    else
+      EXPECT_EQ(rec.still[i], i % 2);
+  }
+}
+
+TEST(RecorderColumns, TheFirstSampleDecidesTheAccelColumns) {
+  TempDir d;
+  std::string file;
+  {
+    Recorder rec(gyrodOptions(d.path("gyro.csv")));
+    file = rec.currentFile();
+    // A gap before any sample waits for the column line, which must stay the first line.
+    rec.pushGap(0, 0.0, 2, "fifo_overflow");
+    rec.flush();
+    EXPECT_EQ(readText(file), "");
+    for (int i = 2; i < 10; ++i) ASSERT_TRUE(rec.pushSample(gyrodSample(i, true)));
+  }
+  const auto lines = linesOf(readText(file));
+  EXPECT_EQ(lines[0], "t,gx,gy,gz,temp,time,ax,ay,az,gx_rate,gy_rate,gz_rate,gx_bias,gy_bias,gz_bias,still");
+  EXPECT_EQ(lines[2], "# GAP seq=0 t=0 count=2 reason=fifo_overflow");
+  EXPECT_EQ(lines[3], "0.04,0.02,-0.2,0.5,25.002,1795000000.040000,0.002,-0.002,1,,,,,,,");
+  try {
+    const auto rec = readRecordingCsv(file);
+    EXPECT_EQ(rec.size(), 8u);
+    EXPECT_EQ(rec.time.size(), 8u);
+  } catch (const gyrod::recording::RecordingError& e) {
+    // Reading ax,ay,az is the accelerometer import's (kalibr's) part of issue 12; until it is merged
+    // the reader does not know them. The Python readers' test checks the values meanwhile.
+    if (std::string(e.what()).find("unknown column 'ax'") == std::string::npos) throw;
+    GTEST_SKIP() << "the CSV reader does not read ax,ay,az yet: " << e.what();
+  }
+}
+
+TEST(RecorderColumns, AFileWithoutSamplesStillHasItsHeader) {
+  TempDir d;
+  std::string file;
+  {
+    auto o = gyrodOptions(d.path("gyro.csv"));
+    o.header_comments = {"device mock"};
+    Recorder rec(o);
+    file = rec.currentFile();
+  }
+  const auto lines = linesOf(readText(file));
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_EQ(lines[0], "t,gx,gy,gz,temp,time,gx_rate,gy_rate,gz_rate,gx_bias,gy_bias,gz_bias,still");
+  EXPECT_EQ(lines[2], "# device mock");
 }

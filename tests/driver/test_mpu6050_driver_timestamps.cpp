@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 
 #include "driver/mock/mock_signal_source.hpp"
 #include "tests/driver/driver_rig.hpp"
@@ -128,4 +129,38 @@ TEST(Mpu6050DriverTimestamps, PollingModeTimestampsWithinAPeriodAndGapsWithinOne
 }
 
 }  // namespace
+
+// The wall clock of a sample is its t plus the clock's realtime offset, read once per burst
+// (driver/clock.hpp): on the virtual clock, a fixed offset, so wall − t is that offset exactly.
+TEST(Mpu6050DriverTimestamps, WallClockIsTheSameEdgeOnTheRealtimeClock) {
+  SinusoidSource source = movingSource();
+  DriverRig rig(source);
+  constexpr std::int64_t kOffset = 1'795'000'000'000'000'000;
+  rig.clock.setRealtimeOffsetNs(kOffset);
+  rig.startStreaming();
+  rig.runFor(2 * kNsPerSecond);
+  ASSERT_GT(rig.recorder.samples.size(), 50u);
+  for (const GyroSample& s : rig.recorder.samples) ASSERT_EQ(s.wall_ns - s.t_ns, kOffset) << s.seq;
+}
+
+TEST(Clock, TheRealtimeOffsetIsMeasuredBackToBack) {
+  std::int64_t uncertainty = -1;
+  const std::int64_t offset = measureRealtimeOffsetNs(&uncertainty);
+  EXPECT_GE(uncertainty, 0);
+  EXPECT_LT(uncertainty, 50'000'000) << "two clock reads 100 ms apart";
+  timespec real{}, mono{};
+  clock_gettime(CLOCK_REALTIME, &real);
+  clock_gettime(CLOCK_MONOTONIC, &mono);
+  const std::int64_t now_offset = (real.tv_sec - mono.tv_sec) * kNsPerSecond + (real.tv_nsec - mono.tv_nsec);
+  EXPECT_NEAR(static_cast<double>(offset), static_cast<double>(now_offset), 1e8);  // unless the clock was stepped
+  MonotonicClock monotonic;
+  EXPECT_NEAR(static_cast<double>(monotonic.realtimeOffsetNs()), static_cast<double>(offset), 1e8);
+  VirtualClock virtual_clock(7 * kNsPerSecond);  // its wall clock starts at the real time of its construction
+  EXPECT_NEAR(static_cast<double>(virtual_clock.realtimeOffsetNs() + 7 * kNsPerSecond),
+              static_cast<double>(real.tv_sec * kNsPerSecond + real.tv_nsec), 1e9);
+  const std::int64_t before = virtual_clock.realtimeOffsetNs();
+  virtual_clock.advanceNs(3600 * kNsPerSecond);  // an accelerated hour: its wall clock moves with it
+  EXPECT_EQ(virtual_clock.realtimeOffsetNs(), before);
+}
+
 }  // namespace gyrod::driver::test

@@ -164,3 +164,124 @@ TEST(RecordingFormat, GapLinesBeforeTheHeaderAndInBareNumberFiles) {
   EXPECT_EQ(rec.axes[0], (std::vector<double>{1.5, 2.5}));
   EXPECT_EQ(rec.lost, (std::vector<LostSamples>{dropped(2, "ring_full", 2, 1)}));
 }
+
+namespace {
+
+SampleValues fullSample(double t) {
+  SampleValues v;
+  v.t_s = t;
+  v.gx_dps = 0.125;
+  v.gy_dps = -1.0 / 3.0;
+  v.gz_dps = 2;
+  v.temp_c = 25.5;
+  v.wall_ns = 1'795'000'000'123'456'789;  // 2026-11-18T...: µs decimals, rounded
+  v.accel_g = {0.01, -0.02, 1.0 / 3.0};
+  v.rate_dps = {0.1 + 0.2, -0.0, 30};
+  v.bias_dps = {-3.34, 1.09, -0.5};
+  v.still = 1;
+  return v;
+}
+
+constexpr SampleColumns kAllColumns{true, true, true};
+
+}  // namespace
+
+TEST(RecordingFormat, GyrodsColumnsAreWrittenByteForByte) {
+  EXPECT_EQ(columnsLine({}), kColumnsLine);
+  EXPECT_EQ(columnsLine(kAllColumns),
+            "t,gx,gy,gz,temp,time,ax,ay,az,gx_rate,gy_rate,gz_rate,gx_bias,gy_bias,gz_bias,still\n");
+  EXPECT_EQ(columnsLine({true, false, true}),
+            "t,gx,gy,gz,temp,time,gx_rate,gy_rate,gz_rate,gx_bias,gy_bias,gz_bias,still\n");
+  RecordingLine line;
+  EXPECT_EQ(formatSampleLine(line, kAllColumns, fullSample(0.02)),
+            "0.02,0.125,-0.3333333333333333,2,25.5,1795000000.123457,0.01,-0.02,0.3333333333333333,"
+            "0.30000000000000004,-0,30,-3.34,1.09,-0.5,1\n");
+  // What a sample does not have is an empty field (the start-up estimation, no detector, no accel).
+  SampleValues partial = fullSample(0.04);
+  partial.wall_ns = 0;
+  partial.accel_g[1] = std::nan("");
+  partial.rate_dps = partial.bias_dps = {std::nan(""), std::nan(""), std::nan("")};
+  partial.still = -1;
+  EXPECT_EQ(formatSampleLine(line, kAllColumns, partial),
+            "0.04,0.125,-0.3333333333333333,2,25.5,,0.01,,0.3333333333333333,,,,,,,\n");
+  partial.still = 0;
+  EXPECT_EQ(formatSampleLine(line, {false, false, true}, partial), "0.04,0.125,-0.3333333333333333,2,25.5,,,,,,,0\n");
+  // The five columns decide a NONFINITE comment, as before.
+  SampleValues bad = fullSample(0.06);
+  bad.temp_c = std::nan("");
+  EXPECT_EQ(formatSampleLine(line, {false, false, true}, bad).rfind("# NONFINITE 0.06,", 0), 0u);
+}
+
+TEST(RecordingFormat, TheLongestGyrodLineFits) {
+  RecordingLine line;
+  SampleValues v;
+  const double big = -std::numeric_limits<double>::min();  // 24 characters
+  v.t_s = v.gx_dps = v.gy_dps = v.gz_dps = big;
+  v.temp_c = std::numeric_limits<double>::infinity();
+  v.wall_ns = std::numeric_limits<std::int64_t>::max();
+  v.accel_g = v.rate_dps = v.bias_dps = {big, big, big};
+  v.still = 1;
+  const auto sample = formatSampleLine(line, kAllColumns, v);
+  EXPECT_EQ(sample.rfind("# NONFINITE ", 0), 0u);
+  EXPECT_EQ(sample.back(), '\n');
+  EXPECT_LT(sample.size(), line.bytes.size());
+}
+
+TEST(RecordingFormat, GyrodsColumnsReadBackWithEmptyFieldsAsNaN) {
+  // Without ax,ay,az: reading them is the accelerometer import's part (kAccelColumns).
+  constexpr SampleColumns columns{true, false, true};
+  RecordingLine line;
+  std::string text = columnsLine(columns);
+  text += recordingHeaderComments(1735732800, "", {"device mock"});
+  text += formatSampleLine(line, columns, fullSample(0.02));
+  text += formatGapLine(line, 2, 0.04, 1, "fifo_overflow");
+  SampleValues partial = fullSample(0.06);
+  partial.rate_dps[2] = std::nan("");
+  partial.still = -1;
+  text += formatSampleLine(line, columns, partial);
+  const TempFile file(text);
+  const Recording rec = readRecordingCsv(file.path());
+  ASSERT_EQ(rec.size(), 2u);
+  EXPECT_EQ(rec.t, (std::vector<double>{0.02, 0.06}));
+  EXPECT_EQ(rec.time, (std::vector<double>{1795000000.123457, 1795000000.123457}));
+  EXPECT_EQ(rec.rate[0], (std::vector<double>{0.1 + 0.2, 0.1 + 0.2}));
+  EXPECT_TRUE(std::signbit(rec.rate[1][0]));
+  EXPECT_EQ(rec.rate[2][0], 30.0);
+  EXPECT_TRUE(std::isnan(rec.rate[2][1]));
+  EXPECT_EQ(rec.bias[0], (std::vector<double>{-3.34, -3.34}));
+  EXPECT_EQ(rec.bias[2], (std::vector<double>{-0.5, -0.5}));
+  EXPECT_EQ(rec.still[0], 1.0);
+  EXPECT_TRUE(std::isnan(rec.still[1]));
+  ASSERT_EQ(rec.lost.size(), 1u);
+  EXPECT_EQ(rec.lost[0].before_sample, 1u);
+  // Only gyrod's optional columns may be empty; "nan" is refused there as anywhere.
+  const TempFile empty_gyro("t,gx,gx_rate\n0,,1\n");
+  EXPECT_THROW(readRecordingCsv(empty_gyro.path()), RecordingError);
+  const TempFile nan_rate("t,gx,gx_rate\n0,1,nan\n");
+  EXPECT_THROW(readRecordingCsv(nan_rate.path()), RecordingError);
+  const TempFile twice("t,gx,still,still\n0,1,1,1\n");
+  EXPECT_THROW(readRecordingCsv(twice.path()), RecordingError);
+  // An old recording (five columns) has none of them.
+  const TempFile old("t,gx,gy,gz,temp\n0,1,2,3,25\n");
+  const Recording five = readRecordingCsv(old.path());
+  EXPECT_TRUE(five.time.empty() && five.rate[0].empty() && five.bias[2].empty() && five.still.empty());
+}
+
+// docs/recording-format.md's column table names the columns columnsLine writes, in order.
+TEST(RecordingFormat, TheDocumentedColumnsAreTheOnesWritten) {
+  std::ifstream in(fs::path(GYROD_TEST_DATA_DIR).parent_path().parent_path() / "docs" / "recording-format.md");
+  ASSERT_TRUE(in) << "cannot read docs/recording-format.md";
+  std::string documented;
+  bool in_columns = false;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("## ", 0) == 0) in_columns = line == "## Columns";
+    if (!in_columns || line.rfind("| `", 0) != 0) continue;
+    const std::string cell = line.substr(1, line.find('|', 1) - 1);  // "`gx`, `gy`, `gz`"
+    for (std::size_t open = cell.find('`'); open != std::string::npos; open = cell.find('`', open + 1)) {
+      const std::size_t close = cell.find('`', open + 1);
+      documented += (documented.empty() ? "" : ",") + cell.substr(open + 1, close - open - 1);
+      open = close;
+    }
+  }
+  EXPECT_EQ(documented + "\n", columnsLine(kAllColumns));
+}

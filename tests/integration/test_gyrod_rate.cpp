@@ -3,9 +3,10 @@
 // turn is the truth within the noise and the model's bias error) while the paper's kalman
 // stream is shrunk; the still detector sees the rest before the turn and not the turn; and
 // `gyroctl filter --model` on gyrod's own recording gives the stream's rate, bias and still
-// bit for bit.
+// bit for bit; and the recording itself holds them (and `time`) as published.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <csignal>
@@ -15,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "formats/recording_csv.hpp"
 #include "gyrod_process.hpp"
 #include "tools/run_command.hpp"
 
@@ -322,6 +324,24 @@ TEST(GyrodRate, TheOfflineRateStreamMatchesAcrossGaps) {
     for (int a = 0; a < 3; ++a) ASSERT_EQ(r["rate"][a].get<double>(), offline[i].rate[a]) << "row " << i;
     ASSERT_EQ(r["still"].get<bool>(), offline[i].still) << "row " << i;
   }
+  // The recording holds the stream itself (issue 11: recoverable even after a SIGHUP model change
+  // or DROPPED rows), and the wall clock of each sample as RATE's `time` gave it.
+  const auto recorded = gyrod::recording::readRecordingCsv(rec_path);
+  ASSERT_EQ(recorded.size(), offline.size());
+  for (const json& r : rates) {
+    const std::size_t i = rowOf(r["seq"].get<std::uint64_t>());
+    ASSERT_EQ(recorded.t[i], r["t"].get<double>()) << "row " << i;
+    ASSERT_EQ(recorded.time[i], r["time"].get<double>()) << "row " << i;
+    for (int a = 0; a < 3; ++a) {
+      ASSERT_EQ(recorded.rate[a][i], r["rate"][a].get<double>()) << "row " << i;
+      ASSERT_EQ(recorded.bias[a][i], r["bias"][a].get<double>()) << "row " << i;
+    }
+    ASSERT_EQ(recorded.still[i], r["still"].get<bool>() ? 1.0 : 0.0) << "row " << i;
+  }
+  const auto gap_lines = std::count_if(recorded.lost.begin(), recorded.lost.end(), [](const auto& l) {
+    return l.kind == gyrod::recording::LostSamples::Kind::Gap;
+  });
+  ASSERT_EQ(static_cast<std::size_t>(gap_lines), gaps.size());
 }
 
 TEST(GyrodRate, AModelFileThatIsNotOneExitsWithExConfigNamingItsLine) {

@@ -84,6 +84,51 @@ TEST(ProtocolRate, SpecialValuesAndTheLongestLineFit) {
   EXPECT_TRUE(sameDouble(j["kalman"][2].get<double>(), longest));
 }
 
+TEST(ProtocolRate, TimeHasMicrosecondDecimalsAndAccelComesInGAndSi) {
+  RateSample s;
+  s.seq = 3;
+  s.t_s = 5123.456;
+  s.temp_c = 31.25;
+  s.raw_dps = s.mean_dps = s.kalman_dps = {0.5, -0.25, 0.125};
+  s.time_s = 1795000000.1234567;  // one more digit than the line keeps: rounded to µs
+  s.accel_g = {0.01, -0.02, 1.0};
+  std::array<char, kMaxRateLineBytes> buf;
+  const std::string line(buf.data(), formatRateLine(s, buf));
+  EXPECT_NE(line.find(R"("time":1795000000.123457,"accel":[0.01,-0.02,1],"accel_ms2":[)"), std::string::npos) << line;
+  const json j = json::parse(line);
+  for (std::size_t i = 0; i < 3; ++i)
+    EXPECT_EQ(j["accel_ms2"][i].get<double>(), s.accel_g[i] * 9.80665) << line;  // standard gravity
+  const auto parsed = std::get<RateSample>(parseServerLine(line.substr(0, line.size() - 1)));
+  EXPECT_EQ(parsed.time_s, 1795000000.123457);
+  EXPECT_EQ(parsed.accel_g, s.accel_g);
+  // Unset (a device without accel, an unknown wall clock): left out, as every field.
+  s.time_s = RateSample::kUnset;
+  s.accel_g = {1.0, RateSample::kUnset, 1.0};
+  const std::string without(buf.data(), formatRateLine(s, buf));
+  EXPECT_EQ(without.find("time"), std::string::npos) << without;
+  EXPECT_EQ(without.find("accel"), std::string::npos) << without;
+  const auto none = std::get<RateSample>(parseServerLine(without.substr(0, without.size() - 1)));
+  EXPECT_TRUE(std::isnan(none.time_s) && std::isnan(none.accel_g[0]));
+}
+
+TEST(ProtocolRate, TheLongestLineWithEveryFieldFits) {
+  RateSample s;
+  s.seq = std::numeric_limits<std::uint64_t>::max();
+  const double longest = -2.2250738585072014e-308;  // 24 characters in shortest form
+  s.t_s = s.temp_c = longest;
+  s.raw_dps = s.mean_dps = s.kalman_dps = s.rate_dps = s.bias_dps = s.accel_g = {longest, longest, longest};
+  s.still = false;
+  for (const double time : {-999999999999999.9, 1e300, longest}) {  // fixed notation, then shortest
+    s.time_s = time;
+    std::array<char, kMaxRateLineBytes> buf;
+    const std::size_t n = formatRateLine(s, buf);
+    EXPECT_LT(n, kMaxRateLineBytes);
+    const json j = parseLine(buf.data(), n);
+    EXPECT_NEAR(j["time"].get<double>(), time, 1e-6 * std::fabs(time) + 1e-6);
+    EXPECT_EQ(j["accel_ms2"].size(), 3u);
+  }
+}
+
 TEST(ProtocolRate, NonFiniteFieldsAreOmittedNotNull) {
   RateSample s;
   s.seq = 7;

@@ -152,6 +152,8 @@ TEST(ProtocolDoc, RateFieldsAreTheOnesSent) {
   protocol::RateSample s;
   s.raw_dps = s.mean_dps = s.kalman_dps = s.rate_dps = s.bias_dps = {1.0, 2.0, 3.0};
   s.still = true;
+  s.time_s = 1.8e9;
+  s.accel_g = {0.0, 0.0, 1.0};
   std::array<char, protocol::kMaxRateLineBytes> buf;
   const std::size_t n = protocol::formatRateLine(s, buf);
   std::set<std::string> sent;

@@ -24,18 +24,21 @@ def is_vector(v):
 
 
 def check_parse_tolerates_unknown_fields():
-    line = ('{"class":"RATE","seq":7,"t":1.5,"temp":30,"raw":[1,2.0,3.0],"accel":[0.0,0.0,1.0],'
-            '"future_field":{"a":1}}')
+    line = ('{"class":"RATE","seq":7,"t":1.5,"temp":30,"raw":[1,2.0,3.0],"time":1795000000.123456,'
+            '"accel":[0,0.0,1.0],"accel_ms2":[0,0,9.80665],"future_field":{"a":1}}')
     r = gyrod_client.parse_line(line)
     check(isinstance(r, gyrod_client.Rate) and r.seq == 7 and r.raw == [1.0, 2.0, 3.0], "parse a RATE line")
     check(isinstance(r.temp, float) and all(isinstance(x, float) for x in r.raw), "whole numbers become floats")
-    check(r.kalman is None and r.fields["accel"] == [0.0, 0.0, 1.0], "an unknown RATE field is kept in .fields")
+    check(r.time == 1795000000.123456 and r.accel == [0.0, 0.0, 1.0] and r.accel_ms2 == [0.0, 0.0, 9.80665],
+          "time, accel and accel_ms2: %r" % r)
+    check(r.kalman is None and r.fields["future_field"] == {"a": 1}, "an unknown RATE field is kept in .fields")
     g = gyrod_client.parse_line('{"class":"GAP","seq":9,"count":2,"reason":"some_new_reason","extra":1}')
     check(isinstance(g, gyrod_client.Gap) and g.count == 2 and g.reason == "some_new_reason", "parse a GAP line")
     check(gyrod_client.parse_line('{"class":"NEWCLASS","x":1}') == {"class": "NEWCLASS", "x": 1},
           "an unknown class is returned as a dict")
     for bad in ('[1,2]', '{"seq":1}', '{"class":"RATE","t":1.0}', '{"class":"RATE","seq":1,"t":1,"raw":[1,2]}',
-                '{"class":"RATE","seq":1,"t":"now"}'):
+                '{"class":"RATE","seq":1,"t":"now"}', '{"class":"RATE","seq":1,"t":1,"time":"today"}',
+                '{"class":"RATE","seq":1,"t":1,"accel":[0,1]}'):
         try:
             gyrod_client.parse_line(bad)
             check(False, "refuse %s" % bad)
@@ -49,7 +52,7 @@ def rate_table_fields():
     with open(doc, encoding="utf-8") as f:
         text = f.read()
     table = text.split("### RATE", 1)[1].split("\n\n", 2)[1]
-    return [m.group(1) for m in re.finditer(r"^\| `([a-z_]+)` \|", table, re.MULTILINE) if m.group(1) != "class"]
+    return [m.group(1) for m in re.finditer(r"^\| `([a-z0-9_]+)` \|", table, re.MULTILINE) if m.group(1) != "class"]
 
 
 def check_rate_fields_are_the_documented_ones():
@@ -75,10 +78,16 @@ def check_against_gyrod(path):
                 break
         for prev, cur in zip(rates, rates[1:]):
             check(cur.seq > prev.seq and cur.t > prev.t, "seq and t increase: %r then %r" % (prev, cur))
+            # One offset per FIFO burst: within a burst time - t is constant (to the double's rounding);
+            # across bursts it moves only as the system clock does, far less than a sample period.
+            check(abs((cur.time - cur.t) - (prev.time - prev.t)) < 0.005, "time follows t: %r then %r" % (prev, cur))
             check(prev.rate is None or cur.rate is not None, "rate stays once it is there: %r" % cur)
         check(rates[-1].rate is not None, "rate appears within %d samples" % len(rates))
         for r in rates:
             check(is_vector(r.raw), "raw vector: %r" % r)
+            # The mock runs on a virtual clock whose wall time began when gyrod started (this decade).
+            check(isinstance(r.time, float) and 1.6e9 < r.time < 2.6e9, "time is UTC epoch seconds: %r" % r)
+            check(r.accel is None or (is_vector(r.accel) and is_vector(r.accel_ms2)), "accel vectors: %r" % r)
             if r.rate is None:
                 continue
             check(is_vector(r.rate) and is_vector(r.bias), "rate and bias vectors: %r" % r)

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -14,6 +15,7 @@
 #include <variant>
 #include <vector>
 
+#include "formats/recording_format.hpp"
 #include "processing/allan.hpp"
 #include "processing/noise_terms.hpp"
 #include "protocol/protocol.hpp"
@@ -48,17 +50,35 @@ struct WatchOptions {
   std::optional<std::uint64_t> count;
 };
 
+// What `t` is, at the end of the header: the clock, and the UTC time (RATE "time") of the
+// sample the header is printed for, so the two can be lined up.
+std::string timeLegend(const protocol::RateSample& r) {
+  std::string legend = "  t: CLOCK_MONOTONIC s of the data-ready edge; time: UTC";
+  if (!std::isfinite(r.time_s) || !std::isfinite(r.t_s)) return legend + " (not sent by this gyrod)";
+  const auto us = static_cast<std::int64_t>(std::llround(r.time_s * 1e6));
+  const auto seconds = us / 1'000'000 - (us % 1'000'000 < 0 ? 1 : 0);
+  const std::tm tm = recording::utcCalendarTime(seconds);
+  char stamp[64];
+  const auto n = std::strftime(stamp, sizeof stamp, "%Y-%m-%dT%H:%M:%S", &tm);
+  std::snprintf(stamp + n, sizeof stamp - n, ".%06lldZ", static_cast<long long>(us - seconds * 1'000'000));
+  char at[32];
+  std::snprintf(at, sizeof at, "%.3f", r.t_s);
+  return legend + ", t " + at + " = " + stamp;
+}
+
 // Two layouts. Once a RATE line carries `rate` the stream to read comes first, then raw and
 // the paper's kalman, then the still detector, with a new header where the switch happens;
 // until then (an older gyrod, or gyrod still estimating its start-up bias) raw and kalman.
-void printRateHeader(bool with_rate) {
+void printRateHeader(bool with_rate, const protocol::RateSample& first) {
+  const std::string legend = timeLegend(first);
   if (with_rate) {
-    std::printf("%10s %12s  %10s %10s %10s  %10s %10s %10s  %10s %10s %10s %6s  [deg/s]\n", "seq", "t [s]", "rate x",
-                "rate y", "rate z", "raw x", "raw y", "raw z", "kalman x", "kalman y", "kalman z", "still");
+    std::printf("%10s %12s  %10s %10s %10s  %10s %10s %10s  %10s %10s %10s %6s  [deg/s]%s\n", "seq", "t [s]", "rate x",
+                "rate y", "rate z", "raw x", "raw y", "raw z", "kalman x", "kalman y", "kalman z", "still",
+                legend.c_str());
     return;
   }
-  std::printf("%10s %12s  %10s %10s %10s  %10s %10s %10s  [deg/s]\n", "seq", "t [s]", "raw x", "raw y", "raw z",
-              "kalman x", "kalman y", "kalman z");
+  std::printf("%10s %12s  %10s %10s %10s  %10s %10s %10s  [deg/s]%s\n", "seq", "t [s]", "raw x", "raw y", "raw z",
+              "kalman x", "kalman y", "kalman z", legend.c_str());
 }
 
 // A value the line left out comes back from the parser as NaN and shows as "-".
@@ -112,7 +132,7 @@ int runWatch(const WatchOptions& opt) {
       const bool carries_rate = std::isfinite(rate->rate_dps[0]) || rate->still.has_value();
       if (!with_rate || (carries_rate && !*with_rate)) {
         with_rate = carries_rate;
-        printRateHeader(*with_rate);
+        printRateHeader(*with_rate, *rate);
       }
       printRate(*rate, *with_rate);
     } else if (const auto* gap = std::get_if<protocol::GapNotice>(&message)) {
@@ -459,8 +479,9 @@ void addClientCommands(CLI::App& app, CommandRunner& run) {
     auto opt = std::make_shared<WatchOptions>();
     auto* sub = app.add_subcommand(
         "watch",
-        "Show gyrod's live samples: seq, t, then per axis rate (the stream to read while the board moves), raw "
-        "and the paper's Kalman, and the still detector (RATE lines)");
+        "Show gyrod's live samples: seq, t (CLOCK_MONOTONIC s of the data-ready edge; the header maps it to UTC), "
+        "then per axis rate (the stream to read while the board moves), raw and the paper's Kalman, and the still "
+        "detector (RATE lines)");
     addCommonOptions(sub, opt->common);
     sub->add_flag("--json", opt->common.json, "print gyrod's lines unchanged (one JSON object per line)");
     sub->add_option("--decimate", opt->decimate, "receive every N-th sample")
