@@ -109,7 +109,7 @@ TEST(GyroctlAnalyzeAccel, AMissingAccelColumnIsNamed) {
   ScratchDir d;
   const auto rec = d.write("g.csv", "t,gx\n0,1\n0.02,2\n");
   const auto r = runGyroctl("analyze " + rec.string() + " --axis az", d.path());
-  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_EQ(r.exit_status, 65);  // EX_DATAERR
   EXPECT_NE(r.err.find(rec.string() + ": no column 'az' (the file has gx)"), std::string::npos) << r.err;
 }
 
@@ -174,7 +174,7 @@ TEST(GyroctlKalibr, AGyroOnlyRecordingSaysTheAccelIsMissingAndWritesNoNumberForI
 TEST(GyroctlKalibr, BadOptionsAreRefusedBeforeTheAnalysis) {
   ScratchDir d;
   const auto rec = d.write("g.csv", "t,gx\n0,1\n0.02,2\n");
-  EXPECT_EQ(runGyroctl("analyze " + rec.string() + " --kalibr-inflate 0", d.path()).exit_status, 2);
+  EXPECT_EQ(runGyroctl("analyze " + rec.string() + " --kalibr-inflate 0", d.path()).exit_status, 64);  // EX_USAGE
   const auto model = runGyroctl("analyze " + rec.string() + " --write-model " + d.path().string(), d.path());
   const auto kalibr = runGyroctl("analyze " + rec.string() + " --kalibr " + d.path().string(), d.path());
   EXPECT_NE(kalibr.exit_status, 0);
