@@ -12,6 +12,7 @@
 #include "processing/detrend.hpp"
 #include "processing/kalman.hpp"
 #include "processing/model_check_pipeline.hpp"
+#include "processing/sensor_model.hpp"
 
 namespace gyrod::processing {
 namespace {
@@ -41,6 +42,12 @@ void validateChannels(const AxisModelCheckInput& in) {
     for (std::size_t i = 0; i < in.temperature_c.size(); ++i)
       if (!std::isfinite(in.temperature_c[i]))
         throw std::invalid_argument("model check: temperature sample " + std::to_string(i) + " is not finite");
+  }
+  try {
+    if (in.chain.dlpf_cfg) sampleRateDivisor(*in.chain.dlpf_cfg, in.rate_hz);
+    if (in.chain.fs_sel) gyroSensitivityLsbPerDps(*in.chain.fs_sel);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("model check: acquisition chain: ") + e.what());
   }
   if (!in.time_s.empty() && in.time_s.size() != in.rate_dps.size())
     throw std::invalid_argument("model check: the time channel has " + std::to_string(in.time_s.size()) +
@@ -90,6 +97,30 @@ void spectrumForPlots(const SeriesStats& measured, const std::vector<SeriesStats
   }
 }
 
+// The Gauss–Markov stage fits the cleaned series' Allan curve as it is; through a DLPF the
+// terms (and a Gauss–Markov process named) are refitted to the curve with the chain's shape.
+void refitThroughChain(std::span<const double> xc, const Context& c, bool deterministic_found, GaussMarkovFound& gm,
+                       AxisModelCheck& out) {
+  if (!c.chain.dlpf_cfg) return;
+  const std::vector<AllanPoint> clean_curve = allanDeviationTable(xc, c.tau0, c.ms);
+  gm.clean_fit = deterministic_found ? fitChainTerms(clean_curve, c) : out.base_fit;
+  gm.extended_terms = gm.clean_fit.value;
+  if (!gm.found) return;
+  std::vector<double> variance;
+  for (const AllanPoint& p : clean_curve) variance.push_back(p.oadev * p.oadev);
+  NoiseTerms terms = gm.clean_fit.value;
+  for (int pass = 0; pass < 4; ++pass) {
+    const std::vector<double> corrected = chainCorrectedVariances(variance, c, whiteCoefficientOf(terms));
+    const std::vector<double> t_fixed{gm.fit.tau_s};
+    const GaussMarkovCurveFit refit = fitGaussMarkovToAllan(c.taus, corrected, c.edf, t_fixed);
+    terms = refit.terms_with_gm;
+    gm.fit.sigma_dps = refit.sigma_dps;
+  }
+  gm.extended_terms = terms;
+  for (DetectedEffect& e : out.effects)
+    if (e.effect == ModelEffect::GaussMarkov) e.sigma_dps = gm.fit.sigma_dps;
+}
+
 }  // namespace
 
 AxisModelCheck checkAxisModel(const AxisModelCheckInput& input, const ModelCheckOptions& options_in) {
@@ -105,7 +136,8 @@ AxisModelCheck checkAxisModel(const AxisModelCheckInput& input, const ModelCheck
 
   std::vector<AllanPoint> curve;
   Context c = makeContext(input, xd, curve);
-  out.base_fit = fitNoiseTerms(curve);
+  out.base_fit = fitChainTerms(curve, c);
+  out.chain = input.chain;
   const TemperatureChannel temp = prepareTemperature(input.temperature_c, c);
   if (!input.time_s.empty()) checkSampleTiming(input.time_s, out);
 
@@ -133,7 +165,8 @@ AxisModelCheck checkAxisModel(const AxisModelCheckInput& input, const ModelCheck
   deterministic_found = checkSinusoids(xc, c, spectral_null, o.replicas, removal, out) || deterministic_found;
   deterministic_found = checkTemperatureAndSteps(input, xc, c, temp, base_reps, o, removal, out) || deterministic_found;
   removeLinearTrend(xc, c.tau0);
-  const GaussMarkovFound gm = checkGaussMarkov(xc, c, deterministic_found, curve, base_reps, o, out);
+  GaussMarkovFound gm = checkGaussMarkov(xc, c, deterministic_found, curve, base_reps, o, out);
+  refitThroughChain(xc, c, deterministic_found, gm, out);
   out.extended_fit = gm.clean_fit;
   out.extended_fit.value = gm.extended_terms;
 

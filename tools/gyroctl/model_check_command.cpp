@@ -25,8 +25,10 @@
 #include "formats/calibration.hpp"
 #include "formats/model_toml.hpp"
 #include "formats/output_file.hpp"
+#include "formats/recording_header.hpp"
 #include "processing/model_check.hpp"
 #include "processing/noise_terms.hpp"
+#include "processing/sensor_model.hpp"
 #include "processing/warm_up_fit.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
@@ -49,6 +51,15 @@ struct ModelCheckCliOptions {
   std::size_t replicas = 40;
   std::size_t threads = 0;
   std::string write_model;
+  std::optional<int> dlpf_cfg, fs_sel;
+};
+
+// The acquisition chain the base model gets, and where each part came from.
+struct ChainChoice {
+  AcquisitionChain chain;
+  double rate_hz = 0.0;  // the rate the check uses: the DLPF's exact rate when one is set
+  std::string dlpf_source, fs_sel_source;
+  std::vector<DlpfCandidate> scores;  // when the DLPF was estimated
 };
 
 std::string fmt(const char* f, double v) {
@@ -215,6 +226,98 @@ void printAxisText(std::ostream& o, const std::string& name, const AxisModelChec
   o << line;
 }
 
+// ---- the acquisition chain --------------------------------------------------------------
+
+// The rate of a DLPF setting nearest to `rate` (the t column's median spacing is not exact),
+// when one is within 1 %.
+std::optional<double> reachableRate(int dlpf_cfg, double rate) {
+  const double internal = dlpfSetting(dlpf_cfg).internal_rate_hz;
+  const double divisor = std::clamp(std::round(internal / rate), 1.0, 256.0);
+  const double made = internal / divisor;
+  if (std::fabs(made - rate) > 0.01 * rate) return std::nullopt;
+  return made;
+}
+
+std::string dlpfText(int cfg) {
+  return "DLPF_CFG " + std::to_string(cfg) + " (" + fmt("%g", dlpfSetting(cfg).bandwidth_hz) + " Hz)";
+}
+
+// --dlpf / --fs-sel first, then the recording's `# device` header, else the DLPF estimated
+// from the Allan curve's short-τ roll-off (FS_SEL is not estimated: without it the replicas are
+// not rounded, which matters only when the noise is a few LSB).
+ChainChoice settleChain(const ModelCheckCliOptions& opt, const LoadedInput& in) {
+  ChainChoice c;
+  c.rate_hz = in.rate_hz;
+  const recording::AcquisitionHeader header = recording::readAcquisitionHeader(opt.file);
+  const std::string at_line = opt.file + ":" + std::to_string(header.line);
+  if (opt.dlpf_cfg) {
+    c.chain.dlpf_cfg = opt.dlpf_cfg;
+    c.dlpf_source = "--dlpf";
+  } else if (header.dlpf_cfg) {
+    c.chain.dlpf_cfg = header.dlpf_cfg;
+    c.dlpf_source = "recording header (" + at_line + ")";
+  }
+  if (opt.fs_sel) {
+    c.chain.fs_sel = opt.fs_sel;
+    c.fs_sel_source = "--fs-sel";
+  } else if (header.fs_sel) {
+    c.chain.fs_sel = header.fs_sel;
+    c.fs_sel_source = "recording header (" + at_line + ")";
+  } else {
+    c.fs_sel_source = "not given: replicas not rounded";
+  }
+  if (!c.chain.dlpf_cfg) {
+    // Estimated on every checked axis at the nearest rate a DLPF can make (1 kHz / k).
+    const double snapped = reachableRate(1, in.rate_hz).value_or(in.rate_hz);
+    c.scores = dlpfCandidates(snapped);
+    for (std::size_t idx : in.axis_indices) scoreDlpfCandidates(in.recording.axes[idx], snapped, c.scores);
+    c.chain.dlpf_cfg = chooseDlpf(c.scores, in.axis_indices.size());
+    double none = 0.0, best = 0.0;
+    for (const DlpfCandidate& cand : c.scores) {
+      if (!cand.dlpf_cfg) none = cand.chi2;
+      if (cand.dlpf_cfg == c.chain.dlpf_cfg) best = cand.chi2;
+    }
+    c.dlpf_source = c.chain.dlpf_cfg ? "estimated from the short-tau roll-off of the Allan curve (reduced chi2 " +
+                                           fmt("%.3g", best) + " with it, " + fmt("%.3g", none) + " without, " +
+                                           std::to_string(in.axis_indices.size()) + " axes)"
+                                     : "none: not in the header, none given, no roll-off seen (reduced chi2 " +
+                                           fmt("%.3g", none) + " without one, no setting clearly better)";
+  }
+  if (c.chain.dlpf_cfg) {
+    const std::optional<double> made = reachableRate(*c.chain.dlpf_cfg, in.rate_hz);
+    if (!made)
+      throw recording::RecordingError(opt.file + ": rate " + fmt("%g", in.rate_hz) + " Hz cannot be made with " +
+                                      dlpfText(*c.chain.dlpf_cfg) + " (" + c.dlpf_source +
+                                      "): the rate is the internal rate / (1 + SMPLRT_DIV)");
+    c.rate_hz = *made;
+  }
+  return c;
+}
+
+std::string chainText(const ChainChoice& c) {
+  return "acquisition chain: " + (c.chain.dlpf_cfg ? dlpfText(*c.chain.dlpf_cfg) : std::string("no DLPF")) + " [" +
+         c.dlpf_source + "]; " +
+         (c.chain.fs_sel ? "FS_SEL " + std::to_string(*c.chain.fs_sel) + " (LSB 1/" +
+                               fmt("%g", gyroSensitivityLsbPerDps(*c.chain.fs_sel)) + " deg/s)"
+                         : std::string("no quantisation")) +
+         " [" + c.fs_sel_source + "]";
+}
+
+json chainJson(const ChainChoice& c) {
+  json j = {{"dlpf_cfg", c.chain.dlpf_cfg ? json(*c.chain.dlpf_cfg) : json(nullptr)},
+            {"dlpf_source", c.dlpf_source},
+            {"fs_sel", c.chain.fs_sel ? json(*c.chain.fs_sel) : json(nullptr)},
+            {"fs_sel_source", c.fs_sel_source},
+            {"rate_hz", c.rate_hz}};
+  if (!c.scores.empty()) {
+    json scores = json::object();
+    for (const DlpfCandidate& cand : c.scores)
+      scores[cand.dlpf_cfg ? std::to_string(*cand.dlpf_cfg) : std::string("none")] = cand.chi2;
+    j["dlpf_estimate_reduced_chi2"] = scores;
+  }
+  return j;
+}
+
 // ---- report ----------------------------------------------------------------------------
 
 // `input`: the recording checked, which no report file may overwrite.
@@ -297,7 +400,8 @@ std::vector<std::string> writeAxisPlots(const std::filesystem::path& dir, const 
 }
 
 void writeReport(const std::string& dir_text, const ModelCheckCliOptions& opt, const LoadedInput& in,
-                 const std::vector<std::pair<std::string, AxisModelCheck>>& results, double seconds) {
+                 const ChainChoice& chain, const std::vector<std::pair<std::string, AxisModelCheck>>& results,
+                 double seconds) {
   const std::filesystem::path dir(dir_text);
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
@@ -311,7 +415,9 @@ void writeReport(const std::string& dir_text, const ModelCheckCliOptions& opt, c
      << (in.recording.t.empty() ? "no t column" : "t column present") << ". Replicas per round: " << opt.replicas
      << ", seed " << opt.seed << "; checked in " << fmt("%.2f", seconds) << " s.\n\n"
      << "The base model is the paper's (five Allan terms fitted to the Allan deviation, AR(p) by AIC for the "
-        "Kalman filter). Every threshold comes from replicas simulated from the fitted model; see docs/model-check.md.\n";
+        "Kalman filter), seen through the acquisition chain. Every threshold comes from replicas simulated from the "
+        "fitted model; see docs/model-check.md.\n\n"
+     << "The " << chainText(chain) << ".\n";
   if (!plots) md << "\n(gnuplot is not installed: the plot data and scripts are written, the pictures are not.)\n";
   for (const auto& [name, r] : results) {
     md << "\n## " << name << "\n\n";
@@ -488,11 +594,12 @@ int runModelCheck(const ModelCheckCliOptions& opt) {
   options.replicas = opt.replicas;
   options.threads = opt.threads;
   for (std::size_t idx : in.axis_indices) requireAnalysableValues(rec, idx);
+  const ChainChoice chain = settleChain(opt, in);
   const TimingSummary timing = checkTiming(rec, opt.rate_hz);
   reportTiming(opt.file, timing, opt.strict_timing);
   std::vector<std::pair<std::string, AxisModelCheck>> results;
   for (std::size_t idx : in.axis_indices) {
-    AxisModelCheckInput axis{rec.axes[idx], in.rate_hz, rec.temp, rec.t};
+    AxisModelCheckInput axis{rec.axes[idx], chain.rate_hz, rec.temp, rec.t, chain.chain};
     try {
       results.emplace_back(rec.axis_names[idx], checkAxisModel(axis, options));
     } catch (const std::invalid_argument& e) {
@@ -510,6 +617,7 @@ int runModelCheck(const ModelCheckCliOptions& opt) {
     doc["replicas"] = opt.replicas;
     doc["elapsed_s"] = seconds;
     doc["timing"] = timingJson(timing);
+    doc["acquisition_chain"] = chainJson(chain);
     doc["axes"] = json::object();
     for (const auto& [name, r] : results) doc["axes"][name] = axisJson(r);
     std::cout << doc.dump(1) << '\n';
@@ -517,11 +625,12 @@ int runModelCheck(const ModelCheckCliOptions& opt) {
     std::printf("gyroctl model-check %s: %zu samples at %g Hz (%s), %.1f s; %zu replicas per round, seed %llu\n",
                 opt.file.c_str(), rec.size(), in.rate_hz, in.rate_source.c_str(),
                 static_cast<double>(rec.size()) / in.rate_hz, opt.replicas, static_cast<unsigned long long>(opt.seed));
+    std::printf("%s\n", chainText(chain).c_str());
     for (const auto& [name, r] : results) printAxisText(std::cout, name, r);
     std::printf("\nchecked in %.2f s\n", seconds);
   }
   if (!opt.report_dir.empty()) {
-    writeReport(opt.report_dir, opt, in, results, seconds);
+    writeReport(opt.report_dir, opt, in, chain, results, seconds);
     if (!opt.json) std::printf("report written to %s/report.md\n", opt.report_dir.c_str());
   }
   if (!opt.write_model.empty()) {
@@ -551,6 +660,13 @@ void addModelCheckCommand(CLI::App& app, CommandRunner& run) {
       ->default_val(40)
       ->check(CLI::Range(std::size_t{8}, std::size_t{10000}));
   sub->add_option("--threads", opt->threads, "threads for the replicas (0: all cores)")->default_val(0);
+  sub->add_option("--dlpf", opt->dlpf_cfg,
+                  "DLPF_CFG 0..6 the recording was made with (default: the recording's '# device' header, else "
+                  "estimated from the Allan curve)")
+      ->check(CLI::Range(0, 6));
+  sub->add_option("--fs-sel", opt->fs_sel,
+                  "FS_SEL 0..3 the recording was made with: the LSB the replicas are rounded to (default: the header)")
+      ->check(CLI::Range(0, 3));
   sub->add_option(
       "--write-model", opt->write_model,
       "write the extended model of every axis (terms and named effects) as TOML for gyroctl simulate --model");
