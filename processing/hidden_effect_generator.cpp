@@ -99,9 +99,9 @@ HiddenEffect HiddenEffectGenerator::drawEffect(ModelEffect e, double duration_s,
       break;
     }
     case ModelEffect::Outliers:
-      h.count = integer(3, 30);
+      h.count = integer(outlier_count_lo, outlier_count_hi);
       extra.outlier_count += h.count;
-      extra.outlier_amplitude_dps = uniform(10.0, 30.0) * white_std[h.axis];
+      extra.outlier_amplitude_dps = uniform(outlier_size_lo, outlier_size_hi) * white_std[h.axis];
       break;
     case ModelEffect::SampleGaps:
       h.count = integer(1, 5);

@@ -95,6 +95,9 @@ struct DetectedEffect {
   double outlier_median_amplitude_dps = 0.0;  // outliers: median |excursion|
   double where_lo = 0.0, where_hi = 0.0;      // unexplained: τ range [s] (Allan)
   EffectEvidence evidence;                    // statistic, value, threshold
+  // false: seen (its statistic fired) but not explained: the extended model with it did not
+  // gain out of sample (AxisModelCheck::verdict says which measures).
+  bool explained = true;
 };
 
 // One statistic of the check: its value on the measured series, the replicas' null
@@ -120,6 +123,22 @@ struct ModelCheckGain {
   double innovation_var_base = 0.0, innovation_var_extended = 0.0;
   double ljung_box_p_base = 0.0, ljung_box_p_extended = 0.0;
   double in_band_base = 0.0, in_band_extended = 0.0;
+  // Out of sample: each Kalman model (its AR part, and the Gauss–Markov state) fitted on the
+  // first half of the record, its innovations scored on the second half.
+  double innovation_var_base_held_out = 0.0, innovation_var_extended_held_out = 0.0;
+  double ljung_box_p_base_held_out = 0.0, ljung_box_p_extended_held_out = 0.0;
+};
+
+// The acceptance rule (docs/model-check.md): an extension is accepted only if it gains out of
+// sample: against fresh replicas of each model (ADEV log error, in-band fraction) and on the
+// held-back half (innovation variance, Ljung–Box), no measure worse beyond its noise and at
+// least one better. Otherwise its effects are "seen, not explained".
+struct ExtensionVerdict {
+  bool judged = false;  // a model effect was named (else there is no extension to judge)
+  bool accepted = true;
+  bool adev_worse = false, band_worse = false, innovation_worse = false, ljung_box_worse = false;
+  bool adev_better = false, band_better = false, innovation_better = false, ljung_box_better = false;
+  bool operator==(const ExtensionVerdict&) const = default;
 };
 
 struct ModelCheckOptions {
@@ -171,6 +190,7 @@ struct AxisModelCheck {
   std::size_t ar_order = 0;  // AR order (AIC) of the base Kalman model
   std::size_t replicas_simulated = 0;
   AcquisitionChain chain;  // the acquisition chain in the base model
+  ExtensionVerdict verdict;
 };
 
 // Throws std::invalid_argument for a rate that is not finite and > 0, fewer than

@@ -172,6 +172,11 @@ bool checkSinusoids(std::vector<double>& xc, const Context& c, const NullSummary
 struct TemperatureChannel {
   std::vector<double> detrended;
   std::vector<double> raw_blocks;  // block means of the measured temperature (plots)
+  // `detrended` smoothed over a block (centred moving average): the regressor of the extended
+  // model. The channel's own noise and its 1/340 °C steps times k would otherwise add white
+  // noise to the replicas and to the Kalman filter's regressor (seen: an extension with a
+  // true temperature response scored worse than the base model).
+  std::vector<double> smoothed;
 };
 
 // A temperature response and bias steps on the low-passed residual of xc, told apart, fitted

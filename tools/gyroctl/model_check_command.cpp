@@ -171,6 +171,41 @@ json termsJson(const NoiseTerms& t) {
   return j;
 }
 
+// Why an extension was not accepted (ExtensionVerdict), in words.
+std::vector<std::string> worseMeasures(const ExtensionVerdict& v) {
+  std::vector<std::string> w;
+  if (v.adev_worse) w.push_back("adev_log_error");
+  if (v.band_worse) w.push_back("in_band");
+  if (v.innovation_worse) w.push_back("innovation_var_held_out");
+  if (v.ljung_box_worse) w.push_back("ljung_box_p_held_out");
+  return w;
+}
+
+std::vector<std::string> betterMeasures(const ExtensionVerdict& v) {
+  std::vector<std::string> b;
+  if (v.adev_better) b.push_back("adev_log_error");
+  if (v.band_better) b.push_back("in_band");
+  if (v.innovation_better) b.push_back("innovation_var_held_out");
+  if (v.ljung_box_better) b.push_back("ljung_box_p_held_out");
+  return b;
+}
+
+std::string joined(const std::vector<std::string>& v) {
+  std::string s;
+  for (const std::string& x : v) s += (s.empty() ? "" : ", ") + x;
+  return s;
+}
+
+std::string notExplainedReason(const ExtensionVerdict& v) {
+  const std::vector<std::string> worse = worseMeasures(v);
+  if (!worse.empty()) return "the extended model with it scored worse out of sample on " + joined(worse);
+  return "the extended model with it gained on no out-of-sample measure beyond its noise";
+}
+
+json verdictJson(const ExtensionVerdict& v) {
+  return {{"judged", v.judged}, {"accepted", v.accepted}, {"worse", worseMeasures(v)}, {"better", betterMeasures(v)}};
+}
+
 json gainJson(const ModelCheckGain& g) {
   return {{"adev_log_error_base", g.adev_log_error_base},
           {"adev_log_error_extended", g.adev_log_error_extended},
@@ -179,15 +214,23 @@ json gainJson(const ModelCheckGain& g) {
           {"ljung_box_p_base", g.ljung_box_p_base},
           {"ljung_box_p_extended", g.ljung_box_p_extended},
           {"in_band_base", g.in_band_base},
-          {"in_band_extended", g.in_band_extended}};
+          {"in_band_extended", g.in_band_extended},
+          {"innovation_var_base_held_out", g.innovation_var_base_held_out},
+          {"innovation_var_extended_held_out", g.innovation_var_extended_held_out},
+          {"ljung_box_p_base_held_out", g.ljung_box_p_base_held_out},
+          {"ljung_box_p_extended_held_out", g.ljung_box_p_extended_held_out}};
 }
 
 json axisJson(const AxisModelCheck& r) {
   json effects = json::array();
-  for (const DetectedEffect& e : r.effects)
-    effects.push_back({{"effect", std::string(modelEffectName(e.effect))},
-                       {"params", effectParams(e)},
-                       {"evidence", evidenceText(e)}});
+  for (const DetectedEffect& e : r.effects) {
+    json one = {{"effect", std::string(modelEffectName(e.effect))},
+                {"params", effectParams(e)},
+                {"evidence", evidenceText(e)},
+                {"explained", e.explained}};
+    if (!e.explained) one["not_explained_reason"] = notExplainedReason(r.verdict);
+    effects.push_back(one);
+  }
   json stats = json::array();
   for (const CheckStatistic& s : r.statistics)
     stats.push_back({{"name", s.name},
@@ -197,6 +240,7 @@ json axisJson(const AxisModelCheck& r) {
                      {"fired", s.fired}});
   return {{"effects", effects},
           {"gain", gainJson(r.gain)},
+          {"extension", verdictJson(r.verdict)},
           {"samples", r.samples},
           {"base_terms", termsJson(r.base_fit.value)},
           {"extended_terms", termsJson(r.extended_fit.value)},
@@ -208,8 +252,11 @@ json axisJson(const AxisModelCheck& r) {
 void printAxisText(std::ostream& o, const std::string& name, const AxisModelCheck& r) {
   o << "\n== " << name << " ==\n";
   if (r.effects.empty()) o << "  the base model holds: no effect\n";
-  for (const DetectedEffect& e : r.effects)
-    o << "  " << modelEffectName(e.effect) << " (" << paramsText(e) << ")\n      " << evidenceText(e) << '\n';
+  for (const DetectedEffect& e : r.effects) {
+    o << "  " << modelEffectName(e.effect) << " (" << paramsText(e) << ")";
+    if (!e.explained) o << ": seen, not explained (" << notExplainedReason(r.verdict) << ")";
+    o << "\n      " << evidenceText(e) << '\n';
+  }
   const ModelCheckGain& g = r.gain;
   char line[256];
   o << "  gain                    base        extended\n";
@@ -224,6 +271,14 @@ void printAxisText(std::ostream& o, const std::string& name, const AxisModelChec
   o << line;
   std::snprintf(line, sizeof line, "  in 90%% band       %12.3f    %12.3f\n", g.in_band_base, g.in_band_extended);
   o << line;
+  std::snprintf(line, sizeof line, "  held out: innovation var %.4g -> %.4g, Ljung-Box p %.4g -> %.4g\n",
+                g.innovation_var_base_held_out, g.innovation_var_extended_held_out, g.ljung_box_p_base_held_out,
+                g.ljung_box_p_extended_held_out);
+  o << line;
+  if (r.verdict.judged)
+    o << "  extension " << (r.verdict.accepted ? "accepted" : "not accepted")
+      << " (better: " << (betterMeasures(r.verdict).empty() ? "none" : joined(betterMeasures(r.verdict)))
+      << "; worse: " << (worseMeasures(r.verdict).empty() ? "none" : joined(worseMeasures(r.verdict))) << ")\n";
 }
 
 // ---- the acquisition chain --------------------------------------------------------------
@@ -426,7 +481,9 @@ void writeReport(const std::string& dir_text, const ModelCheckCliOptions& opt, c
     else {
       md << "| effect | parameters | evidence |\n|---|---|---|\n";
       for (const DetectedEffect& e : r.effects)
-        md << "| `" << modelEffectName(e.effect) << "` | " << paramsText(e) << " | " << evidenceText(e) << " |\n";
+        md << "| `" << modelEffectName(e.effect) << "`" << (e.explained ? "" : " (seen, not explained)") << " | "
+           << paramsText(e) << " | " << evidenceText(e)
+           << (e.explained ? "" : "; not explained: " + notExplainedReason(r.verdict)) << " |\n";
     }
     const ModelCheckGain& g = r.gain;
     md << "\n| figure | base | extended |\n|---|---|---|\n"
@@ -437,7 +494,15 @@ void writeReport(const std::string& dir_text, const ModelCheckCliOptions& opt, c
        << "| Ljung-Box p of the innovations | " << fmt("%.3g", g.ljung_box_p_base) << " | "
        << fmt("%.3g", g.ljung_box_p_extended) << " |\n"
        << "| fraction of tau inside the 90 % band | " << fmt("%.3f", g.in_band_base) << " | "
-       << fmt("%.3f", g.in_band_extended) << " |\n";
+       << fmt("%.3f", g.in_band_extended) << " |\n"
+       << "| held out: innovation variance (fit 1st half, score 2nd) | " << fmt("%.4g", g.innovation_var_base_held_out)
+       << " | " << fmt("%.4g", g.innovation_var_extended_held_out) << " |\n"
+       << "| held out: Ljung-Box p | " << fmt("%.3g", g.ljung_box_p_base_held_out) << " | "
+       << fmt("%.3g", g.ljung_box_p_extended_held_out) << " |\n";
+    if (r.verdict.judged)
+      md << "\nExtension " << (r.verdict.accepted ? "**accepted**" : "**not accepted**")
+         << " (better: " << (betterMeasures(r.verdict).empty() ? "none" : joined(betterMeasures(r.verdict)))
+         << "; worse: " << (worseMeasures(r.verdict).empty() ? "none" : joined(worseMeasures(r.verdict))) << ").\n";
     md << "\nStatistics (value, median of the null, threshold):\n\n";
     for (const CheckStatistic& s : r.statistics)
       md << "- " << s.name << ": " << fmt("%.4g", s.value) << " (null median " << fmt("%.4g", s.null_median)
@@ -488,13 +553,20 @@ AxisNoiseModel extendedAxisModel(const AxisModelCheck& r, std::span<const double
                                  const recording::Recording& rec, double rate_hz, double temperature_reference_c,
                                  const std::string& name, std::vector<std::string>& notes) {
   AxisNoiseModel m;
-  m.terms = r.extended_fit.value;
+  // An extension that did not gain is not the model: the base terms stay, and its effects
+  // become comments.
+  m.terms = r.verdict.accepted ? r.extended_fit.value : r.base_fit.value;
   long double sum = 0.0L;
   for (double v : rate_dps) sum += v;
   double bias = static_cast<double>(sum / static_cast<long double>(rate_dps.size()));
   const double n = static_cast<double>(rate_dps.size());
   AxisExtraEffects& x = m.extra;
   for (const DetectedEffect& e : r.effects) {
+    if (!e.explained) {
+      notes.push_back(name + ": " + std::string(modelEffectName(e.effect)) + " seen, not explained (" +
+                      notExplainedReason(r.verdict) + "): not modelled");
+      continue;
+    }
     switch (e.effect) {
       case ModelEffect::TemperatureBias:
         x.temperature_coefficient_dps_per_c = e.k_dps_per_c;
