@@ -131,8 +131,8 @@ struct ModelCheckGain {
 
 // The acceptance rule (docs/model-check.md): an extension is accepted only if it gains out of
 // sample: against fresh replicas of each model (ADEV log error, in-band fraction) and on the
-// held-back half (innovation variance, Ljung–Box), no measure worse beyond its noise and at
-// least one better. Otherwise its effects are "seen, not explained".
+// held-back half (innovation variance, Ljung–Box), more measures better beyond their noise
+// than worse. Otherwise its effects are "seen, not explained".
 struct ExtensionVerdict {
   bool judged = false;  // a model effect was named (else there is no extension to judge)
   bool accepted = true;

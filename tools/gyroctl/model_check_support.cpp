@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 
 #include "formats/recording_csv.hpp"
 #include "formats/recording_header.hpp"
@@ -68,8 +69,19 @@ ChainChoice settleChain(const std::string& file, std::optional<int> dlpf_cfg, st
     // Estimated on every checked axis at the nearest rate a DLPF can make (1 kHz / k).
     const double snapped = reachableRate(1, in.rate_hz).value_or(in.rate_hz);
     c.scores = dlpfCandidates(snapped);
-    for (std::size_t idx : in.axis_indices) scoreDlpfCandidates(in.recording.axes[idx], snapped, c.scores);
-    c.chain.dlpf_cfg = chooseDlpf(c.scores, in.axis_indices.size());
+    std::size_t scored = 0;
+    for (std::size_t idx : in.axis_indices) {
+      // An axis the base fit cannot take (e.g. constant) is left to the check, which names it.
+      std::vector<DlpfCandidate> axis_scores = dlpfCandidates(snapped);
+      try {
+        scoreDlpfCandidates(in.recording.axes[idx], snapped, axis_scores);
+      } catch (const std::invalid_argument&) {
+        continue;
+      }
+      for (std::size_t k = 0; k < axis_scores.size(); ++k) c.scores[k].chi2 += axis_scores[k].chi2;
+      ++scored;
+    }
+    c.chain.dlpf_cfg = scored > 0 ? chooseDlpf(c.scores, scored) : std::nullopt;
     double none = 0.0, best = 0.0;
     for (const DlpfCandidate& cand : c.scores) {
       if (!cand.dlpf_cfg) none = cand.chi2;
@@ -77,7 +89,7 @@ ChainChoice settleChain(const std::string& file, std::optional<int> dlpf_cfg, st
     }
     c.dlpf_source = c.chain.dlpf_cfg ? "estimated from the short-tau roll-off of the Allan curve (reduced chi2 " +
                                            fmt("%.3g", best) + " with it, " + fmt("%.3g", none) + " without, " +
-                                           std::to_string(in.axis_indices.size()) + " axes)"
+                                           std::to_string(scored) + " axes)"
                                      : "none: not in the header, none given, no roll-off seen (reduced chi2 " +
                                            fmt("%.3g", none) + " without one, no setting clearly better)";
   }
@@ -142,8 +154,10 @@ std::string joined(const std::vector<std::string>& v) {
 }
 
 std::string notExplainedReason(const ExtensionVerdict& v) {
-  const std::vector<std::string> worse = worseMeasures(v);
-  if (!worse.empty()) return "the extended model with it scored worse out of sample on " + joined(worse);
+  const std::vector<std::string> worse = worseMeasures(v), better = betterMeasures(v);
+  if (!worse.empty())
+    return "the extended model with it scored worse out of sample on " + joined(worse) + " and better on " +
+           (better.empty() ? std::string("none") : joined(better));
   return "the extended model with it gained on no out-of-sample measure beyond its noise";
 }
 
