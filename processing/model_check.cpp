@@ -115,6 +115,7 @@ void refitThroughChain(std::span<const double> xc, const Context& c, bool determ
   gm.extended_terms = gm.clean_fit.value;
   if (!gm.found) return;
   std::vector<double> variance;
+  variance.reserve(clean_curve.size());
   for (const AllanPoint& p : clean_curve) variance.push_back(p.oadev * p.oadev);
   NoiseTerms terms = gm.clean_fit.value;
   for (int pass = 0; pass < 4; ++pass) {

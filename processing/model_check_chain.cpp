@@ -143,6 +143,7 @@ NoiseTermFit fitChainTerms(const std::vector<AllanPoint>& curve, const Context& 
   // for the narrowest DLPF, so the fixed point is found by the secant method, not by
   // iterating g.
   std::vector<double> variance;
+  variance.reserve(curve.size());
   for (const AllanPoint& p : curve) variance.push_back(p.oadev * p.oadev);
   auto refit = [&](double white) {
     const std::vector<double> corrected = chainCorrectedVariances(variance, c, white);
