@@ -15,8 +15,10 @@
 #include <system_error>
 
 #include "driver/counter_names.hpp"
+#include "driver/mpu6050_config.hpp"
 #include "formats/calibration.hpp"
 #include "formats/model_toml.hpp"
+#include "formats/recording_header.hpp"
 #include "formats/toml_document.hpp"
 
 namespace gyrod::daemon {
@@ -169,6 +171,9 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
         "time: the same edge in UTC epoch s; GAP lines mark lost samples");
     options.header_comments.push_back(
         "gx_rate..still: the RATE stream's rate, bias and still as published (docs/recording-format.md)");
+    const driver::Mpu6050Config& chip = device_.driver_config;  // the chain the model check puts in its base model
+    options.header_comments.push_back(recording::acquisitionHeaderComment(
+        chip.dlpf_cfg, chip.fs_sel, chip.sample_rate_hz, driver::sampleRateDivider(chip)));
     if (rate_model_.params)  // the recording holds what the rate stream was fed, at full precision
       options.header_comments.push_back("recompute them: gyroctl filter FILE --model " + config_.filter.model +
                                         " --rate " + formats::shortest(config_.device.rate_hz));

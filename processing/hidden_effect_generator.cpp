@@ -99,9 +99,9 @@ HiddenEffect HiddenEffectGenerator::drawEffect(ModelEffect e, double duration_s,
       break;
     }
     case ModelEffect::Outliers:
-      h.count = integer(3, 30);
+      h.count = integer(outlier_count_lo, outlier_count_hi);
       extra.outlier_count += h.count;
-      extra.outlier_amplitude_dps = uniform(10.0, 30.0) * white_std[h.axis];
+      extra.outlier_amplitude_dps = uniform(outlier_size_lo, outlier_size_hi) * white_std[h.axis];
       break;
     case ModelEffect::SampleGaps:
       h.count = integer(1, 5);
@@ -123,6 +123,45 @@ void HiddenEffectGenerator::removeGapRows(GeneratedRecording& g, const HiddenEff
   }
 }
 
+namespace {
+
+void simulateAtOutputRate(const SimulationModel& model, std::size_t n, std::uint64_t seed, GeneratedRecording& g) {
+  NoiseSimulator sim(model, static_cast<double>(n) / model.rate_hz, seed);
+  for (std::size_t i = 0; i < n; ++i) {
+    const SimulatedSample s = sim.next();
+    for (std::size_t a = 0; a < 3; ++a) g.axes[a][i] = s.rate_dps[a];
+  }
+}
+
+// Through the DLPF as gyrod records: gyrod lets the chip settle before it reads (the
+// simulator starts its DLPF at the first noisy analog sample, a transient of a few output
+// samples), so the noise is simulated one second early and that second dropped; the effects
+// (added after the DLPF in the simulator, too) come from a model of their own on the
+// recording's clock, and the sum is quantised as the chip does.
+void simulateThroughDlpf(const SimulationModel& model, std::size_t n, std::uint64_t seed, GeneratedRecording& g) {
+  SimulationModel noise = model, effects;
+  noise.fs_sel.reset();
+  effects.rate_hz = model.rate_hz;
+  for (std::size_t a = 0; a < 3; ++a) {
+    noise.axes[a].extra = {};
+    effects.axes[a].extra = model.axes[a].extra;
+  }
+  const auto lead = static_cast<std::size_t>(std::ceil(model.rate_hz));
+  NoiseSimulator noise_sim(noise, static_cast<double>(n + lead) / model.rate_hz, seed);
+  NoiseSimulator effect_sim(effects, static_cast<double>(n) / model.rate_hz, seed);
+  for (std::size_t i = 0; i < lead; ++i) noise_sim.next();
+  const double lsb = model.fs_sel ? gyroSensitivityLsbPerDps(*model.fs_sel) : 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const SimulatedSample s = noise_sim.next(), e = effect_sim.next();
+    for (std::size_t a = 0; a < 3; ++a) {
+      const double v = s.rate_dps[a] + e.rate_dps[a];
+      g.axes[a][i] = lsb > 0.0 ? std::round(v * lsb) / lsb : v;
+    }
+  }
+}
+
+}  // namespace
+
 GeneratedRecording HiddenEffectGenerator::generate(double duration_s, double rate_hz,
                                                    const std::vector<ModelEffect>& effects) {
   GeneratedRecording g;
@@ -131,6 +170,7 @@ GeneratedRecording HiddenEffectGenerator::generate(double duration_s, double rat
   SimulationModel model;
   model.rate_hz = rate_hz;
   model.fs_sel = 0;  // 131 LSB per deg/s, as the MPU6050 at ±250 deg/s
+  model.dlpf_cfg = dlpf_cfg;
   std::array<double, 3> white_std{}, flat_adev{};
   for (std::size_t a = 0; a < 3; ++a) {
     NoiseTerms& t = g.terms[a];
@@ -162,17 +202,19 @@ GeneratedRecording HiddenEffectGenerator::generate(double duration_s, double rat
     g.hidden.push_back(h);
   }
 
-  NoiseSimulator sim(model, duration_s, next64());
+  const std::uint64_t sim_seed = next64();
   for (auto& axis : g.axes) axis.resize(n);
+  if (dlpf_cfg)
+    simulateThroughDlpf(model, n, sim_seed, g);
+  else
+    simulateAtOutputRate(model, n, sim_seed, g);
   g.temp.resize(n);
   g.t.resize(n);
   NormalGenerator temp_noise(next64());
   double temp_mean = 0.0;
   for (double v : true_temp) temp_mean += v / static_cast<double>(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const SimulatedSample s = sim.next();
     g.t[i] = static_cast<double>(i) / rate_hz;
-    for (std::size_t a = 0; a < 3; ++a) g.axes[a][i] = s.rate_dps[a];
     const double measured_temp = true_temp[i] + 0.02 * temp_noise.next();
     g.temp[i] = std::round(measured_temp * 340.0) / 340.0;  // TEMP_OUT resolution
   }

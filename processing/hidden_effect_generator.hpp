@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "processing/model_check.hpp"
@@ -58,6 +59,13 @@ class HiddenEffectGenerator {
   // σ such that its Allan-deviation peak is gm_peak_lo..gm_peak_hi × the base model's there.
   double gm_tau_hi_fraction = 1.0 / 40.0;
   double gm_peak_lo = 1.5, gm_peak_hi = 3.0;
+  // Number of hidden outliers (inclusive range) and their size in multiples of the white sd.
+  std::size_t outlier_count_lo = 3, outlier_count_hi = 30;
+  double outlier_size_lo = 10.0, outlier_size_hi = 30.0;
+  // The chip's DLPF (DLPF_CFG 0..6) the recording is made through, as gyrod records it: the
+  // analog noise at the internal rate, filtered, decimated to the rate (which must be
+  // reachable), then quantised. None: the noise is made at the output rate (no DLPF).
+  std::optional<int> dlpf_cfg;
 
   double uniform(double lo, double hi) { return lo + (hi - lo) * rng_.uniform(); }
   double logUniform(double lo, double hi) { return std::exp(uniform(std::log(lo), std::log(hi))); }

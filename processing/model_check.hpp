@@ -17,6 +17,7 @@
 // depend on the number of threads.
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -94,6 +95,9 @@ struct DetectedEffect {
   double outlier_median_amplitude_dps = 0.0;  // outliers: median |excursion|
   double where_lo = 0.0, where_hi = 0.0;      // unexplained: τ range [s] (Allan)
   EffectEvidence evidence;                    // statistic, value, threshold
+  // false: seen (its statistic fired) but not explained: the extended model with it did not
+  // gain out of sample (AxisModelCheck::verdict says which measures).
+  bool explained = true;
 };
 
 // One statistic of the check: its value on the measured series, the replicas' null
@@ -119,6 +123,22 @@ struct ModelCheckGain {
   double innovation_var_base = 0.0, innovation_var_extended = 0.0;
   double ljung_box_p_base = 0.0, ljung_box_p_extended = 0.0;
   double in_band_base = 0.0, in_band_extended = 0.0;
+  // Out of sample: each Kalman model (its AR part, and the Gauss–Markov state) fitted on the
+  // first half of the record, its innovations scored on the second half.
+  double innovation_var_base_held_out = 0.0, innovation_var_extended_held_out = 0.0;
+  double ljung_box_p_base_held_out = 0.0, ljung_box_p_extended_held_out = 0.0;
+};
+
+// The acceptance rule (docs/model-check.md): an extension is accepted only if it gains out of
+// sample: against fresh replicas of each model (ADEV log error, in-band fraction) and on the
+// held-back half (innovation variance, Ljung–Box), more measures better beyond their noise
+// than worse. Otherwise its effects are "seen, not explained".
+struct ExtensionVerdict {
+  bool judged = false;  // a model effect was named (else there is no extension to judge)
+  bool accepted = true;
+  bool adev_worse = false, band_worse = false, innovation_worse = false, ljung_box_worse = false;
+  bool adev_better = false, band_better = false, innovation_better = false, ljung_box_better = false;
+  bool operator==(const ExtensionVerdict&) const = default;
 };
 
 struct ModelCheckOptions {
@@ -135,11 +155,23 @@ struct ModelCheckOptions {
   std::size_t max_ar_order = 8;
 };
 
+// How the recording was acquired: the chip's DLPF (DLPF_CFG 0..6, at its internal rate of
+// 8 kHz for cfg 0 and 1 kHz otherwise, decimated to rate_hz by 1 + SMPLRT_DIV) and the
+// quantisation (FS_SEL 0..3: 1/131 … 1/16.4 °/s). The base model includes it: the white rate
+// noise of the replicas has the chain's short-τ shape, and they are rounded to the LSB.
+// None: no DLPF (or one whose effect is not to be modelled), no quantisation.
+struct AcquisitionChain {
+  std::optional<int> dlpf_cfg;
+  std::optional<int> fs_sel;
+  bool operator==(const AcquisitionChain&) const = default;
+};
+
 struct AxisModelCheckInput {
   std::span<const double> rate_dps;
   double rate_hz = 0.0;
   std::span<const double> temperature_c;  // empty: no temperature channel
   std::span<const double> time_s;         // empty: no t column
+  AcquisitionChain chain;                 // the rate must be reachable with its DLPF
 };
 
 struct AxisModelCheck {
@@ -157,6 +189,8 @@ struct AxisModelCheck {
   std::vector<double> block_temperature_c, block_residual_dps;
   std::size_t ar_order = 0;  // AR order (AIC) of the base Kalman model
   std::size_t replicas_simulated = 0;
+  AcquisitionChain chain;  // the acquisition chain in the base model
+  ExtensionVerdict verdict;
 };
 
 // Throws std::invalid_argument for a rate that is not finite and > 0, fewer than
@@ -164,6 +198,27 @@ struct AxisModelCheck {
 // another length, non-increasing times, or options with replicas < 8.
 inline constexpr std::size_t kModelCheckMinSamples = 2000;
 AxisModelCheck checkAxisModel(const AxisModelCheckInput& input, const ModelCheckOptions& options = {});
+
+// ---- the acquisition chain -------------------------------------------------------------
+
+// The shape s(m) of white rate noise through the chain at cluster sizes ms (τ = m/rate):
+// its Allan variance is c·s(m)/τ, s → 1 at long τ (c the white coefficient the output shows
+// there). All ones without a DLPF. Exact, from the DLPF's impulse response.
+std::vector<double> chainWhiteNoiseShape(const AcquisitionChain& chain, double rate_hz,
+                                         std::span<const std::size_t> ms);
+
+// Estimating the DLPF of a recording that does not say: a DLPF shows as a known roll-off of
+// the Allan curve at short τ. Each candidate (none, and every DLPF_CFG that can give this
+// rate) is scored by the reduced χ² of the base fit with its shape; scores add over axes.
+struct DlpfCandidate {
+  std::optional<int> dlpf_cfg;
+  double chi2 = 0.0;
+};
+std::vector<DlpfCandidate> dlpfCandidates(double rate_hz);
+void scoreDlpfCandidates(std::span<const double> rate_dps, double rate_hz, std::vector<DlpfCandidate>& candidates);
+// The estimate from candidates scored on `axes_scored` axes: the best DLPF when it fits
+// clearly better than none (χ² at most 0.8 of none's, and lower by more than 3 per axis), else none.
+std::optional<int> chooseDlpf(const std::vector<DlpfCandidate>& scored, std::size_t axes_scored);
 
 // ---- parts, public for the tests and the report ---------------------------------------
 

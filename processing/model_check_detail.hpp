@@ -106,6 +106,7 @@ struct InnovationStats {
   double variance = 0.0;            // mean square innovation over the samples used
   std::vector<double> innovations;  // samples used, after a burn-in of 100
   std::size_t rejected = 0;
+  std::vector<std::size_t> rejected_samples;  // indices into z of the rejected samples
 };
 InnovationStats kalmanInnovations(std::span<const double> z, std::span<const double> phi, double ar_noise_var,
                                   double gm_decay, double gm_noise_var, bool robust);

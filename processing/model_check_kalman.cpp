@@ -74,6 +74,7 @@ InnovationStats kalmanInnovations(std::span<const double> z, std::span<const dou
     if (reject) {
       x = xp;  // the prediction stands in for the gross error
       ++out.rejected;
+      out.rejected_samples.push_back(n);
       if (!frozen) pp = pm;
       continue;
     }

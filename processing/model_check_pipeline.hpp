@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -25,6 +26,16 @@ namespace gyrod::processing::model_check_detail {
 inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 inline constexpr std::size_t kOutlierHalfWindow = 10;
 
+// ---- the acquisition chain (model_check_chain.cpp) --------------------------------------
+
+struct ChainModel {
+  std::optional<int> dlpf_cfg, fs_sel;
+  std::vector<double> white_shape;  // s(m) per Allan point (1 without a DLPF)
+  std::vector<double> white_ma;     // MA coefficients of unit long-τ white coefficient (empty: no DLPF)
+  double lsb_dps = 0.0;             // 0: no quantisation
+  double quantisation_white = 0.0;  // white coefficient the rounding adds: LSB²·τ0/12
+};
+
 // ---- what every replica (and the measured series) is measured by ----------------------
 
 struct Context {
@@ -38,7 +49,22 @@ struct Context {
   std::vector<std::size_t> scales;    // Haar scales [blocks]
   std::size_t k_lo = 0, k_hi = 0;     // periodogram bins searched for a sinusoid
   std::vector<double> psd_edges;
+  ChainModel chain;
 };
+
+ChainModel makeChainModel(const AcquisitionChain& chain, double rate_hz, std::span<const std::size_t> ms);
+// The white coefficient c (σ² = c/τ) of a set of terms.
+double whiteCoefficientOf(const NoiseTerms& terms);
+// Allan variances with the white power the DLPF took at short τ added back (white coefficient
+// given, less the quantisation's, which is not filtered): what the five terms describe.
+std::vector<double> chainCorrectedVariances(std::span<const double> variance, const Context& c,
+                                            double white_coefficient);
+// The five terms of an Allan curve made through c.chain (fitNoiseTerms when there is no DLPF).
+NoiseTermFit fitChainTerms(const std::vector<AllanPoint>& curve, const Context& c);
+// The chain's white noise of coefficient c (less the quantisation's) added to x, its own stream.
+void addChainWhiteNoise(std::vector<double>& x, const ChainModel& chain, double white_coefficient, std::uint64_t seed);
+// Rounded to the chain's LSB at a random offset (nothing without FS_SEL).
+void quantiseLikeTheChip(std::vector<double>& x, const ChainModel& chain, std::uint64_t seed);
 
 // The Allan grid, Gauss–Markov grid, blocks, Haar scales, sinusoid bins and PSD bands of the
 // detrended series xd; `curve` gets its Allan deviation table.
@@ -146,6 +172,11 @@ bool checkSinusoids(std::vector<double>& xc, const Context& c, const NullSummary
 struct TemperatureChannel {
   std::vector<double> detrended;
   std::vector<double> raw_blocks;  // block means of the measured temperature (plots)
+  // `detrended` smoothed over a block (centred moving average): the regressor of the extended
+  // model. The channel's own noise and its 1/340 °C steps times k would otherwise add white
+  // noise to the replicas and to the Kalman filter's regressor (seen: an extension with a
+  // true temperature response scored worse than the base model).
+  std::vector<double> smoothed;
 };
 
 // A temperature response and bias steps on the low-passed residual of xc, told apart, fitted

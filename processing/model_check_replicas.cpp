@@ -23,13 +23,29 @@ std::uint64_t replicaSeed(std::uint64_t seed, std::uint64_t round, std::uint64_t
   return second.next();
 }
 
-// One replica of axis x of `model`, n samples, plus `added` (same length, or empty),
-// detrended as the measured series is.
-std::vector<double> simulateReplica(const SimulationModel& model, std::size_t n, std::uint64_t seed,
+// One replica of axis x of `model` (terms as the output shows them at long τ), n samples,
+// through the acquisition chain of c, plus `added` (same length, or empty), detrended as the
+// measured series is. The chain's white noise is drawn at the output rate with the chain's
+// autocovariance (model_check_chain.cpp); the rounding adds white noise of its own, which
+// the white term already holds, so that much is taken out of it.
+std::vector<double> simulateReplica(const SimulationModel& model, const Context& c, std::uint64_t seed,
                                     std::span<const double> added) {
-  NoiseSimulator sim(model, static_cast<double>(n) / model.rate_hz, seed);
+  const std::size_t n = c.n;
+  SimulationModel pure = model;
+  NoiseTerms& terms = pure.axes[0].terms;
+  const double white = whiteCoefficientOf(terms);
+  if (c.chain.dlpf_cfg)
+    terms.set(NoiseTerm::AngleRandomWalk, 0.0);
+  else if (c.chain.lsb_dps > 0.0)
+    terms.set(NoiseTerm::AngleRandomWalk,
+              noiseTermFromCoefficient(NoiseTerm::AngleRandomWalk, std::max(0.0, white - c.chain.quantisation_white)));
+  NoiseSimulator sim(pure, static_cast<double>(n) / model.rate_hz, seed);
   std::vector<double> x(n);
-  for (std::size_t i = 0; i < n; ++i) x[i] = sim.next().rate_dps[0] + (added.empty() ? 0.0 : added[i]);
+  for (std::size_t i = 0; i < n; ++i) x[i] = sim.next().rate_dps[0];
+  if (c.chain.dlpf_cfg) addChainWhiteNoise(x, c.chain, white, seed);
+  if (!added.empty())
+    for (std::size_t i = 0; i < n; ++i) x[i] += added[i];
+  quantiseLikeTheChip(x, c.chain, seed);
   removeLinearTrend(x, 1.0 / model.rate_hz);
   return x;
 }
@@ -100,7 +116,7 @@ std::vector<SeriesStats> runReplicas(const SimulationModel& model, const NoiseTe
   std::vector<SeriesStats> out(o.replicas);
   parallelFor(o.replicas, o.threads, [&](std::size_t i) {
     const std::uint64_t seed = replicaSeed(o.seed, round, i);
-    const std::vector<double> x = simulateReplica(replicaModel(model, uncertainty, seed), c.n, seed, added);
+    const std::vector<double> x = simulateReplica(replicaModel(model, uncertainty, seed), c, seed, added);
     out[i] = measureSeries(x, c, mask);
   });
   return out;

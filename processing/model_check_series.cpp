@@ -55,6 +55,7 @@ Context makeContext(const AxisModelCheckInput& in, std::span<const double> xd, s
   const double f_lo = 2.0 / duration, f_hi = 0.5 * in.rate_hz;
   for (std::size_t j = 0; j <= kPsdBands; ++j)
     c.psd_edges.push_back(f_lo * std::pow(f_hi / f_lo, static_cast<double>(j) / static_cast<double>(kPsdBands)));
+  c.chain = makeChainModel(in.chain, in.rate_hz, c.ms);
   return c;
 }
 

@@ -25,11 +25,14 @@
 #include "formats/calibration.hpp"
 #include "formats/model_toml.hpp"
 #include "formats/output_file.hpp"
+#include "formats/recording_header.hpp"
 #include "processing/model_check.hpp"
 #include "processing/noise_terms.hpp"
+#include "processing/sensor_model.hpp"
 #include "processing/warm_up_fit.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
+#include "tools/gyroctl/model_check_support.hpp"
 #include "tools/gyroctl/series_checks.hpp"
 
 namespace gyrod::gyroctl {
@@ -49,6 +52,7 @@ struct ModelCheckCliOptions {
   std::size_t replicas = 40;
   std::size_t threads = 0;
   std::string write_model;
+  std::optional<int> dlpf_cfg, fs_sel;
 };
 
 std::string fmt(const char* f, double v) {
@@ -160,23 +164,16 @@ json termsJson(const NoiseTerms& t) {
   return j;
 }
 
-json gainJson(const ModelCheckGain& g) {
-  return {{"adev_log_error_base", g.adev_log_error_base},
-          {"adev_log_error_extended", g.adev_log_error_extended},
-          {"innovation_var_base", g.innovation_var_base},
-          {"innovation_var_extended", g.innovation_var_extended},
-          {"ljung_box_p_base", g.ljung_box_p_base},
-          {"ljung_box_p_extended", g.ljung_box_p_extended},
-          {"in_band_base", g.in_band_base},
-          {"in_band_extended", g.in_band_extended}};
-}
-
 json axisJson(const AxisModelCheck& r) {
   json effects = json::array();
-  for (const DetectedEffect& e : r.effects)
-    effects.push_back({{"effect", std::string(modelEffectName(e.effect))},
-                       {"params", effectParams(e)},
-                       {"evidence", evidenceText(e)}});
+  for (const DetectedEffect& e : r.effects) {
+    json one = {{"effect", std::string(modelEffectName(e.effect))},
+                {"params", effectParams(e)},
+                {"evidence", evidenceText(e)},
+                {"explained", e.explained}};
+    if (!e.explained) one["not_explained_reason"] = notExplainedReason(r.verdict);
+    effects.push_back(one);
+  }
   json stats = json::array();
   for (const CheckStatistic& s : r.statistics)
     stats.push_back({{"name", s.name},
@@ -186,6 +183,7 @@ json axisJson(const AxisModelCheck& r) {
                      {"fired", s.fired}});
   return {{"effects", effects},
           {"gain", gainJson(r.gain)},
+          {"extension", verdictJson(r.verdict)},
           {"samples", r.samples},
           {"base_terms", termsJson(r.base_fit.value)},
           {"extended_terms", termsJson(r.extended_fit.value)},
@@ -197,8 +195,11 @@ json axisJson(const AxisModelCheck& r) {
 void printAxisText(std::ostream& o, const std::string& name, const AxisModelCheck& r) {
   o << "\n== " << name << " ==\n";
   if (r.effects.empty()) o << "  the base model holds: no effect\n";
-  for (const DetectedEffect& e : r.effects)
-    o << "  " << modelEffectName(e.effect) << " (" << paramsText(e) << ")\n      " << evidenceText(e) << '\n';
+  for (const DetectedEffect& e : r.effects) {
+    o << "  " << modelEffectName(e.effect) << " (" << paramsText(e) << ")";
+    if (!e.explained) o << ": seen, not explained (" << notExplainedReason(r.verdict) << ")";
+    o << "\n      " << evidenceText(e) << '\n';
+  }
   const ModelCheckGain& g = r.gain;
   char line[256];
   o << "  gain                    base        extended\n";
@@ -213,6 +214,14 @@ void printAxisText(std::ostream& o, const std::string& name, const AxisModelChec
   o << line;
   std::snprintf(line, sizeof line, "  in 90%% band       %12.3f    %12.3f\n", g.in_band_base, g.in_band_extended);
   o << line;
+  std::snprintf(line, sizeof line, "  held out: innovation var %.4g -> %.4g, Ljung-Box p %.4g -> %.4g\n",
+                g.innovation_var_base_held_out, g.innovation_var_extended_held_out, g.ljung_box_p_base_held_out,
+                g.ljung_box_p_extended_held_out);
+  o << line;
+  if (r.verdict.judged)
+    o << "  extension " << (r.verdict.accepted ? "accepted" : "not accepted")
+      << " (better: " << (betterMeasures(r.verdict).empty() ? "none" : joined(betterMeasures(r.verdict)))
+      << "; worse: " << (worseMeasures(r.verdict).empty() ? "none" : joined(worseMeasures(r.verdict))) << ")\n";
 }
 
 // ---- report ----------------------------------------------------------------------------
@@ -297,7 +306,8 @@ std::vector<std::string> writeAxisPlots(const std::filesystem::path& dir, const 
 }
 
 void writeReport(const std::string& dir_text, const ModelCheckCliOptions& opt, const LoadedInput& in,
-                 const std::vector<std::pair<std::string, AxisModelCheck>>& results, double seconds) {
+                 const ChainChoice& chain, const std::vector<std::pair<std::string, AxisModelCheck>>& results,
+                 double seconds) {
   const std::filesystem::path dir(dir_text);
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
@@ -311,7 +321,9 @@ void writeReport(const std::string& dir_text, const ModelCheckCliOptions& opt, c
      << (in.recording.t.empty() ? "no t column" : "t column present") << ". Replicas per round: " << opt.replicas
      << ", seed " << opt.seed << "; checked in " << fmt("%.2f", seconds) << " s.\n\n"
      << "The base model is the paper's (five Allan terms fitted to the Allan deviation, AR(p) by AIC for the "
-        "Kalman filter). Every threshold comes from replicas simulated from the fitted model; see docs/model-check.md.\n";
+        "Kalman filter), seen through the acquisition chain. Every threshold comes from replicas simulated from the "
+        "fitted model; see docs/model-check.md.\n\n"
+     << "The " << chainText(chain) << ".\n";
   if (!plots) md << "\n(gnuplot is not installed: the plot data and scripts are written, the pictures are not.)\n";
   for (const auto& [name, r] : results) {
     md << "\n## " << name << "\n\n";
@@ -320,7 +332,9 @@ void writeReport(const std::string& dir_text, const ModelCheckCliOptions& opt, c
     else {
       md << "| effect | parameters | evidence |\n|---|---|---|\n";
       for (const DetectedEffect& e : r.effects)
-        md << "| `" << modelEffectName(e.effect) << "` | " << paramsText(e) << " | " << evidenceText(e) << " |\n";
+        md << "| `" << modelEffectName(e.effect) << "`" << (e.explained ? "" : " (seen, not explained)") << " | "
+           << paramsText(e) << " | " << evidenceText(e)
+           << (e.explained ? "" : "; not explained: " + notExplainedReason(r.verdict)) << " |\n";
     }
     const ModelCheckGain& g = r.gain;
     md << "\n| figure | base | extended |\n|---|---|---|\n"
@@ -331,7 +345,15 @@ void writeReport(const std::string& dir_text, const ModelCheckCliOptions& opt, c
        << "| Ljung-Box p of the innovations | " << fmt("%.3g", g.ljung_box_p_base) << " | "
        << fmt("%.3g", g.ljung_box_p_extended) << " |\n"
        << "| fraction of tau inside the 90 % band | " << fmt("%.3f", g.in_band_base) << " | "
-       << fmt("%.3f", g.in_band_extended) << " |\n";
+       << fmt("%.3f", g.in_band_extended) << " |\n"
+       << "| held out: innovation variance (fit 1st half, score 2nd) | " << fmt("%.4g", g.innovation_var_base_held_out)
+       << " | " << fmt("%.4g", g.innovation_var_extended_held_out) << " |\n"
+       << "| held out: Ljung-Box p | " << fmt("%.3g", g.ljung_box_p_base_held_out) << " | "
+       << fmt("%.3g", g.ljung_box_p_extended_held_out) << " |\n";
+    if (r.verdict.judged)
+      md << "\nExtension " << (r.verdict.accepted ? "**accepted**" : "**not accepted**")
+         << " (better: " << (betterMeasures(r.verdict).empty() ? "none" : joined(betterMeasures(r.verdict)))
+         << "; worse: " << (worseMeasures(r.verdict).empty() ? "none" : joined(worseMeasures(r.verdict))) << ").\n";
     md << "\nStatistics (value, median of the null, threshold):\n\n";
     for (const CheckStatistic& s : r.statistics)
       md << "- " << s.name << ": " << fmt("%.4g", s.value) << " (null median " << fmt("%.4g", s.null_median)
@@ -385,13 +407,20 @@ AxisNoiseModel extendedAxisModel(const AxisModelCheck& r, std::span<const double
                                  const recording::Recording& rec, double rate_hz, double temperature_reference_c,
                                  const std::string& name, std::vector<std::string>& notes) {
   AxisNoiseModel m;
-  m.terms = r.extended_fit.value;
+  // An extension that did not gain is not the model: the base terms stay, and its effects
+  // become comments.
+  m.terms = r.verdict.accepted ? r.extended_fit.value : r.base_fit.value;
   long double sum = 0.0L;
   for (double v : rate_dps) sum += v;
   double bias = static_cast<double>(sum / static_cast<long double>(rate_dps.size()));
   const double n = static_cast<double>(rate_dps.size());
   AxisExtraEffects& x = m.extra;
   for (const DetectedEffect& e : r.effects) {
+    if (!e.explained) {
+      notes.push_back(name + ": " + std::string(modelEffectName(e.effect)) + " seen, not explained (" +
+                      notExplainedReason(r.verdict) + "): not modelled");
+      continue;
+    }
     switch (e.effect) {
       case ModelEffect::TemperatureBias:
         x.temperature_coefficient_dps_per_c = e.k_dps_per_c;
@@ -491,11 +520,12 @@ int runModelCheck(const ModelCheckCliOptions& opt) {
   options.replicas = opt.replicas;
   options.threads = opt.threads;
   for (std::size_t idx : in.axis_indices) requireAnalysableValues(rec, idx);
+  const ChainChoice chain = settleChain(opt.file, opt.dlpf_cfg, opt.fs_sel, in);
   const TimingSummary timing = checkTiming(rec, opt.rate_hz);
   reportTiming(opt.file, timing, opt.strict_timing);
   std::vector<std::pair<std::string, AxisModelCheck>> results;
   for (std::size_t idx : in.axis_indices) {
-    AxisModelCheckInput axis{rec.axes[idx], in.rate_hz, rec.temp, rec.t};
+    AxisModelCheckInput axis{rec.axes[idx], chain.rate_hz, rec.temp, rec.t, chain.chain};
     try {
       results.emplace_back(rec.axis_names[idx], checkAxisModel(axis, options));
     } catch (const std::invalid_argument& e) {
@@ -513,6 +543,7 @@ int runModelCheck(const ModelCheckCliOptions& opt) {
     doc["replicas"] = opt.replicas;
     doc["elapsed_s"] = seconds;
     doc["timing"] = timingJson(timing);
+    doc["acquisition_chain"] = chainJson(chain);
     doc["axes"] = json::object();
     for (const auto& [name, r] : results) doc["axes"][name] = axisJson(r);
     std::cout << doc.dump(1) << '\n';
@@ -520,11 +551,12 @@ int runModelCheck(const ModelCheckCliOptions& opt) {
     std::printf("gyroctl model-check %s: %zu samples at %g Hz (%s), %.1f s; %zu replicas per round, seed %llu\n",
                 opt.file.c_str(), rec.size(), in.rate_hz, in.rate_source.c_str(),
                 static_cast<double>(rec.size()) / in.rate_hz, opt.replicas, static_cast<unsigned long long>(opt.seed));
+    std::printf("%s\n", chainText(chain).c_str());
     for (const auto& [name, r] : results) printAxisText(std::cout, name, r);
     std::printf("\nchecked in %.2f s\n", seconds);
   }
   if (!opt.report_dir.empty()) {
-    writeReport(opt.report_dir, opt, in, results, seconds);
+    writeReport(opt.report_dir, opt, in, chain, results, seconds);
     if (!opt.json) std::printf("report written to %s/report.md\n", opt.report_dir.c_str());
   }
   if (!opt.write_model.empty()) {
@@ -554,6 +586,13 @@ void addModelCheckCommand(CLI::App& app, CommandRunner& run) {
       ->default_val(40)
       ->check(CLI::Range(std::size_t{8}, std::size_t{10000}));
   sub->add_option("--threads", opt->threads, "threads for the replicas (0: all cores)")->default_val(0);
+  sub->add_option("--dlpf", opt->dlpf_cfg,
+                  "DLPF_CFG 0..6 the recording was made with (default: the recording's '# device' header, else "
+                  "estimated from the Allan curve)")
+      ->check(CLI::Range(0, 6));
+  sub->add_option("--fs-sel", opt->fs_sel,
+                  "FS_SEL 0..3 the recording was made with: the LSB the replicas are rounded to (default: the header)")
+      ->check(CLI::Range(0, 3));
   sub->add_option(
       "--write-model", opt->write_model,
       "write the extended model of every axis (terms and named effects) as TOML for gyroctl simulate --model");

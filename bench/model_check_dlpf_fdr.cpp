@@ -1,0 +1,100 @@
+// False discoveries of the model check on clean gyrod-like recordings made through every DLPF
+// setting (processing/hidden_effect_generator.hpp with its dlpf_cfg set; the check told the
+// chain, as gyrod's '# device' header tells it). Any effect reported on an axis is a false
+// discovery. Not a unit test and not run by ctest: scripts/model-check-dlpf-fdr.sh builds and
+// runs it; the table is in docs/model-check.md.
+//
+//   model_check_dlpf_fdr [--seeds N] [--first S] [--duration SEC] [--replicas R] [--cfg C]
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "processing/hidden_effect_generator.hpp"
+#include "processing/model_check.hpp"
+
+using namespace gyrod::processing;
+
+namespace {
+
+// Wilson score interval's upper end at 95 % for k of n.
+double wilsonUpper(std::size_t k, std::size_t n) {
+  if (n == 0) return 1.0;
+  const double z = 1.96, p = static_cast<double>(k) / static_cast<double>(n), nn = static_cast<double>(n);
+  const double centre = p + z * z / (2.0 * nn);
+  const double spread = z * std::sqrt(p * (1.0 - p) / nn + z * z / (4.0 * nn * nn));
+  return (centre + spread) / (1.0 + z * z / nn);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::size_t seeds = 20, first = 1000, replicas = 40;
+  double duration = 600.0;
+  int only_cfg = -1;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string key = argv[i];
+    const char* v = argv[i + 1];
+    if (key == "--seeds")
+      seeds = std::strtoul(v, nullptr, 10);
+    else if (key == "--first")
+      first = std::strtoul(v, nullptr, 10);
+    else if (key == "--duration")
+      duration = std::strtod(v, nullptr);
+    else if (key == "--replicas")
+      replicas = std::strtoul(v, nullptr, 10);
+    else if (key == "--cfg")
+      only_cfg = std::atoi(v);
+    else {
+      std::fprintf(stderr, "model_check_dlpf_fdr: unknown option %s\n", key.c_str());
+      return 2;
+    }
+  }
+  // Each setting at a rate it allows (the narrow ones at gyrod's default 50 Hz).
+  const std::vector<std::pair<int, double>> settings{{0, 100.0}, {1, 200.0}, {2, 200.0}, {3, 100.0},
+                                                     {4, 50.0},  {5, 50.0},  {6, 50.0}};
+  std::printf("clean %g s records through each DLPF setting, %zu seeds from %zu, %zu replicas, 3 axes each\n\n",
+              duration, seeds, first, replicas);
+  std::printf("| DLPF_CFG | rate [Hz] | axes | false discoveries | per axis | 95 %% upper bound | effects named |\n");
+  std::printf("|---|---|---|---|---|---|---|\n");
+  std::size_t all_axes = 0, all_false = 0;
+  const auto start = std::chrono::steady_clock::now();
+  for (const auto& [cfg, rate] : settings) {
+    if (only_cfg >= 0 && cfg != only_cfg) continue;
+    std::size_t axes = 0, false_axes = 0;
+    std::map<std::string, std::size_t> named;
+    for (std::size_t s = first; s < first + seeds; ++s) {
+      HiddenEffectGenerator gen(s);
+      gen.dlpf_cfg = cfg;
+      // The same number of samples at every rate: the check's cost and power depend on it.
+      const GeneratedRecording g = gen.generate(duration * 50.0 / rate, rate, {});
+      for (std::size_t a = 0; a < 3; ++a) {
+        ModelCheckOptions o;
+        o.seed = s;
+        o.replicas = replicas;
+        const AxisModelCheck r = checkAxisModel({g.axes[a], g.rate_hz, g.temp, g.t, {cfg, 0}}, o);
+        ++axes;
+        if (!r.effects.empty()) ++false_axes;
+        for (const DetectedEffect& e : r.effects) ++named[std::string(modelEffectName(e.effect))];
+      }
+    }
+    std::string list;
+    for (const auto& [name, count] : named) list += (list.empty() ? "" : ", ") + name + " " + std::to_string(count);
+    std::printf("| %d | %g | %zu | %zu | %.2f %% | %.2f %% | %s |\n", cfg, rate, axes, false_axes,
+                100.0 * static_cast<double>(false_axes) / static_cast<double>(axes),
+                100.0 * wilsonUpper(false_axes, axes), list.empty() ? "none" : list.c_str());
+    std::fflush(stdout);
+    all_axes += axes;
+    all_false += false_axes;
+  }
+  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf("\nall settings: %zu of %zu axes (%.2f %%, 95 %% upper bound %.2f %%); %.0f s\n", all_false, all_axes,
+              100.0 * static_cast<double>(all_false) / static_cast<double>(all_axes),
+              100.0 * wilsonUpper(all_false, all_axes), secs);
+  return 0;
+}

@@ -1,0 +1,179 @@
+// The acceptance rule of the model check (docs/model-check.md, "An extension is accepted only
+// if it gains"): each hidden effect, and two at once, is found and its extension gains out of
+// sample (fresh replicas for the Allan figures, the held-back half of the record for the
+// Kalman figures); removing outliers leaves the Allan curve the base model predicts; the
+// issue's case (50 of 50 spikes found, yet the axis called unexplained and the extension
+// scored worse) is a regression test; an extension that does not gain is "seen, not explained".
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "processing/hidden_effect_generator.hpp"
+#include "processing/model_check.hpp"
+
+using namespace gyrod::processing;
+
+namespace {
+
+constexpr double kDuration = 600.0;
+constexpr double kRate = 50.0;
+
+ModelCheckOptions options(std::uint64_t seed) {
+  ModelCheckOptions o;
+  o.seed = seed;
+  o.threads = 2;
+  return o;
+}
+
+std::string describe(const AxisModelCheck& r) {
+  std::string s;
+  for (const DetectedEffect& e : r.effects)
+    s += std::string(modelEffectName(e.effect)) + (e.explained ? "" : " (not explained)") + "; ";
+  const ModelCheckGain& g = r.gain;
+  char buf[400];
+  std::snprintf(buf, sizeof buf,
+                "adev %.4g -> %.4g, band %.3f -> %.3f, held-out innovation var %.5g -> %.5g, held-out LB p %.3g -> "
+                "%.3g",
+                g.adev_log_error_base, g.adev_log_error_extended, g.in_band_base, g.in_band_extended,
+                g.innovation_var_base_held_out, g.innovation_var_extended_held_out, g.ljung_box_p_base_held_out,
+                g.ljung_box_p_extended_held_out);
+  return s + buf;
+}
+
+bool has(const AxisModelCheck& r, ModelEffect e) {
+  for (const DetectedEffect& d : r.effects)
+    if (d.effect == e) return true;
+  return false;
+}
+
+// The gain on every measure: none worse beyond the rule's allowance, one better, the
+// extension accepted, every effect explained, nothing unexplained.
+void expectGain(const AxisModelCheck& r, const std::string& what) {
+  const ModelCheckGain& g = r.gain;
+  EXPECT_TRUE(r.verdict.judged) << what << ": " << describe(r);
+  EXPECT_TRUE(r.verdict.accepted) << what << ": " << describe(r);
+  EXPECT_LE(g.innovation_var_extended_held_out, g.innovation_var_base_held_out) << what << ": " << describe(r);
+  EXPECT_LE(g.innovation_var_extended, g.innovation_var_base) << what << ": " << describe(r);
+  EXPECT_LE(g.adev_log_error_extended, 1.5 * g.adev_log_error_base + 0.002) << what << ": " << describe(r);
+  EXPECT_GE(g.in_band_extended, g.in_band_base - 0.2) << what << ": " << describe(r);
+  EXPECT_FALSE(has(r, ModelEffect::Unexplained)) << what << ": " << describe(r);
+  for (const DetectedEffect& e : r.effects) EXPECT_TRUE(e.explained) << what << ": " << describe(r);
+}
+
+AxisModelCheck checkHiddenAxis(const GeneratedRecording& g, std::size_t axis, std::uint64_t seed) {
+  return checkAxisModel({g.axes[axis], g.rate_hz, g.temp, g.t}, options(seed));
+}
+
+}  // namespace
+
+// The issue's case: an axis with 50 isolated spikes. All 50 were found, yet the axis was called
+// unexplained at τ 0.02–0.5 s and the extension scored worse (ADEV log error 0.0104 → 0.0120,
+// in-band 1.00 → 0.59). Six seeds.
+TEST(ModelCheckGain, FiftySpikesAreFoundAndTheExtensionGains) {
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    HiddenEffectGenerator gen(seed);
+    gen.outlier_count_lo = gen.outlier_count_hi = 50;
+    const GeneratedRecording g = gen.generate(kDuration, kRate, {ModelEffect::Outliers});
+    const AxisModelCheck r = checkHiddenAxis(g, g.hidden[0].axis, seed);
+    ASSERT_TRUE(has(r, ModelEffect::Outliers)) << "seed " << seed << ": " << describe(r);
+    for (const DetectedEffect& e : r.effects)
+      if (e.effect == ModelEffect::Outliers) EXPECT_EQ(e.count, 50u) << "seed " << seed;
+    expectGain(r, "50 spikes, seed " + std::to_string(seed));
+  }
+}
+
+// Spikes are white to the Allan variance: with them removed and handed to the extension, its
+// replicas must draw the base model's curve: medians within 3 % at every τ, plus a quarter of
+// the band's width where 40 replicas pin their median less well (long τ).
+TEST(ModelCheckGain, RemovingOutliersLeavesTheBaseModelsAllanCurve) {
+  for (std::uint64_t seed : {2u, 5u}) {
+    HiddenEffectGenerator gen(seed);
+    gen.outlier_count_lo = gen.outlier_count_hi = 50;
+    const GeneratedRecording g = gen.generate(kDuration, kRate, {ModelEffect::Outliers});
+    const AxisModelCheck r = checkHiddenAxis(g, g.hidden[0].axis, seed);
+    ASSERT_EQ(r.allan_base.tau_s.size(), r.allan_extended.tau_s.size());
+    for (std::size_t j = 0; j < r.allan_base.tau_s.size(); ++j)
+      EXPECT_NEAR(r.allan_extended.median[j] / r.allan_base.median[j], 1.0,
+                  0.03 + 0.25 * (r.allan_base.hi[j] - r.allan_base.lo[j]) / r.allan_base.median[j])
+          << "seed " << seed << ", tau " << r.allan_base.tau_s[j];
+  }
+}
+
+// Each catalogue effect hidden alone (clear sizes, as the blind tests use), then two at once.
+TEST(ModelCheckGain, EachHiddenEffectGainsOutOfSample) {
+  struct Case {
+    ModelEffect effect;
+    std::uint64_t seed;
+  };
+  for (const Case& c :
+       {Case{ModelEffect::Sinusoid, 7}, Case{ModelEffect::TemperatureBias, 17}, Case{ModelEffect::Outliers, 11},
+        Case{ModelEffect::BiasSteps, 19}, Case{ModelEffect::GaussMarkov, 23}}) {
+    HiddenEffectGenerator gen(c.seed);
+    gen.step_size_lo = 20.0;
+    gen.step_size_hi = 30.0;
+    gen.gm_tau_hi_fraction = 1.0 / 300.0;
+    gen.gm_peak_lo = 2.5;
+    gen.gm_peak_hi = 3.5;
+    const GeneratedRecording g = gen.generate(kDuration, kRate, {c.effect});
+    const AxisModelCheck r = checkHiddenAxis(g, g.hidden[0].axis, c.seed);
+    const std::string what(modelEffectName(c.effect));
+    ASSERT_TRUE(has(r, c.effect)) << what << ": " << describe(r);
+    expectGain(r, what);
+  }
+}
+
+TEST(ModelCheckGain, TwoEffectsAtOnceGainOutOfSample) {
+  struct Case {
+    ModelEffect a, b;
+    std::uint64_t seed;
+  };
+  for (const Case& c : {Case{ModelEffect::Sinusoid, ModelEffect::TemperatureBias, 31},
+                        Case{ModelEffect::Outliers, ModelEffect::BiasSteps, 37},
+                        Case{ModelEffect::Outliers, ModelEffect::Sinusoid, 41}}) {
+    HiddenEffectGenerator gen(c.seed);
+    gen.step_size_lo = 20.0;
+    gen.step_size_hi = 30.0;
+    const GeneratedRecording g = gen.generate(kDuration, kRate, {c.a, c.b});
+    for (std::size_t axis = 0; axis < 3; ++axis) {
+      std::vector<ModelEffect> hidden;
+      for (const HiddenEffect& h : g.hidden)
+        if (h.axis == axis) hidden.push_back(h.effect);
+      if (hidden.empty()) continue;
+      const AxisModelCheck r = checkHiddenAxis(g, axis, c.seed);
+      const std::string what = std::string(modelEffectName(c.a)) + " + " + std::string(modelEffectName(c.b)) +
+                               ", axis " + std::to_string(axis);
+      for (ModelEffect e : hidden) EXPECT_TRUE(has(r, e)) << what << ": " << describe(r);
+      expectGain(r, what);
+    }
+  }
+}
+
+// An extension that is not accepted was better on no more measures than it was worse on.
+TEST(ModelCheckGain, AnExtensionThatDoesNotGainIsSeenNotExplained) {
+  // A lightly damped AR(2) resonance is outside the catalogue: whatever the check names on it
+  // must not be accepted as an explanation unless it gains; either way the axis is
+  // `unexplained` (tests/processing/test_model_check.cpp has the resonance itself).
+  HiddenEffectGenerator gen(3);
+  const GeneratedRecording g = gen.generate(kDuration, kRate, {});
+  std::vector<double> x = g.axes[0];
+  double a1 = 0.0, a2 = 0.0;
+  NormalGenerator n(9);
+  for (double& v : x) {
+    const double r = 1.6 * a1 - 0.97 * a2 + 0.02 * n.next();
+    a2 = a1;
+    a1 = r;
+    v += r;
+  }
+  const AxisModelCheck r = checkAxisModel({x, g.rate_hz, g.temp, g.t}, options(3));
+  EXPECT_TRUE(has(r, ModelEffect::Unexplained)) << describe(r);
+  for (const DetectedEffect& e : r.effects)
+    if (!e.explained) EXPECT_FALSE(r.verdict.accepted) << describe(r);
+  if (r.verdict.judged && !r.verdict.accepted) {
+    const ExtensionVerdict& v = r.verdict;
+    const int worse = int{v.adev_worse} + int{v.band_worse} + int{v.innovation_worse} + int{v.ljung_box_worse};
+    const int better = int{v.adev_better} + int{v.band_better} + int{v.innovation_better} + int{v.ljung_box_better};
+    EXPECT_LE(better, worse);
+  }
+}
