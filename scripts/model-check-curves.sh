@@ -7,6 +7,7 @@
 #   scripts/model-check-curves.sh [TRIALS_10MIN] [TRIALS_1H] [EFFECTS_1H] [CLEAN_10MIN]
 #     defaults 10, 5, "bias_steps,gauss_markov_long" and 30; the curves run as parallel jobs
 #     (nice -n 10); their tables go to build/model-check-curves/*.txt and to stdout.
+#   PLOT_ONLY=1 scripts/model-check-curves.sh   redraws the PNGs from the last run's tables
 set -euo pipefail
 cd "$(dirname "$0")/.."
 trials_short="${1:-10}"
@@ -15,6 +16,7 @@ effects_long="${3:-bias_steps,gauss_markov_long}"
 clean_short="${4:-30}"
 data=build/model-check-curves
 mkdir -p "$data" docs/img
+if [ -z "${PLOT_ONLY:-}" ]; then
 rm -f "$data"/*.dat "$data"/*.txt
 cmake -S . -B build -DGYROD_BUILD_BENCHMARKS=ON >/dev/null
 cmake --build build -j2 --target model_check_curves >/dev/null
@@ -33,6 +35,7 @@ fi
 wait
 cat "$data"/*.txt
 echo "wall time $(( $(date +%s) - start )) s"
+fi
 command -v gnuplot >/dev/null || { echo "gnuplot not installed: tables only" >&2; exit 0; }
 for dat in "$data"/*-600.dat; do
   name=$(basename "$dat" -600.dat)
@@ -45,12 +48,14 @@ for dat in "$data"/*-600.dat; do
           '$long' u 1:5:6:7 w yerrorlines lw 2 dt 2 lc rgb '#17becf' t 'known form, 1 h'"
   fi
   gnuplot <<GP
-set terminal pngcairo size 720,440 font ",10"
+set terminal pngcairo size 720,440 font ",10" noenhanced
 set output "docs/img/model-check-$name.png"
 set title "$name: detection probability (Wilson 95 % intervals)"
 set xlabel "$what"
 set ylabel "P(detect)"
 set logscale x
+set autoscale xfix
+set offsets graph 0.03, graph 0.03, 0, 0
 set yrange [-0.02:1.02]
 set grid
 set key bottom right
