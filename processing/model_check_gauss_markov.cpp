@@ -3,6 +3,14 @@
 #include "processing/model_check_pipeline.hpp"
 
 namespace gyrod::processing::model_check_detail {
+namespace {
+// The Gauss–Markov statistic's share of the per-axis false-alarm budget: 10 × the nominal α
+// of a statistic (1e-3 at the default 1e-4), as the step statistic's (model_check_steps.cpp).
+// The square root of the χ² gain has a null tail the Gumbel model holds to (the raw gain's
+// did not: docs/model-check.md), so the extra budget buys power, measured on the detection
+// curves, at a clean-data rate that stays within the 1 % per axis of issue 13.
+constexpr double kGaussMarkovAlphaFactor = 10.0;
+}  // namespace
 
 GaussMarkovFound checkGaussMarkov(std::span<const double> xc, const Context& c, bool deterministic_found,
                                   const std::vector<AllanPoint>& curve, const std::vector<SeriesStats>& base_reps,
@@ -24,7 +32,7 @@ GaussMarkovFound checkGaussMarkov(std::span<const double> xc, const Context& c, 
   } else {
     null_values = column(base_reps, &SeriesStats::gm_statistic);
   }
-  const NullSummary null = summarizeNull(null_values, o.false_alarm, false);
+  const NullSummary null = summarizeNull(null_values, o.false_alarm * kGaussMarkovAlphaFactor, false);
   const double stat = gaussMarkovStatistic(gm.fit);
   out.statistics.push_back(makeStatistic("gauss_markov_sqrt_chi2_gain", stat, null));
   gm.found = null.fires(stat) && gm.fit.sigma_dps > 0.0;

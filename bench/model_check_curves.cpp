@@ -1,0 +1,481 @@
+// Detection curves of the model check: for each effect of the catalogue that has a size
+// (bias step, sinusoid, temperature response, Gauss–Markov), the probability that the blind
+// check (processing/model_check.hpp) names it, against the effect's size and the record's
+// length, beside the detector that knows the effect's form (processing/known_form_detectors.hpp)
+// on the same records at a 1 % false-alarm threshold calibrated on clean records.
+// Not a unit test (minutes); scripts/model-check-curves.sh runs it and draws the PNGs of
+// docs/model-check.md; ctest runs its --quick mode (scripts/check-model-check-curves.sh).
+//
+//   model_check_curves [--quick] [--trials N] [--durations S,S] [--effects a,b] [--replicas R]
+//                      [--calibration M] [--clean C] [--data DIR]
+//
+// Records: one axis at 50 Hz of fixed base noise (Q 2 µrad, N 0.5 °/√h, B 10 °/h,
+// K 3 °/h^1.5, quantised at 131 LSB per °/s) with a temperature channel (warm-up + room
+// cycle + noise). Trial j of a duration has its own noise, step time, frequency, phase and
+// Gauss–Markov realisation; only the size changes along a curve (common random numbers).
+// Output: per curve, lines "size trials blind lo hi optimal lo hi" (Wilson 95 % intervals),
+// then a "summary" line; false discoveries on clean records; --data DIR writes each curve as
+// DIR/<effect>-<duration>.dat for gnuplot.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "processing/known_form_detectors.hpp"
+#include "processing/model_check.hpp"
+#include "processing/model_check_detail.hpp"
+#include "processing/noise_simulator.hpp"
+#include "processing/noise_terms.hpp"
+#include "processing/portable_random.hpp"
+
+using namespace gyrod;
+using namespace gyrod::processing;
+
+namespace {
+
+constexpr double kRate = 50.0;
+constexpr double kLsb = 131.0;
+constexpr double kFalseAlarm = 0.01;
+
+NoiseTerms baseTerms() {
+  NoiseTerms t;
+  t.quantization_urad = 2.0;
+  t.arw_deg_per_sqrt_h = 0.5;
+  t.bias_instability_deg_per_h = 10.0;
+  t.rrw_deg_per_h_sqrt_h = 3.0;
+  return t;
+}
+double whiteSd() { return baseTerms().arw_deg_per_sqrt_h / 60.0 * std::sqrt(kRate); }
+double adevFloor() {  // smallest base Allan deviation over τ = 2..128 s, as the generator sizes steps
+  double f = 1e300;
+  for (double tau = 2.0; tau <= 128.0; tau *= 2.0) f = std::min(f, std::sqrt(allanVarianceOfTerms(baseTerms(), tau)));
+  return f;
+}
+
+enum class Kind { Step, Sinusoid, Temperature, GaussMarkov };
+struct Curve {
+  Kind kind;
+  std::string name;          // file and table name
+  std::string size_what;     // what the size is
+  double gm_fraction = 0.0;  // Gauss–Markov: T / duration
+  std::vector<double> sizes;
+};
+
+// What a trial draws once, whatever the size.
+struct TrialShape {
+  std::vector<double> noise;  // base noise, unquantised
+  std::vector<double> temp;   // measured temperature
+  double step_time = 0.0, step_sign = 1.0, freq = 0.0, phase = 0.0;
+  std::vector<double> gm_unit;  // unit-variance Gauss–Markov realisation (when needed)
+};
+
+struct Records {
+  double duration = 0.0;
+  std::size_t n = 0;
+  std::vector<double> true_temp, t;
+  double temp_range = 0.0;  // peak-to-peak of the detrended true temperature
+};
+
+Records makeRecords(double duration) {
+  Records r;
+  r.duration = duration;
+  r.n = static_cast<std::size_t>(duration * kRate);
+  r.true_temp.resize(r.n);
+  r.t.resize(r.n);
+  for (std::size_t i = 0; i < r.n; ++i) {
+    const double t = static_cast<double>(i) / kRate;
+    r.t[i] = t;
+    r.true_temp[i] =
+        23.0 + 6.0 * (1.0 - std::exp(-t / 500.0)) + 0.8 * std::sin(2.0 * std::numbers::pi * t / 2700.0 + 1.0);
+  }
+  std::vector<double> d = r.true_temp;
+  model_check_detail::removeLineInPlace(d);
+  r.temp_range = *std::max_element(d.begin(), d.end()) - *std::min_element(d.begin(), d.end());
+  return r;
+}
+
+TrialShape drawTrial(const Records& rec, std::uint64_t seed, double gm_tau) {
+  SplitMix64 seeder(seed);
+  TrialShape s;
+  SimulationModel model;
+  model.rate_hz = kRate;
+  model.axes[0].terms = baseTerms();
+  NoiseSimulator sim(model, rec.duration, seeder.next());
+  s.noise.resize(rec.n);
+  for (double& v : s.noise) v = sim.next().rate_dps[0];
+  NormalGenerator tn(seeder.next());
+  s.temp.resize(rec.n);
+  for (std::size_t i = 0; i < rec.n; ++i) s.temp[i] = std::round((rec.true_temp[i] + 0.02 * tn.next()) * 340.0) / 340.0;
+  Xoshiro256StarStar u(seeder.next());
+  s.step_time = (0.2 + 0.6 * u.uniform()) * rec.duration;
+  s.step_sign = u.uniform() < 0.5 ? -1.0 : 1.0;
+  s.freq = std::exp(std::log(0.2) + u.uniform() * std::log(0.4 * kRate / 0.2));
+  s.phase = 2.0 * std::numbers::pi * u.uniform();
+  if (gm_tau > 0.0) {
+    NormalGenerator g(seeder.next());
+    const double rho = std::exp(-1.0 / (kRate * gm_tau)), q = std::sqrt(1.0 - rho * rho);
+    s.gm_unit.resize(rec.n);
+    double x = g.next();
+    for (double& v : s.gm_unit) {
+      v = x;
+      x = rho * x + q * g.next();
+    }
+  }
+  return s;
+}
+
+// σ of a Gauss–Markov process of correlation time T whose Allan-deviation peak is `ratio`
+// times the base model's there (as the hidden-effect generator sizes it).
+double gmSigmaForPeak(double tau, double ratio) {
+  double peak = 0.0;
+  for (double t = tau / 10.0; t < tau * 10.0; t *= 1.05)
+    peak = std::max(peak, gaussMarkovAllanVariance(t, tau, 1.0) / allanVarianceOfTerms(baseTerms(), t));
+  return ratio / std::sqrt(peak);
+}
+
+std::vector<double> withEffect(const Records& rec, const TrialShape& s, const Curve& c, double size) {
+  std::vector<double> x = s.noise;
+  const double tr = c.kind == Kind::GaussMarkov ? gmSigmaForPeak(c.gm_fraction * rec.duration, size) : 0.0;
+  double temp_mean = 0.0;
+  for (double v : rec.true_temp) temp_mean += v / static_cast<double>(rec.n);
+  const double k = size * adevFloor() / rec.temp_range;
+  for (std::size_t i = 0; i < rec.n; ++i) {
+    const double t = rec.t[i];
+    switch (c.kind) {
+      case Kind::Step: x[i] += t >= s.step_time ? s.step_sign * size * adevFloor() : 0.0; break;
+      case Kind::Sinusoid: x[i] += size * whiteSd() * std::sin(2.0 * std::numbers::pi * s.freq * t + s.phase); break;
+      case Kind::Temperature: x[i] += k * (rec.true_temp[i] - temp_mean); break;
+      case Kind::GaussMarkov: x[i] += tr * s.gm_unit[i]; break;
+    }
+  }
+  for (double& v : x) v = std::round(v * kLsb) / kLsb;
+  return x;
+}
+
+// ---- the known-form detector, calibrated on clean records ------------------------------
+
+struct Oracle {
+  std::vector<double> step_sd;     // per dyadic window
+  std::vector<double> base_power;  // expected Hann periodogram of the clean record
+  std::vector<double> gm_shape;    // of the curve's T
+  double threshold = 0.0;
+  std::size_t block = 50;  // 1 s blocks
+};
+
+double oracleStatistic(const Oracle& o, const Curve& c, const TrialShape& s, const std::vector<double>& x) {
+  switch (c.kind) {
+    case Kind::Step:
+      return knownStepStatistic(
+          knownStepDifferences(x, static_cast<std::size_t>(std::ceil(s.step_time * kRate)), o.block), o.step_sd);
+    case Kind::Sinusoid: return knownSinusoidStatistic(x, kRate, s.freq);
+    case Kind::Temperature: return knownTemperatureStatistic(x, s.temp, o.block);
+    case Kind::GaussMarkov: {
+      std::vector<double> y = x;
+      model_check_detail::removeLineInPlace(y);
+      return spectralScoreStatistic(model_check_detail::hannPeriodogram(y).power, o.base_power, o.gm_shape);
+    }
+  }
+  return 0.0;
+}
+
+// Calibration: the first half of the clean records sets what the detector knows of the noise
+// (step windows' sd, the expected periodogram), the second half its 1 % threshold.
+Oracle calibrate(const Records& rec, const Curve& c, std::size_t records, std::uint64_t seed_base) {
+  Oracle o;
+  std::vector<TrialShape> shapes;
+  std::vector<std::vector<double>> clean;
+  for (std::size_t j = 0; j < records; ++j) {
+    shapes.push_back(drawTrial(rec, seed_base + j, 0.0));
+    clean.push_back(withEffect(rec, shapes.back(), {Kind::Step, "", "", 0.0, {}}, 0.0));
+  }
+  const std::size_t half = records / 2;
+  if (c.kind == Kind::Step) {
+    std::vector<double> sum2;
+    std::vector<std::size_t> count;
+    for (std::size_t j = 0; j < half; ++j) {
+      const auto d =
+          knownStepDifferences(clean[j], static_cast<std::size_t>(std::ceil(shapes[j].step_time * kRate)), o.block);
+      if (d.size() > sum2.size()) {
+        sum2.resize(d.size(), 0.0);
+        count.resize(d.size(), 0);
+      }
+      for (std::size_t w = 0; w < d.size(); ++w) {
+        sum2[w] += d[w] * d[w];
+        ++count[w];
+      }
+    }
+    for (std::size_t w = 0; w < sum2.size(); ++w)
+      o.step_sd.push_back(count[w] > 4 ? std::sqrt(sum2[w] / static_cast<double>(count[w])) : 0.0);
+  }
+  if (c.kind == Kind::GaussMarkov) {
+    for (std::size_t j = 0; j < half; ++j) {
+      std::vector<double> y = clean[j];
+      model_check_detail::removeLineInPlace(y);
+      const auto p = model_check_detail::hannPeriodogram(y);
+      if (o.base_power.empty()) {
+        o.base_power.assign(p.power.size(), 0.0);
+        o.gm_shape = gaussMarkovSpectralShape(c.gm_fraction * rec.duration, kRate, p.nfft);
+      }
+      for (std::size_t k = 0; k < p.power.size(); ++k) o.base_power[k] += p.power[k] / static_cast<double>(half);
+    }
+    o.base_power[0] = 0.0;  // the mean, removed
+  }
+  std::vector<double> values;
+  for (std::size_t j = half; j < records; ++j) values.push_back(oracleStatistic(o, c, shapes[j], clean[j]));
+  o.threshold = calibratedThreshold(values, kFalseAlarm);
+  return o;
+}
+
+// ---- tallies -------------------------------------------------------------------------
+
+struct Wilson {
+  double p = 0.0, lo = 0.0, hi = 0.0;
+};
+Wilson wilson(std::size_t k, std::size_t n) {
+  if (n == 0) return {NAN, NAN, NAN};
+  const double z = 1.959964, nn = static_cast<double>(n), p = static_cast<double>(k) / nn;
+  const double den = 1.0 + z * z / nn, mid = (p + z * z / (2.0 * nn)) / den;
+  const double half = z * std::sqrt(p * (1.0 - p) / nn + z * z / (4.0 * nn * nn)) / den;
+  return {p, std::max(0.0, mid - half), std::min(1.0, mid + half)};
+}
+
+// Size where the detection fraction first reaches 0.5, interpolated in log size; NaN when it
+// never does, the smallest size (as negative) when it already does there.
+double size50(const std::vector<double>& sizes, const std::vector<double>& p) {
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p[i] < 0.5) continue;
+    if (i == 0) return -sizes[0];
+    const double f = (0.5 - p[i - 1]) / (p[i] - p[i - 1]);
+    return std::exp(std::log(sizes[i - 1]) + f * (std::log(sizes[i]) - std::log(sizes[i - 1])));
+  }
+  return NAN;
+}
+
+std::string formatSize(double s) {
+  char buf[32];
+  if (std::isnan(s)) return ">max";
+  if (s < 0) {
+    std::snprintf(buf, sizeof buf, "<%.3g", -s);
+    return buf;
+  }
+  std::snprintf(buf, sizeof buf, "%.3g", s);
+  return buf;
+}
+
+bool blindNames(const AxisModelCheck& r, Kind k) {
+  const ModelEffect want = k == Kind::Step          ? ModelEffect::BiasSteps
+                           : k == Kind::Sinusoid    ? ModelEffect::Sinusoid
+                           : k == Kind::Temperature ? ModelEffect::TemperatureBias
+                                                    : ModelEffect::GaussMarkov;
+  for (const DetectedEffect& e : r.effects)
+    if (e.effect == want) return true;
+  return false;
+}
+
+struct Options {
+  std::size_t trials = 16, calibration = 300, clean = 40, replicas = 40;
+  std::vector<double> durations = {600.0, 3600.0};
+  std::vector<std::string> effects = {"bias_steps", "sinusoid", "temperature_bias", "gauss_markov_short",
+                                      "gauss_markov_long"};
+  std::string data_dir;
+  bool quick = false;
+};
+
+std::vector<Curve> curvesFor(double duration, const Options& opt) {
+  auto grid = [&](double lo, double factor) {
+    std::vector<double> g;
+    const std::size_t count = opt.quick ? 2 : 8;
+    const double f = opt.quick ? factor * factor * factor * factor : factor;
+    for (std::size_t i = 0; i < count; ++i)
+      g.push_back(lo * std::pow(f, static_cast<double>(i)) * (opt.quick ? 2.0 : 1.0));
+    return g;
+  };
+  const double sin_scale = std::sqrt(600.0 / duration);  // a coherent detector's reach grows as √n
+  // Each grid spans the known-form detector's rise to the blind check's (pilot runs).
+  std::vector<Curve> all = {
+      {Kind::Step, "bias_steps", "step / ADEV floor", 0.0, grid(2.0, std::sqrt(2.0))},
+      {Kind::Sinusoid, "sinusoid", "amplitude / white sd", 0.0, grid(0.01 * sin_scale, std::sqrt(2.0))},
+      {Kind::Temperature, "temperature_bias", "k x temperature range / ADEV floor", 0.0,
+       grid(std::sqrt(2.0), std::sqrt(2.0))},
+      {Kind::GaussMarkov, "gauss_markov_short", "GM ADEV peak / base (T = duration/300)", 1.0 / 300.0,
+       grid(0.5, std::sqrt(2.0))},
+      {Kind::GaussMarkov, "gauss_markov_long", "GM ADEV peak / base (T = duration/60)", 1.0 / 60.0,
+       grid(1.0, std::sqrt(2.0))},
+  };
+  std::vector<Curve> out;
+  for (const Curve& c : all)
+    if (std::find(opt.effects.begin(), opt.effects.end(), c.name) != opt.effects.end()) out.push_back(c);
+  return out;
+}
+
+ModelCheckOptions checkOptions(const Options& opt, std::uint64_t seed) {
+  ModelCheckOptions o;
+  o.replicas = opt.replicas;
+  o.seed = seed;
+  return o;
+}
+
+void runCurve(const Records& rec, const Curve& c, const Options& opt, double& check_seconds, std::size_t& checks) {
+  const auto dur = static_cast<std::uint64_t>(rec.duration);
+  const Oracle oracle = calibrate(rec, c, opt.calibration, 1000000 + dur * 1000);
+  std::vector<std::size_t> blind(c.sizes.size(), 0), optimal(c.sizes.size(), 0);
+  for (std::size_t j = 0; j < opt.trials; ++j) {
+    const std::uint64_t seed = 7000000 + dur * 1000 + j;
+    const TrialShape s = drawTrial(rec, seed, c.gm_fraction * rec.duration);
+    for (std::size_t i = 0; i < c.sizes.size(); ++i) {
+      const std::vector<double> x = withEffect(rec, s, c, c.sizes[i]);
+      optimal[i] += oracleStatistic(oracle, c, s, x) > oracle.threshold ? 1 : 0;
+      const auto t0 = std::chrono::steady_clock::now();
+      const AxisModelCheck r = checkAxisModel({x, kRate, s.temp, rec.t}, checkOptions(opt, seed));
+      check_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      ++checks;
+      blind[i] += blindNames(r, c.kind) ? 1 : 0;
+    }
+  }
+  std::printf("# curve %s duration %.0f s: size = %s; %zu trials per size; optimal threshold %.4g\n", c.name.c_str(),
+              rec.duration, c.size_what.c_str(), opt.trials, oracle.threshold);
+  std::printf("#   size  trials  blind    lo     hi   optimal  lo     hi\n");
+  std::FILE* dat = nullptr;
+  if (!opt.data_dir.empty()) {
+    const std::string path = opt.data_dir + "/" + c.name + "-" + std::to_string(dur) + ".dat";
+    dat = std::fopen(path.c_str(), "w");
+    if (!dat) {
+      std::fprintf(stderr, "cannot write %s\n", path.c_str());
+      std::exit(1);
+    }
+    std::fprintf(dat, "# %s, %.0f s: size blind lo hi optimal lo hi\n", c.size_what.c_str(), rec.duration);
+  }
+  std::vector<double> pb, po;
+  for (std::size_t i = 0; i < c.sizes.size(); ++i) {
+    const Wilson b = wilson(blind[i], opt.trials), o = wilson(optimal[i], opt.trials);
+    pb.push_back(b.p);
+    po.push_back(o.p);
+    std::printf("%8.4g %6zu %6.3f %6.3f %6.3f %6.3f %6.3f %6.3f\n", c.sizes[i], opt.trials, b.p, b.lo, b.hi, o.p, o.lo,
+                o.hi);
+    if (dat) std::fprintf(dat, "%g %g %g %g %g %g %g\n", c.sizes[i], b.p, b.lo, b.hi, o.p, o.lo, o.hi);
+  }
+  if (dat) std::fclose(dat);
+  const double b50 = size50(c.sizes, pb), o50 = size50(c.sizes, po);
+  // Detection above twice the blind 50 % size, pooled over those sizes.
+  std::size_t above_k = 0, above_n = 0;
+  if (!std::isnan(b50))
+    for (std::size_t i = 0; i < c.sizes.size(); ++i)
+      if (c.sizes[i] >= 2.0 * std::fabs(b50)) {
+        above_k += blind[i];
+        above_n += opt.trials;
+      }
+  const Wilson above = wilson(above_k, above_n);
+  const double ratio = (std::isnan(b50) || std::isnan(o50)) ? NAN : std::fabs(b50) / std::fabs(o50);
+  std::printf("summary %s %.0f blind50 %s optimal50 %s ratio %.3g above2x %zu/%zu (%.3f, %.3f..%.3f)\n\n",
+              c.name.c_str(), rec.duration, formatSize(b50).c_str(), formatSize(o50).c_str(), ratio, above_k, above_n,
+              above.p, above.lo, above.hi);
+}
+
+void runClean(const Records& rec, const Options& opt, double& check_seconds, std::size_t& checks) {
+  const auto dur = static_cast<std::uint64_t>(rec.duration);
+  std::size_t with_effect = 0;
+  std::map<std::string, std::size_t> names;
+  for (std::size_t j = 0; j < opt.clean; ++j) {
+    const std::uint64_t seed = 9000000 + dur * 1000 + j;
+    const TrialShape s = drawTrial(rec, seed, 0.0);
+    const std::vector<double> x = withEffect(rec, s, {Kind::Step, "", "", 0.0, {}}, 0.0);
+    const auto t0 = std::chrono::steady_clock::now();
+    const AxisModelCheck r = checkAxisModel({x, kRate, s.temp, rec.t}, checkOptions(opt, seed));
+    check_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ++checks;
+    with_effect += r.effects.empty() ? 0 : 1;
+    for (const DetectedEffect& e : r.effects) ++names[std::string(modelEffectName(e.effect))];
+  }
+  const Wilson w = wilson(with_effect, opt.clean);
+  std::printf("clean %.0f false_discoveries %zu/%zu (%.3f, %.3f..%.3f)", rec.duration, with_effect, opt.clean, w.p,
+              w.lo, w.hi);
+  for (const auto& [name, count] : names) std::printf(" %s:%zu", name.c_str(), count);
+  std::printf("\n\n");
+}
+
+std::vector<std::string> splitList(const std::string& s) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (start <= s.size()) {
+    const std::size_t comma = s.find(',', start);
+    out.push_back(s.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out;
+}
+
+Options parseOptions(int argc, char** argv) {
+  Options opt;
+  for (int i = 1; i < argc; ++i) {
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "%s needs a value\n", argv[i]);
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    const std::string a = argv[i];
+    if (a == "--quick") {
+      opt.quick = true;
+      opt.trials = 2;
+      opt.calibration = 40;
+      opt.clean = 2;
+      opt.replicas = 16;
+      opt.durations = {120.0};
+    } else if (a == "--trials") {
+      opt.trials = std::strtoull(next().c_str(), nullptr, 10);
+    } else if (a == "--calibration") {
+      opt.calibration = std::strtoull(next().c_str(), nullptr, 10);
+    } else if (a == "--clean") {
+      opt.clean = std::strtoull(next().c_str(), nullptr, 10);
+    } else if (a == "--replicas") {
+      opt.replicas = std::strtoull(next().c_str(), nullptr, 10);
+    } else if (a == "--durations") {
+      opt.durations.clear();
+      for (const std::string& d : splitList(next())) opt.durations.push_back(std::atof(d.c_str()));
+    } else if (a == "--effects") {
+      opt.effects = splitList(next());
+    } else if (a == "--data") {
+      opt.data_dir = next();
+    } else {
+      std::fprintf(stderr, "unknown option %s\n", a.c_str());
+      std::exit(2);
+    }
+  }
+  if (opt.trials == 0 || opt.calibration < 4) {
+    std::fprintf(stderr, "--trials must be > 0 and --calibration ≥ 4\n");
+    std::exit(2);
+  }
+  return opt;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Options opt = parseOptions(argc, argv);
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // tables appear as each curve ends
+  std::printf(
+      "model_check_curves: base Q 2 urad, N 0.5 deg/rt-h, B 10 deg/h, K 3 deg/h^1.5 at 50 Hz; white sd %.4g, "
+      "ADEV floor %.4g deg/s; %zu replicas; optimal threshold at %.0f %% false alarm from %zu clean records\n\n",
+      whiteSd(), adevFloor(), opt.replicas, 100.0 * kFalseAlarm, opt.calibration / 2);
+  double check_seconds = 0.0;
+  std::size_t checks = 0;
+  const auto start = std::chrono::steady_clock::now();
+  for (double duration : opt.durations) {
+    const Records rec = makeRecords(duration);
+    for (const Curve& c : curvesFor(duration, opt)) runCurve(rec, c, opt, check_seconds, checks);
+    if (opt.clean > 0) runClean(rec, opt, check_seconds, checks);
+  }
+  std::printf("checks %zu, mean %.2f s per check, total %.0f s\n", checks,
+              checks ? check_seconds / static_cast<double>(checks) : 0.0,
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  return 0;
+}

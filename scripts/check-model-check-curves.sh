@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# ctest's smoke test of the detection-curve program (bench/model_check_curves.cpp): its --quick
+# mode runs, and every table it prints parses (8 numbers per row, fractions in [0, 1], lo ≤ p
+# ≤ hi) with a summary line per curve and a clean-data line. No timing, no detection figures.
+#   scripts/check-model-check-curves.sh PATH/TO/model_check_curves
+set -euo pipefail
+out=$("$1" --quick)
+echo "$out"
+echo "$out" | awk '
+  /^# curve / { curves++; in_table = 1; next }
+  /^#/ { next }
+  /^summary / { summaries++; if (NF < 10 || $4 != "blind50" || $6 != "optimal50") { print "bad summary: " $0; bad++ } in_table = 0; next }
+  /^clean / { cleans++; next }
+  /^checks / { next }
+  NF == 0 || /^model_check_curves:/ { next }
+  in_table {
+    rows++
+    if (NF != 8) { print "row without 8 fields: " $0; bad++; next }
+    for (i = 1; i <= 8; i++) if ($i !~ /^[-+0-9.eE]+$/) { print "not a number: " $0; bad++; next }
+    for (c = 3; c <= 6; c += 3)
+      if ($c < 0 || $c > 1 || $(c + 1) > $c + 1e-9 || $(c + 2) < $c - 1e-9) { print "bad fraction or interval: " $0; bad++ }
+    next
+  }
+  { print "unexpected line: " $0; bad++ }
+  END {
+    if (curves < 5 || summaries != curves || cleans < 1 || rows < 2 * curves) {
+      printf "expected 5 curves with rows and summaries and a clean line; got %d curves, %d summaries, %d rows, %d clean\n", curves, summaries, rows, cleans
+      exit 1
+    }
+    exit bad > 0
+  }'
