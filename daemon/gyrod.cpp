@@ -221,12 +221,17 @@ int Gyrod::run() {
   ::sd_notify(0, "STOPPING=1");
   std::string recording;
   if (recorder_) {
+    // The last writes and the fdatasync of the file: the step of the exit that waits for the
+    // disk, so the line says how long it took (a slow exit then names or clears it).
+    const std::int64_t stop_start_ns = monotonicNowNs();
     recorder_->stop();
+    const std::int64_t stop_ms = (monotonicNowNs() - stop_start_ns) / 1'000'000;
     const RecorderStats s = recorder_->stats();
     const std::string last_error = recorder_->lastError();
     recording = fmt::format(
-        "; recording: {} written, {} dropped (ring full), {} lost to write errors ({} failed calls{})", s.written,
-        s.dropped, s.lost_to_errors, s.write_errors, last_error.empty() ? std::string() : ", last: " + last_error);
+        "; recording: {} written, {} dropped (ring full), {} lost to write errors ({} failed calls{}), closed in {} ms",
+        s.written, s.dropped, s.lost_to_errors, s.write_errors,
+        last_error.empty() ? std::string() : ", last: " + last_error, stop_ms);
   }
   spdlog::info("stopped after {} samples, {} gaps ({} samples lost by the device){}; longest loop turn {} us",
                samples_published_, gaps_, missing_samples_, recording,
