@@ -14,6 +14,7 @@
 #include <sstream>
 #include <system_error>
 
+#include "daemon/watchdog.hpp"
 #include "driver/counter_names.hpp"
 #include "formats/calibration.hpp"
 #include "formats/model_toml.hpp"
@@ -193,7 +194,7 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
   loop_.addPeriodicTimer(refit, [this](std::uint64_t) { noise_refit_.startCycle(); });
 
   if (::sd_watchdog_enabled(0, &watchdog_usec_) > 0 && watchdog_usec_ > 0) {
-    loop_.addPeriodicTimer(std::chrono::microseconds(watchdog_usec_ / 2), [this](std::uint64_t) { petWatchdog(); });
+    loop_.addPeriodicTimer(watchdogPingPeriod(watchdog_usec_), [this](std::uint64_t) { petWatchdog(); });
   } else {
     watchdog_usec_ = 0;
   }
@@ -344,10 +345,8 @@ void Gyrod::notifyReadyOnce() {
 }
 
 void Gyrod::petWatchdog() {
-  // Only while fresh samples arrive: a timer that pets blindly would hide a dead sensor.
-  if (last_sample_real_ns_ != 0 &&
-      monotonicNowNs() - last_sample_real_ns_ < static_cast<std::int64_t>(watchdog_usec_) * 1000)
-    ::sd_notify(0, "WATCHDOG=1");
+  // Only while fresh samples arrive (daemon/watchdog.hpp): a timer that pets blindly would hide a dead sensor.
+  if (watchdogPingDue(monotonicNowNs(), last_sample_real_ns_, watchdog_usec_)) ::sd_notify(0, "WATCHDOG=1");
 }
 
 void Gyrod::reload() {
