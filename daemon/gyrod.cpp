@@ -14,6 +14,7 @@
 #include <sstream>
 #include <system_error>
 
+#include "daemon/watchdog.hpp"
 #include "driver/counter_names.hpp"
 #include "driver/mpu6050_config.hpp"
 #include "formats/calibration.hpp"
@@ -169,11 +170,11 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
     options.header_comments.push_back(
         "gx,gy,gz: raw rates as read from the chip (bias not removed); t: CLOCK_MONOTONIC s of the data-ready edge; "
         "time: the same edge in UTC epoch s; GAP lines mark lost samples");
-    options.header_comments.push_back(
-        "gx_rate..still: the RATE stream's rate, bias and still as published (docs/recording-format.md)");
     const driver::Mpu6050Config& chip = device_.driver_config;  // the chain the model check puts in its base model
     options.header_comments.push_back(recording::acquisitionHeaderComment(
         chip.dlpf_cfg, chip.fs_sel, chip.sample_rate_hz, driver::sampleRateDivider(chip)));
+    options.header_comments.push_back(
+        "gx_rate..still: the RATE stream's rate, bias and still as published (docs/recording-format.md)");
     if (rate_model_.params)  // the recording holds what the rate stream was fed, at full precision
       options.header_comments.push_back("recompute them: gyroctl filter FILE --model " + config_.filter.model +
                                         " --rate " + formats::shortest(config_.device.rate_hz));
@@ -219,7 +220,7 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
   loop_.addPeriodicTimer(refit, [this](std::uint64_t) { noise_refit_.startCycle(); });
 
   if (::sd_watchdog_enabled(0, &watchdog_usec_) > 0 && watchdog_usec_ > 0) {
-    loop_.addPeriodicTimer(std::chrono::microseconds(watchdog_usec_ / 2), [this](std::uint64_t) { petWatchdog(); });
+    loop_.addPeriodicTimer(watchdogPingPeriod(watchdog_usec_), [this](std::uint64_t) { petWatchdog(); });
   } else {
     watchdog_usec_ = 0;
   }
@@ -247,12 +248,17 @@ int Gyrod::run() {
   ::sd_notify(0, "STOPPING=1");
   std::string recording;
   if (recorder_) {
+    // The last writes and the fdatasync of the file: the step of the exit that waits for the
+    // disk, so the line says how long it took (a slow exit then names or clears it).
+    const std::int64_t stop_start_ns = monotonicNowNs();
     recorder_->stop();
+    const std::int64_t stop_ms = (monotonicNowNs() - stop_start_ns) / 1'000'000;
     const RecorderStats s = recorder_->stats();
     const std::string last_error = recorder_->lastError();
     recording = fmt::format(
-        "; recording: {} written, {} dropped (ring full), {} lost to write errors ({} failed calls{})", s.written,
-        s.dropped, s.lost_to_errors, s.write_errors, last_error.empty() ? std::string() : ", last: " + last_error);
+        "; recording: {} written, {} dropped (ring full), {} lost to write errors ({} failed calls{}), closed in {} ms",
+        s.written, s.dropped, s.lost_to_errors, s.write_errors,
+        last_error.empty() ? std::string() : ", last: " + last_error, stop_ms);
   }
   spdlog::info("stopped after {} samples, {} gaps ({} samples lost by the device){}; longest loop turn {} us",
                samples_published_, gaps_, missing_samples_, recording,
@@ -368,10 +374,8 @@ void Gyrod::notifyReadyOnce() {
 }
 
 void Gyrod::petWatchdog() {
-  // Only while fresh samples arrive: a timer that pets blindly would hide a dead sensor.
-  if (last_sample_real_ns_ != 0 &&
-      monotonicNowNs() - last_sample_real_ns_ < static_cast<std::int64_t>(watchdog_usec_) * 1000)
-    ::sd_notify(0, "WATCHDOG=1");
+  // Only while fresh samples arrive (daemon/watchdog.hpp): a timer that pets blindly would hide a dead sensor.
+  if (watchdogPingDue(monotonicNowNs(), last_sample_real_ns_, watchdog_usec_)) ::sd_notify(0, "WATCHDOG=1");
 }
 
 void Gyrod::reload() {

@@ -7,33 +7,48 @@
 #include <unistd.h>
 
 #include <cstdint>
+#include <stdexcept>
+#include <string>
 
 namespace gyrod::daemon {
 
+NoiseRefitWorker::Shared::Shared(const processing::RollingOverlappingAllan& stream, double tau0, RefitFunction function)
+    : tau0_s(tau0),
+      refit(std::move(function)),
+      done_fd(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)),
+      copy(stream) {}  // allocated (and its pages touched) once, here
+
 NoiseRefitWorker::NoiseRefitWorker(EventLoop& loop, SamplePipeline& pipeline, double rate_hz,
-                                   std::function<void()> on_cycle_done)
+                                   std::function<void()> on_cycle_done, RefitFunction refit)
     : loop_(loop),
       pipeline_(pipeline),
-      tau0_s_(1.0 / rate_hz),
       on_cycle_done_(std::move(on_cycle_done)),
-      done_fd_(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)),
-      copy_(pipeline.rawAllan(0)) {  // allocated (and its pages touched) once, here
-  if (!done_fd_) throw errnoError("eventfd for the noise refit");
-  loop_.addFd(done_fd_.get(), EPOLLIN, [this](std::uint32_t) {
+      shared_(std::make_shared<Shared>(pipeline.rawAllan(0), 1.0 / rate_hz, std::move(refit))) {
+  if (!shared_->refit) throw std::invalid_argument("NoiseRefitWorker: empty refit function");
+  if (!shared_->done_fd) throw errnoError("eventfd for the noise refit");
+  const int done_fd = shared_->done_fd.get();
+  loop_.addFd(done_fd, EPOLLIN, [this, done_fd](std::uint32_t) {
     std::uint64_t count = 0;
-    if (::read(done_fd_.get(), &count, sizeof count) == static_cast<ssize_t>(sizeof count)) onAxisDone();
+    if (::read(done_fd, &count, sizeof count) == static_cast<ssize_t>(sizeof count)) onAxisDone();
   });
-  thread_ = std::thread([this] { threadMain(); });
+  thread_ = std::thread([shared = shared_] { threadMain(shared); });
 }
 
 NoiseRefitWorker::~NoiseRefitWorker() {
+  loop_.removeFd(shared_->done_fd.get());
+  bool refitting = false;
   {
-    const std::lock_guard lock(mutex_);
-    stop_ = true;
+    const std::lock_guard lock(shared_->mutex);
+    shared_->stop = true;
+    refitting = shared_->work;
   }
-  wake_.notify_one();
-  thread_.join();  // a refit in progress finishes first (seconds at most)
-  loop_.removeFd(done_fd_.get());
+  shared_->wake.notify_one();
+  // A refit of one axis takes seconds at a 1 h window at 1 kHz, more on a Pi, and a join
+  // would hold gyrod's exit on SIGTERM that long. The thread owns what it uses (shared_).
+  if (refitting)
+    thread_.detach();
+  else
+    thread_.join();  // waiting for work or about to: it sees stop at once
 }
 
 bool NoiseRefitWorker::startCycle() {
@@ -46,21 +61,21 @@ void NoiseRefitWorker::startJob(std::size_t job) {
   job_ = job;
   const auto stream = static_cast<AllanStream>(job % kStreams);
   {
-    const std::lock_guard lock(mutex_);
-    copy_ = pipeline_.allanStream(job / kStreams, stream);  // same sizes: reuses copy_'s memory
-    fit_terms_ = stream == AllanStream::Raw;
-    work_ = true;
+    const std::lock_guard lock(shared_->mutex);
+    shared_->copy = pipeline_.allanStream(job / kStreams, stream);  // same sizes: reuses copy's memory
+    shared_->fit_terms = stream == AllanStream::Raw;
+    shared_->work = true;
   }
-  wake_.notify_one();
+  shared_->wake.notify_one();
 }
 
 void NoiseRefitWorker::onAxisDone() {
   if (!job_) return;
   NoiseRefit result;
   {
-    const std::lock_guard lock(mutex_);
-    if (work_) return;  // not done yet (a stale wake-up)
-    result = std::move(result_);
+    const std::lock_guard lock(shared_->mutex);
+    if (shared_->work) return;  // not done yet (a stale wake-up)
+    result = std::move(shared_->result);
   }
   pipeline_.applyNoiseRefit(*job_ / kStreams, static_cast<AllanStream>(*job_ % kStreams), result);
   if (*job_ + 1 < kAxes * kStreams) {
@@ -71,28 +86,34 @@ void NoiseRefitWorker::onAxisDone() {
   if (on_cycle_done_) on_cycle_done_();
 }
 
-void NoiseRefitWorker::threadMain() {
+void NoiseRefitWorker::threadMain(const std::shared_ptr<Shared>& shared) {
   // Seconds of arithmetic must never compete with the loop: when gyrod runs SCHED_FIFO, a
   // thread of the same priority would keep the loop off a single CPU until it finished.
   const sched_param normal{};
   ::pthread_setschedparam(::pthread_self(), SCHED_OTHER, &normal);
-  std::unique_lock lock(mutex_);
+  Shared& s = *shared;
+  std::unique_lock lock(s.mutex);
   while (true) {
-    wake_.wait(lock, [this] { return work_ || stop_; });
-    if (stop_) return;
-    // Unlocked while refitting: the loop does not write copy_ while work_ is set.
+    s.wake.wait(lock, [&s] { return s.work || s.stop; });
+    if (s.stop) return;
+    // Unlocked while refitting: the loop does not write copy while work is set.
     lock.unlock();
     NoiseRefit result;
+    std::string error;
     try {
-      result = refitNoiseTerms(copy_, tau0_s_, fit_terms_);
+      result = s.refit(s.copy, s.tau0_s, s.fit_terms);
     } catch (const std::exception& e) {
-      spdlog::error("noise refit failed: {}", e.what());
+      error = e.what();
     }
     lock.lock();
-    result_ = std::move(result);
-    work_ = false;
+    // Abandoned (~NoiseRefitWorker): nobody reads the result, and the process may be exiting
+    // (its logger with it). Otherwise the worker cannot finish destruction while this holds the lock.
+    if (s.stop) return;
+    if (!error.empty()) spdlog::error("noise refit failed: {}", error);
+    s.result = std::move(result);
+    s.work = false;
     const std::uint64_t one = 1;
-    [[maybe_unused]] const ssize_t n = ::write(done_fd_.get(), &one, sizeof one);
+    [[maybe_unused]] const ssize_t n = ::write(s.done_fd.get(), &one, sizeof one);
   }
 }
 

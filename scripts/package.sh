@@ -13,6 +13,8 @@
 # `scripts/cross-test.sh ARCH`, and this script stops when they are absent. The tree is
 # reconfigured with the Debian install paths (prefix /usr, /etc, units in /lib/systemd/system as
 # on bookworm), which changes no compiled file, and only gyrod and gyroctl are (re)built.
+# It also turns GYROD_HARDENING on (the default) in a tree configured without it: that tree is
+# then rebuilt once.
 # The same tree and SOURCE_DATE_EPOCH give the same .deb, byte for byte.
 # Needs: cmake, binutils (readelf, objcopy), gzip; dpkg-dev when present (dpkg-shlibdeps).
 # Environment: GYROD_DEB_MAINTAINER ("Name <address>"), SOURCE_DATE_EPOCH (file times and the
@@ -60,7 +62,9 @@ fi
 
 # The Debian layout of bookworm: units and udev rules under /lib (where debhelper puts them),
 # sysusers.d under /usr/lib.
-cmake -S . -B "$build_dir" -DCMAKE_INSTALL_PREFIX=/usr \
+# With Debian's hardening flags (cmake/Hardening.cmake), checked on the staged binaries below as
+# lintian would.
+cmake -S . -B "$build_dir" -DCMAKE_INSTALL_PREFIX=/usr -DGYROD_HARDENING=ON \
   -DGYROD_SYSTEMD_UNIT_DIR=/lib/systemd/system -DGYROD_UDEV_RULES_DIR=/lib/udev/rules.d \
   -DGYROD_SYSUSERS_DIR=/usr/lib/sysusers.d >/dev/null
 cmake --build "$build_dir" -j"$(nproc)" --target gyrod gyroctl >/dev/null
@@ -82,6 +86,9 @@ objcopy=$(sed -n 's/^CMAKE_OBJCOPY:FILEPATH=//p' "$build_dir/CMakeCache.txt")
 for binary in "$root/usr/sbin/gyrod" "$root/usr/bin/gyroctl"; do
   "${objcopy:-objcopy}" --remove-section=.comment --remove-section=.note "$binary"
 done
+
+tests/packaging/check-hardening.sh "$root/usr/sbin/gyrod" "$root/usr/bin/gyroctl" >/dev/null ||
+  die "the binaries lack Debian's hardening (above)"
 
 doc=$root/usr/share/doc/gyrod
 mkdir -p "$doc" "$root/DEBIAN"

@@ -3,7 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <condition_variable>
+#include <future>
+#include <memory>
+#include <mutex>
 #include <random>
+#include <stdexcept>
 
 #include "daemon/noise_refit_worker.hpp"
 
@@ -77,4 +82,61 @@ TEST(NoiseRefitWorker, TooEarlyKeepsNothingAndStillCompletesTheCycle) {
   EXPECT_EQ(cycles, 1);
   for (std::size_t axis = 0; axis < kAxes; ++axis) EXPECT_FALSE(p.noiseTerms()[axis].has_value());
   EXPECT_TRUE(worker.startCycle());  // and the next cycle can start
+}
+
+// gyrod's exit on SIGTERM destroys the worker; a refit of one axis takes seconds at a 1 h window
+// at 1 kHz (more on a Pi), and the destructor used to join the thread, so the exit waited for
+// it. Here the refit is held until the destructor has returned: a destructor that waits for it
+// never returns on its own (the wait below would run out), one that abandons it returns at once.
+TEST(NoiseRefitWorker, StoppingAbandonsARefitInProgressAndDropsItsResult) {
+  SamplePipeline p(settings());
+  feed(p, 0, 3000, 1);
+  EventLoop loop;
+  std::mutex m;
+  std::condition_variable changed;
+  bool entered = false, released = false, finished = false;
+  int cycles = 0;
+  auto held_refit = [&](const gyrod::processing::RollingOverlappingAllan& stream, double tau0_s, bool fit_terms) {
+    {
+      std::unique_lock lock(m);
+      entered = true;
+      changed.notify_all();
+      changed.wait(lock, [&] { return released; });
+    }
+    const NoiseRefit result = refitNoiseTerms(stream, tau0_s, fit_terms);
+    const std::lock_guard lock(m);
+    finished = true;
+    changed.notify_all();  // under the lock: after it, nothing here touches this test's variables
+    return result;
+  };
+  auto worker = std::make_unique<NoiseRefitWorker>(
+      loop, p, 50.0, [&] { ++cycles; }, held_refit);
+  ASSERT_TRUE(worker->startCycle());
+  {
+    std::unique_lock lock(m);
+    ASSERT_TRUE(changed.wait_for(lock, 60s, [&] { return entered; }));
+  }
+  auto destroyed = std::async(std::launch::async, [&] { worker.reset(); });
+  const bool returned_while_refitting = destroyed.wait_for(60s) == std::future_status::ready;
+  {
+    const std::lock_guard lock(m);
+    released = true;
+    changed.notify_all();
+  }
+  destroyed.wait();
+  EXPECT_TRUE(returned_while_refitting) << "the destructor waited for the refit in progress";
+  {
+    std::unique_lock lock(m);
+    ASSERT_TRUE(changed.wait_for(lock, 60s, [&] { return finished; }));
+  }
+  loop.runOnce(0ms);  // the result of the abandoned refit never reaches the pipeline
+  EXPECT_EQ(cycles, 0);
+  for (std::size_t axis = 0; axis < kAxes; ++axis) EXPECT_FALSE(p.noiseTerms()[axis].has_value()) << axis;
+}
+
+TEST(NoiseRefitWorker, AnIdleWorkerStopsAndAnEmptyRefitFunctionIsRefused) {
+  SamplePipeline p(settings());
+  EventLoop loop;
+  { NoiseRefitWorker idle(loop, p, 50.0, {}); }
+  EXPECT_THROW(NoiseRefitWorker(loop, p, 50.0, {}, NoiseRefitWorker::RefitFunction{}), std::invalid_argument);
 }

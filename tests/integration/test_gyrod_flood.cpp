@@ -22,6 +22,7 @@
 #include <sstream>
 #include <thread>
 
+#include "binary_command.hpp"
 #include "gyrod_process.hpp"
 #include "tools/run_command.hpp"
 
@@ -146,6 +147,14 @@ TEST(GyrodFlood, NoSampleLostAt1kHzWithAOneHourWindowWhileClientsFloodIt) {
   EXPECT_EQ(m[2].str(), "0") << text;
   EXPECT_EQ(m[3].str(), "0") << text;
   EXPECT_GT(rates, 1000u * 8);  // the watcher was served: at least 8 of the 12 s of samples
+  if (gyrod::test::underEmulator()) {
+    // Under qemu-user gyrod and the seven clients run every instruction emulated (5 to 20 times
+    // slower, docs/testing.md): how many replies fit in 12 real seconds measures the emulator, not
+    // the target (qemu-aarch64 on a loaded host: 7696 of the 10000 pipelined). What must hold on
+    // ARM too, no sample lost while flooded, is checked above; the counts are checked natively.
+    GTEST_SKIP() << "emulator speed: the reply counts measure qemu-user's speed (" << allan_replies << " ALLAN, "
+                 << status_replies << " STATUS, " << pipelined_replies << " pipelined in 12 s), not ARM's";
+  }
   EXPECT_GT(allan_replies.load(), 1000u);
   EXPECT_GT(status_replies.load(), 1000u);
   EXPECT_GE(pipelined_replies.load(), 10'000u);  // one whole pipelined write at least

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <sstream>
 
 #include "formats/recording_csv.hpp"
@@ -200,6 +201,8 @@ TEST(GyrodLimits, TheRecorderKeepsUpWithTheMockAtFiftyTimesRealTime) {
   EXPECT_EQ(status["recorder"]["lost"].get<std::uint64_t>(), 0u) << status.dump();
   const std::string log = readWholeFile(d.path() / "log.txt");
   EXPECT_NE(log.find(" 0 dropped (ring full), 0 lost to write errors"), std::string::npos) << log;
+  // How long the recorder's last writes and fdatasync held the exit: what a slow exit is made of.
+  EXPECT_TRUE(std::regex_search(log, std::regex(R"(failed calls\), closed in \d+ ms)"))) << log;
 }
 
 TEST(GyrodLimits, RecordIntoAFolderWritesInsideIt) {
