@@ -37,7 +37,7 @@ GeneratedRecording generate(std::uint64_t seed, std::vector<ModelEffect> effects
 }
 
 AxisModelCheck check(const GeneratedRecording& g, std::size_t axis, std::uint64_t seed = 1) {
-  return checkAxisModel({g.axes[axis], g.rate_hz, g.temp, g.t}, testOptions(seed));
+  return checkAxisModel({g.axes[axis], g.rate_hz, g.temp, g.t, {}}, testOptions(seed));
 }
 
 std::string describe(const AxisModelCheck& r) {
@@ -207,7 +207,7 @@ TEST(ModelCheck, AResonanceIsUnexplainedNotForcedIntoTheCatalogue) {
   for (double& v : x) v = sim.next().rate_dps[0];
   ModelCheckOptions o = testOptions(41);
   o.replicas = 8;
-  const AxisModelCheck res = checkAxisModel({x, kRate, {}, {}}, o);
+  const AxisModelCheck res = checkAxisModel({x, kRate, {}, {}, {}}, o);
   const DetectedEffect* u = find(res, ModelEffect::Unexplained);
   ASSERT_NE(u, nullptr) << describe(res);
   // Where: around τ ≈ 1/(2·5 Hz) = 0.1 s.
@@ -221,8 +221,8 @@ TEST(ModelCheck, ResultDoesNotDependOnTheNumberOfThreads) {
   one.threads = 1;
   two.threads = 3;
   const std::size_t a = g.hidden[0].axis;
-  const AxisModelCheck r1 = checkAxisModel({g.axes[a], kRate, g.temp, g.t}, one);
-  const AxisModelCheck r2 = checkAxisModel({g.axes[a], kRate, g.temp, g.t}, two);
+  const AxisModelCheck r1 = checkAxisModel({g.axes[a], kRate, g.temp, g.t, {}}, one);
+  const AxisModelCheck r2 = checkAxisModel({g.axes[a], kRate, g.temp, g.t, {}}, two);
   ASSERT_EQ(r1.effects.size(), r2.effects.size());
   for (std::size_t i = 0; i < r1.effects.size(); ++i) EXPECT_EQ(r1.effects[i].evidence, r2.effects[i].evidence);
   EXPECT_EQ(r1.gain.adev_log_error_extended, r2.gain.adev_log_error_extended);
@@ -232,16 +232,16 @@ TEST(ModelCheck, ResultDoesNotDependOnTheNumberOfThreads) {
 TEST(ModelCheck, BadInputIsRejectedNamingTheProblem) {
   std::vector<double> x(5000, 0.0), t(4000, 0.0);
   for (std::size_t i = 0; i < x.size(); ++i) x[i] = std::sin(static_cast<double>(i));
-  EXPECT_THROW(checkAxisModel({std::span<const double>(x).first(100), kRate, {}, {}}), std::invalid_argument);
-  EXPECT_THROW(checkAxisModel({x, 0.0, {}, {}}), std::invalid_argument);
-  EXPECT_THROW(checkAxisModel({x, kRate, t, {}}), std::invalid_argument);
-  EXPECT_THROW(checkAxisModel({x, kRate, {}, t}), std::invalid_argument);
+  EXPECT_THROW(checkAxisModel({std::span<const double>(x).first(100), kRate, {}, {}, {}}), std::invalid_argument);
+  EXPECT_THROW(checkAxisModel({x, 0.0, {}, {}, {}}), std::invalid_argument);
+  EXPECT_THROW(checkAxisModel({x, kRate, t, {}, {}}), std::invalid_argument);
+  EXPECT_THROW(checkAxisModel({x, kRate, {}, t, {}}), std::invalid_argument);
   ModelCheckOptions o;
   o.replicas = 3;
-  EXPECT_THROW(checkAxisModel({x, kRate, {}, {}}, o), std::invalid_argument);
+  EXPECT_THROW(checkAxisModel({x, kRate, {}, {}, {}}, o), std::invalid_argument);
   x[17] = std::nan("");
   try {
-    checkAxisModel({x, kRate, {}, {}});
+    checkAxisModel({x, kRate, {}, {}, {}});
     FAIL();
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("sample 17"), std::string::npos) << e.what();

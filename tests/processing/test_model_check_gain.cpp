@@ -63,7 +63,7 @@ void expectGain(const AxisModelCheck& r, const std::string& what) {
 }
 
 AxisModelCheck checkHiddenAxis(const GeneratedRecording& g, std::size_t axis, std::uint64_t seed) {
-  return checkAxisModel({g.axes[axis], g.rate_hz, g.temp, g.t}, options(seed));
+  return checkAxisModel({g.axes[axis], g.rate_hz, g.temp, g.t, {}}, options(seed));
 }
 
 }  // namespace
@@ -79,7 +79,9 @@ TEST(ModelCheckGain, FiftySpikesAreFoundAndTheExtensionGains) {
     const AxisModelCheck r = checkHiddenAxis(g, g.hidden[0].axis, seed);
     ASSERT_TRUE(has(r, ModelEffect::Outliers)) << "seed " << seed << ": " << describe(r);
     for (const DetectedEffect& e : r.effects)
-      if (e.effect == ModelEffect::Outliers) EXPECT_EQ(e.count, 50u) << "seed " << seed;
+      if (e.effect == ModelEffect::Outliers) {
+        EXPECT_EQ(e.count, 50u) << "seed " << seed;
+      }
     expectGain(r, "50 spikes, seed " + std::to_string(seed));
   }
 }
@@ -166,10 +168,12 @@ TEST(ModelCheckGain, AnExtensionThatDoesNotGainIsSeenNotExplained) {
     a1 = r;
     v += r;
   }
-  const AxisModelCheck r = checkAxisModel({x, g.rate_hz, g.temp, g.t}, options(3));
+  const AxisModelCheck r = checkAxisModel({x, g.rate_hz, g.temp, g.t, {}}, options(3));
   EXPECT_TRUE(has(r, ModelEffect::Unexplained)) << describe(r);
   for (const DetectedEffect& e : r.effects)
-    if (!e.explained) EXPECT_FALSE(r.verdict.accepted) << describe(r);
+    if (!e.explained) {
+      EXPECT_FALSE(r.verdict.accepted) << describe(r);
+    }
   if (r.verdict.judged && !r.verdict.accepted) {
     const ExtensionVerdict& v = r.verdict;
     const int worse = int{v.adev_worse} + int{v.band_worse} + int{v.innovation_worse} + int{v.ljung_box_worse};

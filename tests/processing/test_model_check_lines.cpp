@@ -38,7 +38,7 @@ TEST(ModelCheckLines, ALineWhosePhaseJumpsIsOneSinusoid) {
     ModelCheckOptions o;
     o.replicas = 40;  // the product default: with 16 the thresholds are too noisy for a clean "nothing else" check
     o.seed = seed;
-    const AxisModelCheck r = checkAxisModel({x, rate, {}, {}}, o);
+    const AxisModelCheck r = checkAxisModel({x, rate, {}, {}, {}}, o);
     std::size_t lines = 0;
     const DetectedEffect* line = nullptr;
     for (const DetectedEffect& e : r.effects)
@@ -63,7 +63,7 @@ TEST(ModelCheckLines, AFixedSinusoidStaysOneComponent) {
     x[i] += amp * std::sin(2.0 * std::numbers::pi * freq * static_cast<double>(i) / rate + 1.0);
   ModelCheckOptions o;
   o.replicas = 40;  // the product default: with 16 the thresholds are too noisy for a clean "nothing else" check
-  const AxisModelCheck r = checkAxisModel({x, rate, {}, {}}, o);
+  const AxisModelCheck r = checkAxisModel({x, rate, {}, {}, {}}, o);
   std::string all;
   for (const DetectedEffect& e : r.effects) all += std::string(modelEffectName(e.effect)) + "\n";
   ASSERT_EQ(r.effects.size(), 1u) << all;

@@ -50,7 +50,7 @@ AxisModelCheck check(const std::vector<double>& x, std::uint64_t seed) {
   ModelCheckOptions o;
   o.seed = seed;
   o.threads = 2;
-  return checkAxisModel({x, kRate, {}, {}}, o);
+  return checkAxisModel({x, kRate, {}, {}, {}}, o);
 }
 
 std::string describe(const AxisModelCheck& r) {

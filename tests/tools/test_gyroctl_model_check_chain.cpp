@@ -74,12 +74,12 @@ TEST(GyroctlModelCheckChain, ImpossibleRatesAndBadHeadersAreErrors) {
   for (double v : g.axes[0]) no_t += std::to_string(v) + "\n";
   const auto csv = d.write("rec.csv", no_t);
   auto r = runGyroctl("model-check " + csv.string() + " --rate 30 --dlpf 4", d.path());
-  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_EQ(r.exit_status, 65);  // EX_DATAERR: no chain makes that rate
   EXPECT_NE(r.err.find("30 Hz cannot be made with DLPF_CFG 4"), std::string::npos) << r.err;
   const auto bad = d.write("bad.csv", recordingCsv(dlpf4Recording(), "# device dlpf_cfg=9\n"));
   r = runGyroctl("model-check " + bad.string(), d.path());
-  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_EQ(r.exit_status, 65);  // EX_DATAERR
   EXPECT_NE(r.err.find("bad.csv:1: device header: dlpf_cfg='9'"), std::string::npos) << r.err;
   r = runGyroctl("model-check " + csv.string() + " --dlpf 7", d.path());
-  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_EQ(r.exit_status, 64);  // EX_USAGE
 }
