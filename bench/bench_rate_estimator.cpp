@@ -76,7 +76,7 @@ BENCHMARK(BM_RateEstimator)->Arg(0)->Arg(1);
 void BM_PaperChain(benchmark::State& state) {
   const auto& data = samples();
   gyrod::processing::FilterChainParameters p;
-  p.kalman = {0.95, 3e-5, 5e-3};
+  p.kalman = {0.95, 3e-5, 5e-3, 0.0, {}};
   std::array<gyrod::processing::AxisFilterChain, 3> chains = {gyrod::processing::AxisFilterChain(p),
                                                               gyrod::processing::AxisFilterChain(p),
                                                               gyrod::processing::AxisFilterChain(p)};

@@ -333,7 +333,7 @@ void runCurve(const Records& rec, const Curve& c, const Options& opt, double& ch
       const std::vector<double> x = withEffect(rec, s, c, c.sizes[i]);
       optimal[i] += oracleStatistic(oracle, c, s, x) > oracle.threshold ? 1 : 0;
       const auto t0 = std::chrono::steady_clock::now();
-      const AxisModelCheck r = checkAxisModel({x, kRate, s.temp, rec.t}, checkOptions(opt, seed));
+      const AxisModelCheck r = checkAxisModel({x, kRate, s.temp, rec.t, {}}, checkOptions(opt, seed));
       check_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       ++checks;
       blind[i] += blindNames(r, c.kind) ? 1 : 0;
@@ -387,7 +387,7 @@ void runClean(const Records& rec, const Options& opt, double& check_seconds, std
     const TrialShape s = drawTrial(rec, seed, 0.0);
     const std::vector<double> x = withEffect(rec, s, {Kind::Step, "", "", 0.0, {}}, 0.0);
     const auto t0 = std::chrono::steady_clock::now();
-    const AxisModelCheck r = checkAxisModel({x, kRate, s.temp, rec.t}, checkOptions(opt, seed));
+    const AxisModelCheck r = checkAxisModel({x, kRate, s.temp, rec.t, {}}, checkOptions(opt, seed));
     check_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     ++checks;
     with_effect += r.effects.empty() ? 0 : 1;

@@ -183,7 +183,7 @@ int main(int argc, char** argv) {
     o.replicas = replicas;
     o.seed = s;
     for (std::size_t a = 0; a < 3; ++a) {
-      processing::AxisModelCheckInput in{rec.axes[a], rate, rec.temp, rec.t};
+      processing::AxisModelCheckInput in{rec.axes[a], rate, rec.temp, rec.t, {}};
       const auto t0 = std::chrono::steady_clock::now();
       const processing::AxisModelCheck r = processing::checkAxisModel(in, o);
       seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
