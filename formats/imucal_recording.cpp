@@ -107,6 +107,15 @@ ImucalConversion convertImucal(std::istream& in, const std::string& path, int fs
     }
   }
   if (columns.empty()) fail(path, line_no, "no column-name line (ax,ay,az,gx,gy,gz) found");
+  // A sensor column once: given twice it would be converted twice, and no reader could tell
+  // which of the two is the sensor's.
+  for (std::size_t c = 0; c < columns.size(); ++c) {
+    const bool sensor = std::find(kGyroColumns.begin(), kGyroColumns.end(), columns[c]) != kGyroColumns.end() ||
+                        std::find(kAccelColumns.begin(), kAccelColumns.end(), columns[c]) != kAccelColumns.end();
+    const auto before = columns.begin() + static_cast<std::ptrdiff_t>(c);
+    if (sensor && std::find(columns.begin(), before, columns[c]) != before)
+      fail(path, line_no, "column " + formats::quotedValue(columns[c]) + " appears twice");
+  }
   result.lsb_per_dps = kGyroLsbPerDps[fs_sel];
   result.lsb_per_g = kAccelLsbPerG[afs_sel];
   const auto outputs = outputColumns(columns, result.lsb_per_dps, result.lsb_per_g);

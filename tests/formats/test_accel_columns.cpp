@@ -85,3 +85,18 @@ TEST(ImucalImport, AGyroOnlyLoggerFileStaysGyroOnly) {
   EXPECT_EQ(c.csv, "t,gx,gy,gz\n0,1,2,0\n");
   EXPECT_EQ(c.accel_columns, 0u);
 }
+
+// Found by fuzz_import_imucal: a header naming a sensor column twice was converted into a
+// recording that the reader (rightly) refuses; the importer now refuses it, naming the line.
+TEST(ImucalImport, ASensorColumnNamedTwiceIsRefused) {
+  for (const std::string header : {"ax,ay,az,gx,gy,ay", "gx,gy,gx"}) {
+    std::istringstream in("Fs,100\n" + header + "\n1,2,3,4,5,6\n");
+    try {
+      convertImucal(in, "raw.txt", 0);
+      ADD_FAILURE() << header << ": accepted";
+    } catch (const RecordingError& e) {
+      const std::string name = header.substr(header.rfind(',') + 1);
+      EXPECT_EQ(std::string(e.what()), "raw.txt:2: column '" + name + "' appears twice") << header;
+    }
+  }
+}
