@@ -6,9 +6,10 @@
 
 namespace gyrod::driver {
 
-FifoFrame decodeFifoFrame(std::span<const std::uint8_t, kFrameBytes> bytes) {
-  mpu6050::fifo::TempGyroFrame raw;
-  std::memcpy(&raw, bytes.data(), sizeof raw);
+namespace {
+// The temperature and gyro words, which both frame layouts carry under the same names.
+template <typename RawFrame>
+FifoFrame decodeTempGyro(const RawFrame& raw) {
   FifoFrame frame;
   frame.temp = mpu6050::combineBigEndian(raw.TEMP_OUT_H, raw.TEMP_OUT_L);
   frame.gyro = {mpu6050::combineBigEndian(raw.GYRO_XOUT_H, raw.GYRO_XOUT_L),
@@ -16,15 +17,18 @@ FifoFrame decodeFifoFrame(std::span<const std::uint8_t, kFrameBytes> bytes) {
                 mpu6050::combineBigEndian(raw.GYRO_ZOUT_H, raw.GYRO_ZOUT_L)};
   return frame;
 }
+}  // namespace
+
+FifoFrame decodeFifoFrame(std::span<const std::uint8_t, kFrameBytes> bytes) {
+  mpu6050::fifo::TempGyroFrame raw;
+  std::memcpy(&raw, bytes.data(), sizeof raw);
+  return decodeTempGyro(raw);
+}
 
 FifoFrame decodeFifoFrame(std::span<const std::uint8_t, kAccelFrameBytes> bytes) {
   mpu6050::fifo::FullFrame raw;
   std::memcpy(&raw, bytes.data(), sizeof raw);
-  FifoFrame frame;
-  frame.temp = mpu6050::combineBigEndian(raw.TEMP_OUT_H, raw.TEMP_OUT_L);
-  frame.gyro = {mpu6050::combineBigEndian(raw.GYRO_XOUT_H, raw.GYRO_XOUT_L),
-                mpu6050::combineBigEndian(raw.GYRO_YOUT_H, raw.GYRO_YOUT_L),
-                mpu6050::combineBigEndian(raw.GYRO_ZOUT_H, raw.GYRO_ZOUT_L)};
+  FifoFrame frame = decodeTempGyro(raw);
   frame.has_accel = true;
   frame.accel = {mpu6050::combineBigEndian(raw.ACCEL_XOUT_H, raw.ACCEL_XOUT_L),
                  mpu6050::combineBigEndian(raw.ACCEL_YOUT_H, raw.ACCEL_YOUT_L),
