@@ -225,7 +225,13 @@ NoiseSimulator::NoiseSimulator(const SimulationModel& model, double duration_s, 
   if (samples < 1.0)
     throw std::invalid_argument("duration_s " + formatNumber(duration_s) + " at rate_hz " +
                                 formatNumber(model_.rate_hz) + " gives no sample");
-  sample_count_ = static_cast<std::size_t>(samples);
+  // 2^53: every count up to it is exact in the double it came from. The count is 64-bit on every
+  // ABI: on 32-bit ARM a std::size_t would wrap long simulations (8e10 samples is 1e7 s at 8 kHz).
+  constexpr double kMaxExactCount = 9007199254740992.0;
+  if (samples > kMaxExactCount)
+    throw std::invalid_argument("duration_s " + formatNumber(duration_s) + " at rate_hz " +
+                                formatNumber(model_.rate_hz) + " gives more than 2^53 samples");
+  sample_count_ = static_cast<std::uint64_t>(samples);
 
   if (model_.dlpf_cfg) {
     decimation_ = sampleRateDivisor(*model_.dlpf_cfg, model_.rate_hz);

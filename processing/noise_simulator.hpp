@@ -215,8 +215,8 @@ class NoiseSimulator {
 
   double outputRateHz() const { return model_.rate_hz; }
   double internalRateHz() const { return internal_rate_hz_; }
-  std::size_t decimation() const { return decimation_; }     // 1 + SMPLRT_DIV
-  std::size_t sampleCount() const { return sample_count_; }  // ⌊duration·rate⌋
+  std::size_t decimation() const { return decimation_; }       // 1 + SMPLRT_DIV
+  std::uint64_t sampleCount() const { return sample_count_; }  // ⌊duration·rate⌋, 64-bit on every ABI
   const SimulationModel& model() const { return model_; }
   // The flicker bank in use (same for all axes up to their level; empty if B = 0).
   const std::vector<GaussMarkovComponent>& flickerBank(std::size_t axis) const;
@@ -262,7 +262,7 @@ class NoiseSimulator {
   ZigguratNormalGenerator temperature_noise_;
   double internal_rate_hz_ = 0.0;
   std::size_t decimation_ = 1;
-  std::size_t sample_count_ = 0;
+  std::uint64_t sample_count_ = 0;
   std::optional<double> lsb_per_dps_;
   std::vector<AxisState> axes_;
   std::vector<DigitalLowPassFilter> dlpf_;

@@ -155,6 +155,14 @@ TEST(NoiseSimulatorModel, NonStationaryArIsRejected) {
 
 // ---- reproducibility -----------------------------------------------------------------
 
+// The sample count is 64-bit on every ABI: on 32-bit ARM a std::size_t count would wrap (armhf's
+// gyroctl simulate once reported 4294967295 samples for 1e7 s at 8 kHz). Nothing is generated here.
+TEST(NoiseSimulatorModel, LongSimulationsCountPast32Bits) {
+  EXPECT_EQ(NoiseSimulator(pureModel(8000.0), 1e7, 1).sampleCount(), std::uint64_t{80'000'000'000});
+  EXPECT_EQ(NoiseSimulator(pureModel(50.0), 1e9, 1).sampleCount(), std::uint64_t{50'000'000'000});
+  EXPECT_THROW(NoiseSimulator(pureModel(8000.0), 1e15, 1), std::invalid_argument);  // past 2^53 samples
+}
+
 TEST(NoiseSimulatorStream, SameSeedSameStreamDifferentSeedsDiffer) {
   const SimulationModel m = paperSensorModel();
   NoiseSimulator a(m, 600.0, 42), b(m, 600.0, 42), c(m, 600.0, 43);

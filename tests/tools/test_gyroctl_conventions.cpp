@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <regex>
 
+#include "binary_command.hpp"
 #include "tools/run_command.hpp"
 
 using gyrod::test::readWholeFile;
@@ -42,7 +43,9 @@ TEST(GyroctlConventions, GyrodVersionPrintsTheSameVersion) {
   if (!std::filesystem::exists(gyrod)) GTEST_SKIP() << "gyrod is not built";
   ScratchDir d;
   const auto out = d.path() / "out.txt";
-  const int status = std::system((gyrod.string() + " --version >" + out.string() + " 2>&1 </dev/null").c_str());
+  // Through the cross build's emulator when there is one (binfmt_misc is not assumed).
+  const std::string command = gyrod::test::binaryShellCommand("gyrod");
+  const int status = std::system((command + " --version >" + out.string() + " 2>&1 </dev/null").c_str());
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 0);
   EXPECT_EQ(readWholeFile(out), "gyrod " + cmakeProjectVersion() + "\n");

@@ -79,7 +79,7 @@ void requireDurationWithinBound(double duration_s) {
 }
 
 // Refuses before writing when the recording cannot fit on the target's filesystem.
-void requireRoomFor(std::size_t samples, std::uint64_t line_bytes, const formats::AtomicOutputFile& out) {
+void requireRoomFor(std::uint64_t samples, std::uint64_t line_bytes, const formats::AtomicOutputFile& out) {
   const double needed = static_cast<double>(samples) * static_cast<double>(line_bytes) + 64.0;
   const std::uint64_t available = out.availableBytes();
   if (needed > static_cast<double>(available))
@@ -142,7 +142,7 @@ int runSimulate(const SimulateOptions& opt) {
   std::vector<std::string> inputs{opt.model_file};
   if (with_motion && !recording::isMotionProfileText(opt.motion)) inputs.push_back(opt.motion);
   formats::AtomicOutputFile out(opt.output, inputs);
-  const std::size_t n = sim.sampleCount();
+  const std::uint64_t n = sim.sampleCount();
   requireRoomFor(
       n, (with_motion ? kMaxSimulateLineBytesWithTruth : kMaxSimulateLineBytes) + (opt.accel ? kAccelLineBytes : 0),
       out);
@@ -150,7 +150,7 @@ int runSimulate(const SimulateOptions& opt) {
   std::fputs("t,gx,gy,gz,temp", f);
   if (opt.accel) std::fputs(",ax,ay,az", f);
   std::fputs(with_motion ? ",wx,wy,wz\n" : "\n", f);
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::uint64_t i = 0; i < n; ++i) {
     // Stop at the first failed write (a full disk) instead of computing the rest.
     if (i % kSamplesBetweenWriteChecks == 0 && out.failed()) break;
     const SimulatedSample s = sim.next();
