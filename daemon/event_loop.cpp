@@ -24,7 +24,8 @@ sigset_t signalSet(std::initializer_list<int> signals) {
   sigemptyset(&set);
   for (const int s : signals) {
     if (sigaddset(&set, s) != 0)
-      throw std::invalid_argument("EventLoop: " + std::to_string(s) + " is not a signal number");
+      throw std::invalid_argument("the event loop cannot watch signal " + std::to_string(s) +
+                                  ": it is not a signal number");
   }
   return set;
 }
@@ -49,9 +50,10 @@ EventLoop::SourceId EventLoop::addSource(std::shared_ptr<Source> source, std::ui
 }
 
 void EventLoop::addFd(int fd, std::uint32_t events, FdCallback callback) {
-  if (fd < 0) throw std::invalid_argument("EventLoop::addFd: fd " + std::to_string(fd) + " is not a descriptor");
-  if (watches(fd)) throw std::invalid_argument("EventLoop::addFd: fd " + std::to_string(fd) + " is already watched");
-  if (!callback) throw std::invalid_argument("EventLoop::addFd: empty callback");
+  if (fd < 0)
+    throw std::invalid_argument("the event loop cannot watch fd " + std::to_string(fd) + ": it is not a descriptor");
+  if (watches(fd)) throw std::invalid_argument("the event loop cannot watch fd " + std::to_string(fd) + " twice");
+  if (!callback) throw std::invalid_argument("the event loop needs a callback for a descriptor; none given");
   auto source = std::make_shared<Source>();
   source->kind = Kind::Fd;
   source->fd = fd;
@@ -63,7 +65,7 @@ void EventLoop::addFd(int fd, std::uint32_t events, FdCallback callback) {
 void EventLoop::modifyFd(int fd, std::uint32_t events) {
   const auto it = fd_sources_.find(fd);
   if (it == fd_sources_.end())
-    throw std::invalid_argument("EventLoop::modifyFd: fd " + std::to_string(fd) + " is not watched");
+    throw std::invalid_argument("the event loop cannot change fd " + std::to_string(fd) + ": it is not watched");
   epoll_event ev{};
   ev.events = events;
   ev.data.u64 = it->second;
@@ -81,7 +83,7 @@ void EventLoop::removeFd(int fd) noexcept {
 
 EventLoop::SourceId EventLoop::addTimer(std::chrono::nanoseconds first, std::chrono::nanoseconds period, bool one_shot,
                                         TimerCallback callback) {
-  if (!callback) throw std::invalid_argument("EventLoop: empty timer callback");
+  if (!callback) throw std::invalid_argument("the event loop needs a callback for a timer; none given");
   auto source = std::make_shared<Source>();
   source->kind = Kind::Timer;
   source->owned.reset(::timerfd_create(CLOCK_MONOTONIC, TFD_NONBLOCK | TFD_CLOEXEC));
@@ -98,14 +100,14 @@ EventLoop::SourceId EventLoop::addTimer(std::chrono::nanoseconds first, std::chr
 
 EventLoop::SourceId EventLoop::addPeriodicTimer(std::chrono::nanoseconds period, TimerCallback callback) {
   if (period <= std::chrono::nanoseconds::zero())
-    throw std::invalid_argument("EventLoop::addPeriodicTimer: period must be > 0 (got " +
-                                std::to_string(period.count()) + " ns)");
+    throw std::invalid_argument("the event loop needs a timer period > 0 (got " + std::to_string(period.count()) +
+                                " ns)");
   return addTimer(period, period, false, std::move(callback));
 }
 
 EventLoop::SourceId EventLoop::addOneShotTimer(std::chrono::nanoseconds delay, TimerCallback callback) {
   if (delay <= std::chrono::nanoseconds::zero())
-    throw std::invalid_argument("EventLoop::addOneShotTimer: delay must be > 0 (got " + std::to_string(delay.count()) +
+    throw std::invalid_argument("the event loop needs a timer delay > 0 (got " + std::to_string(delay.count()) +
                                 " ns)");
   return addTimer(delay, std::chrono::nanoseconds::zero(), true, std::move(callback));
 }
@@ -125,7 +127,7 @@ void EventLoop::blockSignals(std::initializer_list<int> signals) {
 }
 
 EventLoop::SourceId EventLoop::addSignals(std::initializer_list<int> signals, SignalCallback callback) {
-  if (!callback) throw std::invalid_argument("EventLoop::addSignals: empty callback");
+  if (!callback) throw std::invalid_argument("the event loop needs a callback for signals; none given");
   blockSignals(signals);
   const sigset_t set = signalSet(signals);
   auto source = std::make_shared<Source>();
@@ -164,7 +166,7 @@ void EventLoop::dispatch(SourceId id, std::uint32_t events) {
 }
 
 void EventLoop::defer(std::function<void()> callback) {
-  if (!callback) throw std::invalid_argument("EventLoop::defer: empty callback");
+  if (!callback) throw std::invalid_argument("the event loop needs a callback to defer; none given");
   deferred_.push_back(std::move(callback));
 }
 

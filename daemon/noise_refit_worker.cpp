@@ -24,7 +24,7 @@ NoiseRefitWorker::NoiseRefitWorker(EventLoop& loop, SamplePipeline& pipeline, do
       pipeline_(pipeline),
       on_cycle_done_(std::move(on_cycle_done)),
       shared_(std::make_shared<Shared>(pipeline.rawAllan(0), 1.0 / rate_hz, std::move(refit))) {
-  if (!shared_->refit) throw std::invalid_argument("NoiseRefitWorker: empty refit function");
+  if (!shared_->refit) throw std::invalid_argument("the noise refit worker needs a refit function; none given");
   if (!shared_->done_fd) throw errnoError("eventfd for the noise refit");
   const int done_fd = shared_->done_fd.get();
   loop_.addFd(done_fd, EPOLLIN, [this, done_fd](std::uint32_t) {

@@ -20,7 +20,8 @@ std::array<RollingOverlappingAllan, kAxes> makeAllanArray(const PipelineSettings
 }
 
 const PipelineSettings& validated(const PipelineSettings& s) {
-  if (!(s.rate_hz > 0.0) || !std::isfinite(s.rate_hz)) throw std::invalid_argument("pipeline: rate must be > 0 Hz");
+  if (!(s.rate_hz > 0.0) || !std::isfinite(s.rate_hz))
+    throw std::invalid_argument("the sample pipeline needs a rate > 0 Hz, got " + std::to_string(s.rate_hz));
   if (!(s.still_seconds >= 0.0) || !std::isfinite(s.still_seconds))
     throw std::invalid_argument("pipeline: still period must be >= 0 s");
   for (double b : s.bias_dps)
@@ -119,8 +120,9 @@ void SamplePipeline::finishEstimation() {
   // retried and refused at every following sample with the samples piling up.
   Vec3 bias = bias_;
   std::array<processing::FilterChainParameters, kAxes> params = params_;
+  std::size_t axis = 0;  // named in the message when this axis cannot be identified
   try {
-    for (std::size_t axis = 0; axis < kAxes; ++axis) {
+    for (axis = 0; axis < kAxes; ++axis) {
       auto& x = still_[axis];
       if (settings_.bias_origin == BiasOrigin::Estimate) {
         long double sum = 0.0L;
@@ -140,9 +142,9 @@ void SamplePipeline::finishEstimation() {
     still_period_.state = StillPeriodState::Collecting;  // a fresh start, motion check included
     still_period_.attempts = 0;
     std::ostringstream msg;
-    msg << "the still period cannot identify the filter (" << e.what()
-        << "; a sensor whose output never changes?): estimating again over the next " << settings_.still_seconds
-        << " s";
+    msg << "the still period cannot identify the filter on axis "
+        << "xyz"[axis] << " (" << e.what() << "; a sensor whose output never changes?): estimating again over the next "
+        << settings_.still_seconds << " s";
     throw std::invalid_argument(msg.str());
   }
   bias_ = bias;

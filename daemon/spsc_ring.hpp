@@ -20,7 +20,8 @@ class SpscRing {
   // Capacity is min_capacity rounded up to a power of two (so that index = counter & mask).
   explicit SpscRing(std::size_t min_capacity) {
     if (min_capacity == 0 || min_capacity > (std::size_t{1} << 30))
-      throw std::invalid_argument("SpscRing: capacity must be 1..2^30 (got " + std::to_string(min_capacity) + ")");
+      throw std::invalid_argument("the sample queue needs a capacity of 1..2^30 samples (got " +
+                                  std::to_string(min_capacity) + ")");
     std::size_t c = 1;
     while (c < min_capacity) c <<= 1;
     capacity_ = c;

@@ -61,14 +61,14 @@ struct UnixSocketServer::Client {
 UnixSocketServer::UnixSocketServer(EventLoop& loop, ListeningSocket listening, ServerContent& content,
                                    ServerOptions options)
     : loop_(loop), listening_(std::move(listening)), content_(content), options_(std::move(options)) {
-  if (!listening_.fd) throw std::invalid_argument("UnixSocketServer: no listening socket");
+  if (!listening_.fd) throw std::invalid_argument("the socket server needs a listening socket; none given");
   if (options_.client_buffer_bytes < kMinClientBufferBytes)
-    throw std::invalid_argument(
-        "UnixSocketServer: client_buffer_bytes = " + std::to_string(options_.client_buffer_bytes) +
-        " is below the minimum of " + std::to_string(kMinClientBufferBytes));
-  if (options_.max_clients == 0) throw std::invalid_argument("UnixSocketServer: max_clients must be >= 1");
+    throw std::invalid_argument("the socket server's client buffer of " + std::to_string(options_.client_buffer_bytes) +
+                                " bytes is below the minimum of " + std::to_string(kMinClientBufferBytes) + " bytes");
+  if (options_.max_clients == 0)
+    throw std::invalid_argument("the socket server needs room for at least 1 client, got 0");
   if (options_.max_requests_per_turn == 0)
-    throw std::invalid_argument("UnixSocketServer: max_requests_per_turn must be >= 1");
+    throw std::invalid_argument("the socket server needs at least 1 request per client per turn, got 0");
   // Reserved once, so that adding and removing clients never reallocates the list.
   clients_.reserve(options_.max_clients);
   setNonBlockingCloseOnExec(listening_.fd.get());

@@ -41,15 +41,15 @@ VirtualClock::VirtualClock(std::int64_t start_ns)
 
 void VirtualClock::advanceNs(std::int64_t delta_ns) {
   if (delta_ns < 0) {
-    throw std::invalid_argument("VirtualClock::advanceNs: delta_ns must be >= 0, got " + std::to_string(delta_ns));
+    throw std::invalid_argument("the simulated clock cannot go back: a step of " + std::to_string(delta_ns) + " ns");
   }
   now_ns_ += delta_ns;
 }
 
 void VirtualClock::setNs(std::int64_t t_ns) {
   if (t_ns < now_ns_) {
-    throw std::invalid_argument("VirtualClock::setNs: time may not go backwards (now " + std::to_string(now_ns_) +
-                                " ns, asked " + std::to_string(t_ns) + " ns)");
+    throw std::invalid_argument("the simulated clock cannot go back (now " + std::to_string(now_ns_) + " ns, asked " +
+                                std::to_string(t_ns) + " ns)");
   }
   now_ns_ = t_ns;
 }

@@ -48,9 +48,10 @@ std::string describeFunctionalityError(int error, const std::string& path) {
 
 std::array<i2c_msg, 2> registerReadMessages(std::uint8_t address, std::uint8_t* reg_byte, std::span<std::uint8_t> out) {
   if (address > 0x7F)
-    throw std::invalid_argument("registerReadMessages: address must be 7-bit, got " + hexByte(address));
+    throw std::invalid_argument("an I2C register read needs a 7-bit device address, got " + hexByte(address));
   if (out.empty() || out.size() > 0xFFFF) {
-    throw std::invalid_argument("registerReadMessages: length must be 1..65535, got " + std::to_string(out.size()));
+    throw std::invalid_argument("an I2C register read needs a length of 1..65535 bytes, got " +
+                                std::to_string(out.size()));
   }
   std::array<i2c_msg, 2> m{};
   m[0].addr = address;

@@ -13,7 +13,7 @@ namespace gyrod::driver {
 PollingDataReady::PollingDataReady(const Clock& clock, std::int64_t period_ns)
     : clock_(clock), period_ns_(period_ns), next_poll_ns_(clock.nowNs() + period_ns) {
   if (period_ns <= 0) {
-    throw std::invalid_argument("PollingDataReady: period_ns must be > 0, got " + std::to_string(period_ns));
+    throw std::invalid_argument("the data-ready poll needs a period > 0 ns, got " + std::to_string(period_ns));
   }
   fd_.reset(timerfd_create(CLOCK_MONOTONIC, TFD_NONBLOCK | TFD_CLOEXEC));
   if (!fd_) throw std::system_error(errno, std::generic_category(), "timerfd_create for FIFO polling");

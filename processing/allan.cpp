@@ -25,7 +25,7 @@ std::string formatNumber(double v) {
 }
 
 void requireClusterSize(std::size_t m, const char* where) {
-  if (m == 0) throw std::invalid_argument(std::string(where) + ": averaging factor m must be >= 1 (got 0)");
+  if (m == 0) throw std::invalid_argument(std::string(where) + " needs an averaging factor m of at least 1 (got 0)");
 }
 
 // Mean of the series by Neumaier-compensated summation; throws on a non-finite sample
@@ -36,8 +36,8 @@ double compensatedMean(std::span<const double> rate, const char* where) {
   for (std::size_t i = 0; i < rate.size(); ++i) {
     const double v = rate[i];
     if (!std::isfinite(v)) {
-      throw std::invalid_argument(std::string(where) + ": rate[" + std::to_string(i) + "] is not finite (" +
-                                  formatNumber(v) + ")");
+      throw std::invalid_argument(std::string(where) + " cannot use rate sample " + std::to_string(i) +
+                                  ": it is not finite (" + formatNumber(v) + ")");
     }
     const double t = sum + v;
     compensation += std::abs(sum) >= std::abs(v) ? (sum - t) + v : (v - t) + sum;
@@ -292,8 +292,8 @@ int identifyWithMean(std::span<const double> rate, std::size_t m, double mean, c
   const std::size_t m_a = std::min(m, m_max);
   const std::size_t m_b = (m_a + 1 <= m_max) ? m_a + 1 : m_a - 1;
   if (m_b == 0) {
-    throw std::invalid_argument("identifyPowerLawNoise: series too short for a slope (" + std::to_string(count) +
-                                " samples)");
+    throw std::invalid_argument("the power-law noise identification needs more samples for a slope (" +
+                                std::to_string(count) + " samples)");
   }
   const double va = phase->overlappingAllanVariance(m_a);
   const double vb = phase->overlappingAllanVariance(m_b);
@@ -402,7 +402,7 @@ std::vector<std::size_t> octaveClusterSizes(std::size_t sample_count) {
 }
 
 std::vector<std::size_t> denseClusterSizes(std::size_t sample_count, std::size_t per_decade) {
-  if (per_decade == 0) throw std::invalid_argument("denseClusterSizes: per_decade must be >= 1 (got 0)");
+  if (per_decade == 0) throw std::invalid_argument("the Allan tau grid needs at least 1 tau per decade (got 0)");
   std::vector<std::size_t> ms;
   const std::size_t m_max = sample_count / 2;
   for (std::size_t k = 0;; ++k) {
@@ -416,26 +416,26 @@ std::vector<std::size_t> denseClusterSizes(std::size_t sample_count, std::size_t
 
 std::vector<std::size_t> clusterSizesForTaus(std::span<const double> taus_s, double tau0_s, std::size_t sample_count) {
   if (!(std::isfinite(tau0_s) && tau0_s > 0.0)) {
-    throw std::invalid_argument("clusterSizesForTaus: tau0 must be a finite positive time in s (got " +
+    throw std::invalid_argument("the Allan taus need a sample interval tau0 that is a finite positive time in s (got " +
                                 formatNumber(tau0_s) + ")");
   }
   std::vector<std::size_t> ms;
   ms.reserve(taus_s.size());
   for (double tau : taus_s) {
     if (!(std::isfinite(tau) && tau > 0.0)) {
-      throw std::invalid_argument("clusterSizesForTaus: tau = " + formatNumber(tau) +
-                                  " s is not a finite positive time");
+      throw std::invalid_argument("the Allan deviation at tau " + formatNumber(tau) +
+                                  " s cannot be computed: tau is not a finite positive time");
     }
     const double samples = tau / tau0_s;
     const double whole = std::round(samples);
     if (whole < 1.0 || std::abs(samples - whole) > 1e-9 * samples) {
-      throw std::invalid_argument("clusterSizesForTaus: tau = " + formatNumber(tau) +
-                                  " s is not a whole number of samples (tau0 = " + formatNumber(tau0_s) + " s gives " +
-                                  formatNumber(samples) + " samples)");
+      throw std::invalid_argument("the Allan deviation at tau " + formatNumber(tau) +
+                                  " s cannot be computed: tau is not a whole number of samples (tau0 = " +
+                                  formatNumber(tau0_s) + " s gives " + formatNumber(samples) + " samples)");
     }
     // m may be at most floor(N/2): two clusters must fit.
     if (whole > static_cast<double>(sample_count / 2)) {  // NOLINT(bugprone-integer-division)
-      throw std::invalid_argument("clusterSizesForTaus: tau = " + formatNumber(tau) + " s (m = " + formatNumber(whole) +
+      throw std::invalid_argument("the Allan deviation at tau " + formatNumber(tau) + " s (m = " + formatNumber(whole) +
                                   " samples) is too long for " + std::to_string(sample_count) +
                                   " samples: the overlapping estimator needs 2*m <= sample count");
     }
@@ -447,45 +447,45 @@ std::vector<std::size_t> clusterSizesForTaus(std::span<const double> taus_s, dou
 // ---- estimators ----------------------------------------------------------------------
 
 double allanVariance(std::span<const double> rate, std::size_t m) {
-  requireClusterSize(m, "allanVariance");
+  requireClusterSize(m, "the Allan variance");
   if (rate.size() / m < 2) {
-    compensatedMean(rate, "allanVariance");  // still reject non-finite input
+    compensatedMean(rate, "the Allan variance");  // still reject non-finite input
     return kNaN;
   }
-  return IntegratedPhase(rate, "allanVariance").allanVariance(m);
+  return IntegratedPhase(rate, "the Allan variance").allanVariance(m);
 }
 
 double overlappingAllanVariance(std::span<const double> rate, std::size_t m) {
-  requireClusterSize(m, "overlappingAllanVariance");
+  requireClusterSize(m, "the overlapping Allan variance");
   if (2 * m > rate.size()) {
-    compensatedMean(rate, "overlappingAllanVariance");
+    compensatedMean(rate, "the overlapping Allan variance");
     return kNaN;
   }
-  return IntegratedPhase(rate, "overlappingAllanVariance").overlappingAllanVariance(m);
+  return IntegratedPhase(rate, "the overlapping Allan variance").overlappingAllanVariance(m);
 }
 
 std::vector<double> overlappingAllanVariances(std::span<const double> rate, std::span<const std::size_t> ms) {
-  for (std::size_t m : ms) requireClusterSize(m, "overlappingAllanVariances");
-  const IntegratedPhase phase(rate, "overlappingAllanVariances");
+  for (std::size_t m : ms) requireClusterSize(m, "the overlapping Allan variances");
+  const IntegratedPhase phase(rate, "the overlapping Allan variances");
   return phase.overlappingAllanVariances(ms);
 }
 
 int identifyPowerLawNoise(std::span<const double> rate, std::size_t m) {
-  requireClusterSize(m, "identifyPowerLawNoise");
+  requireClusterSize(m, "the power-law noise identification");
   if (rate.size() < 3) {
-    throw std::invalid_argument("identifyPowerLawNoise: need at least 3 samples (got " + std::to_string(rate.size()) +
-                                ")");
+    throw std::invalid_argument("the power-law noise identification needs at least 3 samples (got " +
+                                std::to_string(rate.size()) + ")");
   }
-  const double mean = compensatedMean(rate, "identifyPowerLawNoise");
+  const double mean = compensatedMean(rate, "the power-law noise identification");
   if (rate.size() >= kMinAveragedPointsForNoiseId) return identifyWithMean(rate, m, mean, nullptr);
-  const IntegratedPhase phase(rate, "identifyPowerLawNoise");
+  const IntegratedPhase phase(rate, "the power-law noise identification");
   return identifyWithMean(rate, m, mean, &phase);
 }
 
 double overlappingAllanEdf(int alpha, std::size_t phase_points, std::size_t m) {
-  requireClusterSize(m, "overlappingAllanEdf");
+  requireClusterSize(m, "the Allan deviation's degrees of freedom");
   if (phase_points < 2 * m + 1) {
-    throw std::invalid_argument("overlappingAllanEdf: need phase_points >= 2m + 1 (N = " +
+    throw std::invalid_argument("the Allan deviation's degrees of freedom need at least 2m + 1 phase points (N = " +
                                 std::to_string(phase_points) + ", m = " + std::to_string(m) + ")");
   }
   const double N = static_cast<double>(phase_points);
@@ -505,20 +505,22 @@ double overlappingAllanEdf(int alpha, std::size_t phase_points, std::size_t m) {
       return (N - 2.0) / md * (n1 * n1 - 3.0 * md * n1 + 4.0 * md * md) / ((N - 3.0) * (N - 3.0));
     }
     default:
-      throw std::invalid_argument("overlappingAllanEdf: alpha must be an integer in [-2, 2] (got " +
-                                  std::to_string(alpha) + ")");
+      throw std::invalid_argument(
+          "the Allan deviation's degrees of freedom need a noise type alpha that is an integer in [-2, 2] (got " +
+          std::to_string(alpha) + ")");
   }
 }
 
 DeviationInterval allanDeviationConfidenceInterval(double deviation, double edf, double confidence) {
   if (!(confidence > 0.0 && confidence < 1.0)) {
-    throw std::invalid_argument("allanDeviationConfidenceInterval: confidence must be in (0, 1) (got " +
+    throw std::invalid_argument("the Allan deviation's confidence interval needs a confidence in (0, 1) (got " +
                                 formatNumber(confidence) + ")");
   }
   if (std::isnan(deviation)) return {kNaN, kNaN};
   if (!(std::isfinite(edf) && edf > 0.0)) {
-    throw std::invalid_argument("allanDeviationConfidenceInterval: edf must be finite and > 0 (got " +
-                                formatNumber(edf) + ")");
+    throw std::invalid_argument(
+        "the Allan deviation's confidence interval needs degrees of freedom that are finite and > 0 (got " +
+        formatNumber(edf) + ")");
   }
   // NIST SP 1065 eq. 45: σ²·edf/σ̂² ~ χ²(edf).
   return {deviation * std::sqrt(edf / chiSquareQuantile(0.5 * (1.0 + confidence), edf)),
@@ -528,23 +530,24 @@ DeviationInterval allanDeviationConfidenceInterval(double deviation, double edf,
 std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double tau0_s,
                                             std::span<const std::size_t> ms, const AllanOptions& options) {
   if (!(std::isfinite(tau0_s) && tau0_s > 0.0)) {
-    throw std::invalid_argument("allanDeviationTable: tau0 must be a finite positive time in s (got " +
-                                formatNumber(tau0_s) + ")");
+    throw std::invalid_argument(
+        "the Allan deviation table needs a sample interval tau0 that is a finite positive time in s (got " +
+        formatNumber(tau0_s) + ")");
   }
   if (!(options.confidence > 0.0 && options.confidence < 1.0)) {
-    throw std::invalid_argument("allanDeviationTable: confidence must be in (0, 1) (got " +
+    throw std::invalid_argument("the Allan deviation table needs a confidence in (0, 1) (got " +
                                 formatNumber(options.confidence) + ")");
   }
   if (rate.size() < 3) {
-    throw std::invalid_argument("allanDeviationTable: need at least 3 rate samples (got " +
+    throw std::invalid_argument("the Allan deviation table needs at least 3 rate samples (got " +
                                 std::to_string(rate.size()) + ")");
   }
-  for (std::size_t m : ms) requireClusterSize(m, "allanDeviationTable");
+  for (std::size_t m : ms) requireClusterSize(m, "the Allan deviation table");
 
   const std::size_t count = rate.size();
   // The noise types first, while only the rate is held (the lag-1 method averages the rate
   // itself); the phase, twice the rate's size, comes after.
-  const double mean = compensatedMean(rate, "allanDeviationTable");  // one pass for both
+  const double mean = compensatedMean(rate, "the Allan deviation table");  // one pass for both
   const std::vector<int> alphas = noiseTypesForTable(rate, ms, mean);
   const IntegratedPhase phase(rate, mean);
   const std::vector<double> overlapping = phase.overlappingAllanVariances(ms);

@@ -2,19 +2,30 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
 namespace gyrod::processing {
 
+namespace {
+// A sample's value as a user would write it (std::to_string would show 0.000000 for 1e-9).
+std::string formatValue(double v) {
+  std::ostringstream os;
+  os.precision(6);
+  os << v;
+  return os.str();
+}
+}  // namespace
+
 std::vector<double> autocovariance(std::span<const double> x, std::size_t max_lag) {
   if (max_lag >= x.size())
-    throw std::invalid_argument("autocovariance: max_lag = " + std::to_string(max_lag) + " needs more than " +
+    throw std::invalid_argument("the autocovariance at lag " + std::to_string(max_lag) + " needs more than " +
                                 std::to_string(max_lag) + " samples, got " + std::to_string(x.size()));
   double mean = 0.0;
   for (std::size_t i = 0; i < x.size(); ++i) {
     if (!std::isfinite(x[i]))
-      throw std::invalid_argument("autocovariance: sample " + std::to_string(i) + " is not finite");
+      throw std::invalid_argument("the autocovariance cannot use sample " + std::to_string(i) + ": it is not finite");
     mean += x[i];
   }
   const double n = static_cast<double>(x.size());
@@ -31,12 +42,14 @@ std::vector<double> autocovariance(std::span<const double> x, std::size_t max_la
 }
 
 std::vector<ArModel> yuleWalker(std::span<const double> x, std::size_t max_order) {
-  if (max_order == 0) throw std::invalid_argument("yuleWalker: max_order must be >= 1");
+  if (max_order == 0) throw std::invalid_argument("the AR model fit needs a maximum order of at least 1, got 0");
   if (x.size() <= max_order)
-    throw std::invalid_argument("yuleWalker: max_order = " + std::to_string(max_order) + " needs more than " +
+    throw std::invalid_argument("the AR model fit of order " + std::to_string(max_order) + " needs more than " +
                                 std::to_string(max_order) + " samples, got " + std::to_string(x.size()));
   const std::vector<double> gamma = autocovariance(x, max_order);
-  if (!(gamma[0] > 0.0)) throw std::invalid_argument("yuleWalker: the series has zero variance");
+  if (!(gamma[0] > 0.0))
+    throw std::invalid_argument("the AR model fit needs a series that varies; this one is constant (all " +
+                                std::to_string(x.size()) + " values are " + formatValue(x.front()) + ")");
   const double n = static_cast<double>(x.size());
 
   // Levinson–Durbin: from the order-(k−1) solution φ^(k−1) and σ²_(k−1),
@@ -62,8 +75,8 @@ std::vector<ArModel> yuleWalker(std::span<const double> x, std::size_t max_order
     for (std::size_t j = 1; j < k; ++j) phi[j - 1] = previous[j - 1] - kappa * previous[k - j - 1];
     sigma2 *= (1.0 - kappa * kappa);
     if (!(sigma2 > 0.0))
-      throw std::invalid_argument("yuleWalker: the series is perfectly predictable at order " + std::to_string(k) +
-                                  " (innovation variance " + std::to_string(sigma2) + ")");
+      throw std::invalid_argument("the AR model fit found the series perfectly predictable at order " +
+                                  std::to_string(k) + " (innovation variance " + std::to_string(sigma2) + ")");
 
     ArModel m;
     m.phi = phi;
@@ -87,7 +100,7 @@ std::vector<ArModel> yuleWalker(std::span<const double> x, std::size_t max_order
 namespace {
 template <typename Criterion>
 std::size_t orderMinimising(std::span<const ArModel> models, Criterion criterion, const char* who) {
-  if (models.empty()) throw std::invalid_argument(std::string(who) + ": no models given");
+  if (models.empty()) throw std::invalid_argument(std::string(who) + " needs at least one AR model; none given");
   std::size_t best = 0;
   for (std::size_t i = 1; i < models.size(); ++i)
     if (criterion(models[i]) < criterion(models[best])) best = i;
@@ -97,12 +110,12 @@ std::size_t orderMinimising(std::span<const ArModel> models, Criterion criterion
 
 std::size_t orderByAic(std::span<const ArModel> models) {
   return orderMinimising(
-      models, [](const ArModel& m) { return m.aic; }, "orderByAic");
+      models, [](const ArModel& m) { return m.aic; }, "choosing the AR order by AIC");
 }
 
 std::size_t orderByBic(std::span<const ArModel> models) {
   return orderMinimising(
-      models, [](const ArModel& m) { return m.bic; }, "orderByBic");
+      models, [](const ArModel& m) { return m.bic; }, "choosing the AR order by BIC");
 }
 
 }  // namespace gyrod::processing

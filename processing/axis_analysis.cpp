@@ -82,7 +82,8 @@ AxisAnalysis analyzeAxis(std::span<const double> rate_dps, const AnalysisOptions
 // 24 bytes a sample.
 AxisAnalysis analyzeAxis(std::vector<double>&& rate_dps, const AnalysisOptions& options) {
   if (!(options.rate_hz > 0.0) || !std::isfinite(options.rate_hz))
-    throw std::invalid_argument("analyzeAxis: rate must be a positive number of Hz");
+    throw std::invalid_argument("the axis analysis needs a sample rate that is a positive number of Hz, got " +
+                                std::to_string(options.rate_hz));
   const double tau0 = 1.0 / options.rate_hz;
   AxisAnalysis a;
   a.samples = rate_dps.size();

@@ -8,9 +8,10 @@ namespace gyrod::processing {
 
 LinearTrend fitLinearTrend(std::span<const double> x, double dt_s) {
   if (x.size() < 2)
-    throw std::invalid_argument("fitLinearTrend: need at least 2 samples, got " + std::to_string(x.size()));
+    throw std::invalid_argument("the linear trend fit needs at least 2 samples, got " + std::to_string(x.size()));
   if (!(dt_s > 0.0) || !std::isfinite(dt_s))
-    throw std::invalid_argument("fitLinearTrend: dt_s must be positive and finite, got " + std::to_string(dt_s));
+    throw std::invalid_argument("the linear trend fit needs a sample interval that is positive and finite, got " +
+                                std::to_string(dt_s));
   // Centred normal equations: with t̄ = (n−1)/2 (in samples) and x̄ the means,
   // slope = Σ(i − t̄)(x_i − x̄) / Σ(i − t̄)², which avoids the cancellation of the raw
   // Σi², Σi·x_i form on long records. Σ(i − t̄)² = n(n²−1)/12 exactly.
@@ -30,7 +31,7 @@ LinearTrend fitLinearTrend(std::span<const double> x, double dt_s) {
 }
 
 double removeConstant(std::span<double> x) {
-  if (x.empty()) throw std::invalid_argument("removeConstant: empty series");
+  if (x.empty()) throw std::invalid_argument("removing the mean needs at least one sample; the series is empty");
   double mean = 0.0;
   for (double v : x) mean += v;
   mean /= static_cast<double>(x.size());

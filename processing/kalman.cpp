@@ -11,24 +11,28 @@ namespace gyrod::processing {
 namespace {
 
 void requireFinite(double v, const char* who, const char* name) {
-  if (!std::isfinite(v)) throw std::invalid_argument(std::string(who) + ": " + name + " is not finite");
+  if (!std::isfinite(v))
+    throw std::invalid_argument(std::string(who) + " needs a finite " + name + ", got " + std::to_string(v));
 }
 
 void validateNoise(const char* who, double q, double r, double p0) {
   requireFinite(q, who, "q");
   requireFinite(r, who, "r");
   requireFinite(p0, who, "p0");
-  if (q < 0.0) throw std::invalid_argument(std::string(who) + ": q must be >= 0, got " + std::to_string(q));
-  if (!(r > 0.0)) throw std::invalid_argument(std::string(who) + ": r must be > 0, got " + std::to_string(r));
-  if (p0 < 0.0) throw std::invalid_argument(std::string(who) + ": p0 must be >= 0, got " + std::to_string(p0));
+  if (q < 0.0)
+    throw std::invalid_argument(std::string(who) + " needs a process noise q >= 0, got " + std::to_string(q));
+  if (!(r > 0.0))
+    throw std::invalid_argument(std::string(who) + " needs a measurement noise r > 0, got " + std::to_string(r));
+  if (p0 < 0.0)
+    throw std::invalid_argument(std::string(who) + " needs an initial covariance p0 >= 0, got " + std::to_string(p0));
 }
 
 }  // namespace
 
 ScalarKalmanFilter::ScalarKalmanFilter(const ScalarKalmanParameters& p) : params_(p) {
-  requireFinite(p.a, "ScalarKalmanFilter", "a");
-  validateNoise("ScalarKalmanFilter", p.q, p.r, p.p0);
-  if (p.x0) requireFinite(*p.x0, "ScalarKalmanFilter", "x0");
+  requireFinite(p.a, "the Kalman filter", "a");
+  validateNoise("the Kalman filter", p.q, p.r, p.p0);
+  if (p.x0) requireFinite(*p.x0, "the Kalman filter", "x0");
   reset();
 }
 
@@ -41,7 +45,9 @@ void ScalarKalmanFilter::reset() {
 }
 
 double ScalarKalmanFilter::update(double z) {
-  if (!std::isfinite(z)) throw std::invalid_argument("ScalarKalmanFilter::update: measurement is not finite");
+  if (!std::isfinite(z))
+    throw std::invalid_argument("the Kalman filter cannot take a measurement that is not finite, got " +
+                                std::to_string(z));
   if (!initialised_) {
     // Paper: x̂0 = Z0, P0 as given; nothing to predict from yet.
     initialised_ = true;
@@ -62,8 +68,8 @@ double ScalarKalmanFilter::update(double z) {
 }
 
 double steadyStatePriorCovariance(double a, double q, double r) {
-  requireFinite(a, "steadyStatePriorCovariance", "a");
-  validateNoise("steadyStatePriorCovariance", q, r, 0.0);
+  requireFinite(a, "the steady-state Kalman covariance", "a");
+  validateNoise("the steady-state Kalman covariance", q, r, 0.0);
   // M² + b·M − QR = 0 with b = R(1 − A²) − Q. The roots have product −QR ≤ 0; take the
   // larger (the positive one for Q > 0), written to avoid cancellation for either sign of b.
   const double b = r * (1.0 - a * a) - q;
@@ -85,10 +91,11 @@ double steadyStatePosteriorCovariance(double a, double q, double r) {
 KalmanIdentification identifyKalmanParameters(std::span<const double> raw_detrended,
                                               std::span<const double> mean_filtered) {
   if (raw_detrended.size() != mean_filtered.size())
-    throw std::invalid_argument("identifyKalmanParameters: raw_detrended has " + std::to_string(raw_detrended.size()) +
-                                " samples but mean_filtered has " + std::to_string(mean_filtered.size()));
+    throw std::invalid_argument(
+        "the Kalman filter identification needs as many raw samples as mean-filtered ones; there are " +
+        std::to_string(raw_detrended.size()) + " raw and " + std::to_string(mean_filtered.size()) + " mean-filtered");
   if (mean_filtered.size() < 2)
-    throw std::invalid_argument("identifyKalmanParameters: need at least 2 samples, got " +
+    throw std::invalid_argument("the Kalman filter identification needs at least 2 samples, got " +
                                 std::to_string(mean_filtered.size()));
   // A, Q: the AR(1) Yule–Walker fit of the mean-filtered series (throws on non-finite
   // values or zero variance).
@@ -99,7 +106,8 @@ KalmanIdentification identifyKalmanParameters(std::span<const double> raw_detren
   double mean = 0.0;
   for (std::size_t i = 0; i < raw_detrended.size(); ++i) {
     if (!std::isfinite(raw_detrended[i]))
-      throw std::invalid_argument("identifyKalmanParameters: raw sample " + std::to_string(i) + " is not finite");
+      throw std::invalid_argument("the Kalman filter identification cannot use raw sample " + std::to_string(i) +
+                                  ": it is not finite");
     mean += raw_detrended[i] - mean_filtered[i];
   }
   mean /= n;
@@ -111,7 +119,8 @@ KalmanIdentification identifyKalmanParameters(std::span<const double> raw_detren
   const double r = ss / n;
   if (!(r > 0.0))
     throw std::invalid_argument(
-        "identifyKalmanParameters: raw and mean-filtered series differ only by a constant, so R would be 0");
+        "the Kalman filter identification needs raw samples that differ from the mean-filtered ones by more than "
+        "a constant (the measurement noise R would be 0)");
 
   KalmanIdentification id;
   id.params.a = ar1[0].phi[0];
@@ -124,10 +133,10 @@ KalmanIdentification identifyKalmanParameters(std::span<const double> raw_detren
 
 ArKalmanFilter::ArKalmanFilter(std::span<const double> phi, double q, double r, double p0) : q_(q), r_(r), p0_(p0) {
   if (phi.empty() || phi.size() > kMaxArOrder)
-    throw std::invalid_argument("ArKalmanFilter: AR order must be in [1, " + std::to_string(kMaxArOrder) + "], got " +
-                                std::to_string(phi.size()));
-  for (double v : phi) requireFinite(v, "ArKalmanFilter", "a coefficient phi");
-  validateNoise("ArKalmanFilter", q, r, p0);
+    throw std::invalid_argument("the AR Kalman filter needs an AR order in [1, " + std::to_string(kMaxArOrder) +
+                                "], got " + std::to_string(phi.size()));
+  for (double v : phi) requireFinite(v, "the AR Kalman filter", "a coefficient phi");
+  validateNoise("the AR Kalman filter", q, r, p0);
   const auto p = static_cast<Eigen::Index>(phi.size());
   // Companion matrix: first row φ1..φp, ones on the subdiagonal (x_{k−i} shifts down).
   f_.setZero(p, p);
@@ -150,7 +159,9 @@ void ArKalmanFilter::reset() {
 }
 
 double ArKalmanFilter::update(double z) {
-  if (!std::isfinite(z)) throw std::invalid_argument("ArKalmanFilter::update: measurement is not finite");
+  if (!std::isfinite(z))
+    throw std::invalid_argument("the AR Kalman filter cannot take a measurement that is not finite, got " +
+                                std::to_string(z));
   if (!initialised_) {
     initialised_ = true;
     x_.setConstant(z);

@@ -9,9 +9,10 @@ namespace gyrod::processing {
 namespace {
 
 void validateParameters(const char* who, std::size_t window_length, double threshold) {
-  if (window_length == 0) throw std::invalid_argument(std::string(who) + ": window length L must be >= 1, got 0");
+  if (window_length == 0)
+    throw std::invalid_argument(std::string(who) + " needs a window length L of at least 1, got 0");
   if (!(threshold > 0.0) || !std::isfinite(threshold))
-    throw std::invalid_argument(std::string(who) + ": threshold r must be positive and finite, got " +
+    throw std::invalid_argument(std::string(who) + " needs a threshold r that is positive and finite, got " +
                                 std::to_string(threshold));
 }
 
@@ -46,12 +47,13 @@ WindowEstimate rejectAndAverage(std::span<const double> older, std::span<const d
 
 GrossErrorMeanFilter::GrossErrorMeanFilter(std::size_t window_length, double threshold_dps)
     : threshold_(threshold_dps) {
-  validateParameters("GrossErrorMeanFilter", window_length, threshold_dps);
+  validateParameters("the mean filter", window_length, threshold_dps);
   window_.assign(window_length, 0.0);
 }
 
 double GrossErrorMeanFilter::update(double x) {
-  if (!std::isfinite(x)) throw std::invalid_argument("GrossErrorMeanFilter::update: sample is not finite");
+  if (!std::isfinite(x))
+    throw std::invalid_argument("the mean filter cannot take a sample that is not finite, got " + std::to_string(x));
   const std::size_t len = window_.size();
   window_[next_] = x;
   next_ = next_ + 1 == len ? 0 : next_ + 1;
@@ -72,10 +74,11 @@ void GrossErrorMeanFilter::reset() {
 }
 
 std::vector<double> blockMeanFilter(std::span<const double> x, std::size_t window_length, double threshold_dps) {
-  validateParameters("blockMeanFilter", window_length, threshold_dps);
+  validateParameters("the block mean filter", window_length, threshold_dps);
   for (std::size_t i = 0; i < x.size(); ++i)
     if (!std::isfinite(x[i]))
-      throw std::invalid_argument("blockMeanFilter: sample " + std::to_string(i) + " is not finite");
+      throw std::invalid_argument("the block mean filter cannot use sample " + std::to_string(i) +
+                                  ": it is not finite");
   std::vector<double> out;
   out.reserve(x.size() / window_length);
   for (std::size_t start = 0; start + window_length <= x.size(); start += window_length)

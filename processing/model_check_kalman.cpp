@@ -30,10 +30,14 @@ InnovationStats kalmanInnovations(std::span<const double> z, std::span<const dou
   const std::size_t p = phi.size();
   const bool gm = gm_noise_var > 0.0;
   if (p == 0 || p > kMaxArOrder)
-    throw std::invalid_argument("kalmanInnovations: AR order must be 1.." + std::to_string(kMaxArOrder));
+    throw std::invalid_argument("the Kalman innovations need an AR order of 1.." + std::to_string(kMaxArOrder) +
+                                ", got " + std::to_string(p));
   if (!(ar_noise_var > 0.0) || !std::isfinite(ar_noise_var))
-    throw std::invalid_argument("kalmanInnovations: AR noise variance must be > 0");
-  if (z.size() <= kBurnIn + 10) throw std::invalid_argument("kalmanInnovations: series too short");
+    throw std::invalid_argument("the Kalman innovations need an AR noise variance > 0, got " +
+                                std::to_string(ar_noise_var));
+  if (z.size() <= kBurnIn + 10)
+    throw std::invalid_argument("the Kalman innovations need more than " + std::to_string(kBurnIn + 10) +
+                                " samples, got " + std::to_string(z.size()));
   const auto d = static_cast<Eigen::Index>(p + (gm ? 1 : 0));
   const auto pi = static_cast<Eigen::Index>(p);
 

@@ -27,8 +27,11 @@ double sortedQuantile(const std::vector<double>& sorted, double q) {
 }
 
 NullSummary summarizeNull(std::vector<double> values, double alpha, bool two_sided) {
-  if (values.size() < 2) throw std::invalid_argument("summarizeNull: need at least 2 replica values");
-  if (!(alpha > 0.0 && alpha < 0.5)) throw std::invalid_argument("summarizeNull: alpha must be in (0, 0.5)");
+  if (values.size() < 2)
+    throw std::invalid_argument("the null distribution needs at least 2 replica values, got " +
+                                std::to_string(values.size()));
+  if (!(alpha > 0.0 && alpha < 0.5))
+    throw std::invalid_argument("the null distribution needs a level alpha in (0, 0.5), got " + std::to_string(alpha));
   std::sort(values.begin(), values.end());
   NullSummary s;
   s.two_sided = two_sided;
@@ -57,7 +60,7 @@ double NullSummary::excess(double value) const {
 }
 
 std::vector<double> blockMeans(std::span<const double> x, std::size_t length) {
-  if (length == 0) throw std::invalid_argument("blockMeans: block length must be > 0");
+  if (length == 0) throw std::invalid_argument("the block means need a block length of at least 1 sample, got 0");
   std::vector<double> out(x.size() / length);
   for (std::size_t b = 0; b < out.size(); ++b) {
     double s = 0.0;
@@ -100,7 +103,7 @@ std::size_t fftLength(std::size_t n) {
 
 Periodogram hannPeriodogram(std::span<const double> x) {
   const std::size_t n = x.size();
-  if (n < 4) throw std::invalid_argument("hannPeriodogram: need at least 4 samples");
+  if (n < 4) throw std::invalid_argument("the periodogram needs at least 4 samples, got " + std::to_string(n));
   const std::size_t nfft = fftLength(n);
   std::vector<double> in(nfft, 0.0);
   double wp = 0.0;
@@ -240,7 +243,9 @@ GaussMarkovCurveFit fitGaussMarkovToAllan(std::span<const double> tau_s, std::sp
                                           std::span<const double> edf, std::span<const double> t_grid) {
   const auto n = static_cast<Eigen::Index>(tau_s.size());
   if (tau_s.size() != variance.size() || tau_s.size() != edf.size() || n < 7 || t_grid.empty())
-    throw std::invalid_argument("fitGaussMarkovToAllan: need ≥ 7 points with variance and edf, and a T grid");
+    throw std::invalid_argument(
+        "the Gauss-Markov fit to the Allan curve needs at least 7 points with a variance and edf, and a grid of "
+        "correlation times");
   Eigen::MatrixXd five(n, static_cast<Eigen::Index>(kNoiseTermCount));
   for (Eigen::Index j = 0; j < n; ++j)
     for (std::size_t i = 0; i < kNoiseTermCount; ++i)
@@ -328,7 +333,7 @@ std::string_view modelEffectName(ModelEffect e) {
 
 double gaussMarkovAllanVariance(double tau_s, double correlation_time_s, double sigma_dps) {
   if (!(tau_s > 0.0) || !(correlation_time_s > 0.0) || !std::isfinite(sigma_dps))
-    throw std::invalid_argument("gaussMarkovAllanVariance: tau and T must be > 0 and sigma finite");
+    throw std::invalid_argument("the Gauss-Markov Allan variance needs tau and T > 0 and a finite sigma");
   const double x = tau_s / correlation_time_s;
   // bracket = 1 − (3 − 4e^{−x} + e^{−2x})/(2x); below x = 0.01 its series
   // x²/3 − x³/4 + 7x⁴/60 − x⁵/24 avoids the cancellation.
@@ -344,12 +349,13 @@ double gaussMarkovAllanVariance(double tau_s, double correlation_time_s, double 
 
 SampleTiming analyzeSampleTiming(std::span<const double> t) {
   SampleTiming s;
-  if (t.size() < 3) throw std::invalid_argument("analyzeSampleTiming: need at least 3 times");
+  if (t.size() < 3)
+    throw std::invalid_argument("the sample timing check needs at least 3 times, got " + std::to_string(t.size()));
   std::vector<double> dt(t.size() - 1);
   for (std::size_t i = 0; i + 1 < t.size(); ++i) {
     dt[i] = t[i + 1] - t[i];
     if (!std::isfinite(dt[i]) || !(dt[i] > 0.0))
-      throw std::invalid_argument("analyzeSampleTiming: times must be finite and increasing (at index " +
+      throw std::invalid_argument("the sample timing check needs finite, increasing times (at index " +
                                   std::to_string(i + 1) + ")");
   }
   std::vector<double> sorted = dt;
@@ -375,14 +381,17 @@ SampleTiming analyzeSampleTiming(std::span<const double> t) {
 LjungBox ljungBoxTest(std::span<const double> x, std::size_t lags, std::size_t fitted_parameters) {
   const std::size_t n = x.size();
   if (lags == 0 || n <= lags + 1)
-    throw std::invalid_argument("ljungBoxTest: need lags >= 1 and more samples than lags + 1");
+    throw std::invalid_argument("the Ljung-Box test needs at least 1 lag and more samples than lags + 1 (" +
+                                std::to_string(lags) + " lags, " + std::to_string(n) + " samples)");
   double mean = 0.0;
   for (double v : x) mean += v;
   mean /= static_cast<double>(n);
   double c0 = 0.0;
   for (double v : x) c0 += (v - mean) * (v - mean);
   LjungBox lb;
-  if (!(c0 > 0.0)) throw std::invalid_argument("ljungBoxTest: the series is constant");
+  if (!(c0 > 0.0))
+    throw std::invalid_argument("the Ljung-Box test needs a series that varies; this one is constant (every value " +
+                                std::to_string(mean) + ")");
   const double nn = static_cast<double>(n);
   for (std::size_t k = 1; k <= lags; ++k) {
     double ck = 0.0;
@@ -430,7 +439,9 @@ SinusoidFit fitSinusoidAt(std::span<const double> x, double rate_hz, double freq
 
 std::vector<double> localOutlierScores(std::span<const double> x, std::size_t h) {
   const std::size_t n = x.size();
-  if (h == 0 || n < 2 * h + 2) throw std::invalid_argument("localOutlierScores: series too short for the window");
+  if (h == 0 || n < 2 * h + 2)
+    throw std::invalid_argument("the outlier scores need at least " + std::to_string(2 * h + 2) +
+                                " samples for a half-window of " + std::to_string(h) + ", got " + std::to_string(n));
   std::vector<double> prefix(n + 1, 0.0);
   for (std::size_t i = 0; i < n; ++i) prefix[i + 1] = prefix[i] + x[i];
   std::vector<double> d(n);

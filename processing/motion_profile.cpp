@@ -55,7 +55,8 @@ double portableSinOfCycles(double cycles) {
 }
 
 MotionProfile MotionProfile::table(std::vector<MotionPoint> points) {
-  if (points.empty()) throw std::invalid_argument("table: needs at least one point (t, wx, wy, wz), got none");
+  if (points.empty())
+    throw std::invalid_argument("the motion table needs at least one point (t, wx, wy, wz), got none");
   for (std::size_t i = 0; i < points.size(); ++i) {
     const std::string where = "table point " + std::to_string(i) + ": ";
     requireFinite(points[i].t_s, where + "t");

@@ -34,15 +34,17 @@ std::vector<CurvePoint> usablePoints(std::span<const AllanPoint> curve, std::siz
   for (const AllanPoint& p : curve) {
     if (p.oadev_terms < min_terms || !std::isfinite(p.oadev)) continue;
     if (!(std::isfinite(p.tau_s) && p.tau_s > 0.0)) {
-      throw std::invalid_argument(std::string(where) + ": " + describeTau(p.tau_s) + " is not a positive time");
+      throw std::invalid_argument(std::string(where) + " needs positive times; " + describeTau(p.tau_s) +
+                                  " is not one");
     }
     if (!(p.oadev > 0.0)) {
-      throw std::invalid_argument(std::string(where) + ": oadev at " + describeTau(p.tau_s) +
-                                  " is 0: a curve without noise has no terms to read");
+      throw std::invalid_argument(std::string(where) + " needs an Allan deviation above 0; at " + describeTau(p.tau_s) +
+                                  " it is 0 (a signal without noise, such as a constant one, has no terms to read)");
     }
     if (need_edf && !(std::isfinite(p.edf) && p.edf > 0.0)) {
-      throw std::invalid_argument(std::string(where) + ": edf at " + describeTau(p.tau_s) +
-                                  " must be finite and > 0 (it weights the fit)");
+      throw std::invalid_argument(std::string(where) +
+                                  " needs degrees of freedom that are finite and > 0 (they weight the fit); at " +
+                                  describeTau(p.tau_s) + " they are not");
     }
     double edf = p.edf;
     if (need_edf && p.m > 0) {
@@ -58,8 +60,8 @@ std::vector<CurvePoint> usablePoints(std::span<const AllanPoint> curve, std::siz
     points.push_back({p.tau_s, p.oadev * p.oadev, edf});
   }
   if (points.empty()) {
-    throw std::invalid_argument(std::string(where) + ": no usable point (need oadev_terms >= " +
-                                std::to_string(min_terms) + " and a finite oadev)");
+    throw std::invalid_argument(std::string(where) + " has no usable point (each needs at least " +
+                                std::to_string(min_terms) + " terms in its Allan deviation, and a finite one)");
   }
   return points;
 }
@@ -96,14 +98,14 @@ std::optional<Eigen::MatrixXd> covarianceOfColumns(const Eigen::MatrixXd& a, con
 NonNegativeLeastSquares solveNonNegativeLeastSquares(const Eigen::MatrixXd& a, const Eigen::VectorXd& b) {
   const Eigen::Index n = a.cols();
   if (n < 1 || n > 16) {
-    throw std::invalid_argument("solveNonNegativeLeastSquares: need 1..16 columns (got " + std::to_string(n) + ")");
+    throw std::invalid_argument("the noise term fit needs 1..16 terms (got " + std::to_string(n) + ")");
   }
   if (a.rows() != b.size()) {
-    throw std::invalid_argument("solveNonNegativeLeastSquares: A has " + std::to_string(a.rows()) + " rows but b has " +
-                                std::to_string(b.size()));
+    throw std::invalid_argument("the noise term fit has " + std::to_string(a.rows()) + " rows of terms but " +
+                                std::to_string(b.size()) + " Allan variances");
   }
   if (!a.allFinite() || !b.allFinite()) {
-    throw std::invalid_argument("solveNonNegativeLeastSquares: A and b must be finite");
+    throw std::invalid_argument("the noise term fit needs finite terms and Allan variances");
   }
   Eigen::VectorXd norms = a.colwise().norm().transpose();
   Eigen::MatrixXd scaled = a;
@@ -153,7 +155,7 @@ NonNegativeLeastSquares solveNonNegativeLeastSquares(const Eigen::MatrixXd& a, c
 }
 
 NoiseTermFit fitNoiseTerms(std::span<const AllanPoint> curve, std::size_t min_terms) {
-  const std::vector<CurvePoint> points = usablePoints(curve, min_terms, true, "fitNoiseTerms");
+  const std::vector<CurvePoint> points = usablePoints(curve, min_terms, true, "the noise term fit");
   const auto n = static_cast<Eigen::Index>(points.size());
 
   // Row j of the weighted system is divided by the standard deviation of σ̂²_j,
@@ -228,7 +230,7 @@ NoiseTermFit fitNoiseTerms(std::span<const AllanPoint> curve, std::size_t min_te
 }
 
 NoiseTerms readNoiseTermsFromSlopes(std::span<const AllanPoint> curve, std::size_t min_terms) {
-  const std::vector<CurvePoint> points = usablePoints(curve, min_terms, false, "readNoiseTermsFromSlopes");
+  const std::vector<CurvePoint> points = usablePoints(curve, min_terms, false, "the noise terms read from the slopes");
   NoiseTerms terms;
   for (NoiseTerm t : kAllNoiseTerms) {
     const double s = noiseTermSlope(t);

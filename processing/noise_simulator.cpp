@@ -524,7 +524,8 @@ SimulatedSample NoiseSimulator::next() {
 
 const std::vector<GaussMarkovComponent>& NoiseSimulator::flickerBank(std::size_t axis) const {
   if (axis >= kSimulatedAxes)
-    throw std::invalid_argument("flickerBank: axis must be 0..2, got " + std::to_string(axis));
+    throw std::invalid_argument("the simulator's flicker noise exists for axes 0..2 (x, y, z), not for axis " +
+                                std::to_string(axis));
   return axes_[axis].flicker_bank;
 }
 

@@ -18,7 +18,7 @@ constexpr double kSqrtHalf = 0.70710678118654752440;
 
 double log(double x) {
   if (!(x > 0.0) || !std::isfinite(x))
-    throw std::invalid_argument("portable::log: argument must be finite and > 0, got " + std::to_string(x));
+    throw std::invalid_argument("the logarithm needs an argument that is finite and > 0, got " + std::to_string(x));
   int e = 0;
   double m = std::frexp(x, &e);  // x = m·2^e, m in [0.5, 1), exact
   if (m < kSqrtHalf) {
@@ -47,7 +47,7 @@ double log(double x) {
 }
 
 double exp(double x) {
-  if (std::isnan(x)) throw std::invalid_argument("portable::exp: argument is NaN");
+  if (std::isnan(x)) throw std::invalid_argument("the exponential cannot take NaN");
   if (x > 709.78) return HUGE_VAL;
   if (x < -745.2) return 0.0;
   // k = nearest integer to x/ln2 (floor(y + 0.5) is exact rounding arithmetic).
@@ -79,7 +79,7 @@ double exp(double x) {
 }
 
 double expm1(double x) {
-  if (std::isnan(x)) throw std::invalid_argument("portable::expm1: argument is NaN");
+  if (std::isnan(x)) throw std::invalid_argument("the exponential cannot take NaN");
   // Beyond 0.7 the subtraction exp(x) − 1 costs at most about one bit.
   if (std::fabs(x) > 0.7) return exp(x) - 1.0;
   // x·(1 + x/2! + x²/3! + … + x¹⁸/19!), remainder < 1e-21 relative for |x| ≤ 0.7.
@@ -107,7 +107,7 @@ double expm1(double x) {
 
 double tan(double x) {
   if (!(std::fabs(x) <= 1.2))
-    throw std::invalid_argument("portable::tan: |x| must be <= 1.2, got " + std::to_string(x));
+    throw std::invalid_argument("the tangent is computed only for |x| <= 1.2, got " + std::to_string(x));
   const double x2 = x * x;
   // sin x = x·Σ (−x²)^n/(2n+1)!, cos x = Σ (−x²)^n/(2n)!, to n = 12 (remainder < 1e-22
   // relative at |x| = 1.2).

@@ -105,7 +105,7 @@ namespace {
 
 std::vector<std::size_t> octaveFactorsForWindow(std::size_t window_samples) {
   if (window_samples < 2) {
-    throw std::invalid_argument("RollingOverlappingAllan: window_samples must be >= 2 (got " +
+    throw std::invalid_argument("the live Allan window needs at least 2 samples (got " +
                                 std::to_string(window_samples) + "): m = 1 needs 2 samples");
   }
   std::vector<std::size_t> ms;
@@ -121,26 +121,26 @@ RollingOverlappingAllan::RollingOverlappingAllan(std::size_t window_samples)
 RollingOverlappingAllan::RollingOverlappingAllan(std::size_t window_samples, std::span<const std::size_t> cluster_sizes)
     : window_capacity_(window_samples), cluster_sizes_(cluster_sizes.begin(), cluster_sizes.end()) {
   if (window_samples < 2) {
-    throw std::invalid_argument("RollingOverlappingAllan: window_samples must be >= 2 (got " +
+    throw std::invalid_argument("the live Allan window needs at least 2 samples (got " +
                                 std::to_string(window_samples) + "): m = 1 needs 2 samples");
   }
   if (cluster_sizes_.empty()) {
-    throw std::invalid_argument("RollingOverlappingAllan: cluster_sizes is empty (need at least one m)");
+    throw std::invalid_argument("the live Allan variance needs at least one averaging factor m; none given");
   }
   for (std::size_t i = 0; i < cluster_sizes_.size(); ++i) {
     const std::size_t m = cluster_sizes_[i];
     if (m == 0) {
-      throw std::invalid_argument("RollingOverlappingAllan: cluster_sizes[" + std::to_string(i) +
-                                  "] = 0; averaging factor m must be >= 1");
+      throw std::invalid_argument("the live Allan variance needs averaging factors m >= 1; number " +
+                                  std::to_string(i + 1) + " is 0");
     }
     if (m > window_samples / 2) {
-      throw std::invalid_argument("RollingOverlappingAllan: cluster_sizes[" + std::to_string(i) +
-                                  "] = " + std::to_string(m) + " is too long for a window of " +
+      throw std::invalid_argument("the live Allan variance's averaging factor m = " + std::to_string(m) + " (number " +
+                                  std::to_string(i + 1) + ") is too long for a window of " +
                                   std::to_string(window_samples) + " samples (need 2*m <= window)");
     }
     if (i > 0 && m <= cluster_sizes_[i - 1]) {
       throw std::invalid_argument(
-          "RollingOverlappingAllan: cluster_sizes must be strictly increasing (m = " + std::to_string(m) +
+          "the live Allan variance needs strictly increasing averaging factors (m = " + std::to_string(m) +
           " at index " + std::to_string(i) + " follows " + std::to_string(cluster_sizes_[i - 1]) + ")");
     }
   }
@@ -179,7 +179,7 @@ double RollingOverlappingAllan::secondDifference(std::size_t back, std::size_t m
 
 void RollingOverlappingAllan::push(double rate) {
   if (!std::isfinite(rate) || std::abs(rate) > kMaxAbsRate) {
-    throw std::invalid_argument("RollingOverlappingAllan::push: rate = " + formatNumber(rate) +
+    throw std::invalid_argument("the live Allan variance cannot take rate " + formatNumber(rate) +
                                 " is not a finite number of magnitude <= 1e100 (sample " +
                                 std::to_string(total_count_) + ")");
   }
@@ -218,21 +218,21 @@ void RollingOverlappingAllan::push(double rate) {
 
 void RollingOverlappingAllan::requireIndex(std::size_t index, const char* where) const {
   if (index >= cluster_sizes_.size()) {
-    throw std::out_of_range(std::string("RollingOverlappingAllan::") + where + ": index " + std::to_string(index) +
+    throw std::out_of_range(std::string("the live Allan variance's ") + where + ": index " + std::to_string(index) +
                             " is not below the number of cluster sizes (" + std::to_string(cluster_sizes_.size()) +
                             ")");
   }
 }
 
 std::size_t RollingOverlappingAllan::windowTerms(std::size_t index) const {
-  requireIndex(index, "windowTerms");
+  requireIndex(index, "noise terms over the window");
   const std::size_t n = windowCount();
   const std::size_t m = cluster_sizes_[index];
   return 2 * m <= n ? n - 2 * m + 1 : 0;
 }
 
 std::uint64_t RollingOverlappingAllan::sinceStartTerms(std::size_t index) const {
-  requireIndex(index, "sinceStartTerms");
+  requireIndex(index, "noise terms since the start");
   const std::uint64_t m = cluster_sizes_[index];
   return 2 * m <= total_count_ ? total_count_ - 2 * m + 1 : 0;
 }
@@ -260,11 +260,12 @@ std::size_t RollingOverlappingAllan::stateBytes() const {
 
 RollingOverlappingAllan::Snapshot RollingOverlappingAllan::snapshot(double tau0_s, const AllanOptions& options) const {
   if (!(std::isfinite(tau0_s) && tau0_s > 0.0)) {
-    throw std::invalid_argument("RollingOverlappingAllan::snapshot: tau0 must be a finite positive time in s (got " +
-                                formatNumber(tau0_s) + ")");
+    throw std::invalid_argument(
+        "the live Allan table needs a sample interval tau0 that is a finite positive time in s (got " +
+        formatNumber(tau0_s) + ")");
   }
   if (!(options.confidence > 0.0 && options.confidence < 1.0)) {
-    throw std::invalid_argument("RollingOverlappingAllan::snapshot: confidence must be in (0, 1) (got " +
+    throw std::invalid_argument("the live Allan table needs a confidence in (0, 1) (got " +
                                 formatNumber(options.confidence) + ")");
   }
   // The window's rates (minus the reference, which the mean-removed noise identification

@@ -9,11 +9,12 @@ namespace gyrod::processing {
 SampleTimingCheck::SampleTimingCheck(std::optional<double> nominal_dt_s, SampleTimingLimits limits) {
   if (!(limits.gap_factor > 1.0 && std::isfinite(limits.gap_factor)) ||
       !(limits.jitter_tolerance > 0.0 && limits.jitter_tolerance < limits.gap_factor - 1.0))
-    throw std::invalid_argument("SampleTimingCheck: need gap_factor > 1 and 0 < jitter_tolerance < gap_factor - 1");
+    throw std::invalid_argument(
+        "the sample timing check needs a gap factor > 1 and a jitter tolerance between 0 and the gap factor - 1");
   report_.limits = limits;
   if (nominal_dt_s) {
     if (!(std::isfinite(*nominal_dt_s) && *nominal_dt_s > 0.0))
-      throw std::invalid_argument("SampleTimingCheck: the nominal spacing must be finite and > 0");
+      throw std::invalid_argument("the sample timing check needs a nominal sample interval that is finite and > 0");
     report_.nominal_dt_s = *nominal_dt_s;
     report_.nominal_given = true;
     settled_ = true;

@@ -85,7 +85,7 @@ double gyroSensitivityLsbPerDps(int fs_sel) {
 
 std::int16_t quantizeToInt16(double value, double lsb_per_unit) {
   if (!(lsb_per_unit > 0.0) || !std::isfinite(lsb_per_unit))
-    throw std::invalid_argument("quantizeToInt16: lsb_per_unit must be finite and > 0, got " +
+    throw std::invalid_argument("the sensor model needs a scale (LSB per unit) that is finite and > 0, got " +
                                 std::to_string(lsb_per_unit));
   if (std::isnan(value)) return 0;
   const double counts = std::round(value * lsb_per_unit);  // ±inf stays ±inf

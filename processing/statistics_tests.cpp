@@ -18,7 +18,7 @@ constexpr double kNormalCritical5Percent = 1.96;
 void requireFinite(std::span<const double> x, const char* who) {
   for (std::size_t i = 0; i < x.size(); ++i) {
     if (!std::isfinite(x[i]))
-      throw std::invalid_argument(std::string(who) + ": sample " + std::to_string(i) + " is not finite");
+      throw std::invalid_argument(std::string(who) + " cannot use sample " + std::to_string(i) + ": it is not finite");
   }
 }
 
@@ -68,8 +68,8 @@ class EqualCellIndex {
 
 ZeroMeanTest zeroMeanTest(std::span<const double> x) {
   if (x.size() < 2)
-    throw std::invalid_argument("zeroMeanTest: need at least 2 samples, got " + std::to_string(x.size()));
-  requireFinite(x, "zeroMeanTest");
+    throw std::invalid_argument("the zero-mean test needs at least 2 samples, got " + std::to_string(x.size()));
+  requireFinite(x, "the zero-mean test");
   const double n = static_cast<double>(x.size());
   ZeroMeanTest t;
   t.mean = meanOf(x);
@@ -97,10 +97,10 @@ std::size_t countReverseArrangements(std::span<const double> v) {
 
 ReverseArrangementsTest reverseArrangementsTestOfSequence(std::span<const double> v) {
   if (v.size() < kMinReverseArrangementsSegments)
-    throw std::invalid_argument("reverseArrangementsTest: need at least " +
+    throw std::invalid_argument("the reverse arrangements test needs at least " +
                                 std::to_string(kMinReverseArrangementsSegments) + " values, got " +
                                 std::to_string(v.size()));
-  requireFinite(v, "reverseArrangementsTest");
+  requireFinite(v, "the reverse arrangements test");
   const double n = static_cast<double>(v.size());
   ReverseArrangementsTest t;
   t.segments = v.size();
@@ -116,12 +116,13 @@ ReverseArrangementsTest reverseArrangementsTestOfSequence(std::span<const double
 ReverseArrangementsTest reverseArrangementsTest(std::span<const double> x, std::size_t segments,
                                                 SegmentStatistic statistic) {
   if (segments < kMinReverseArrangementsSegments)
-    throw std::invalid_argument("reverseArrangementsTest: segments must be >= " +
-                                std::to_string(kMinReverseArrangementsSegments) + ", got " + std::to_string(segments));
+    throw std::invalid_argument("the reverse arrangements test needs at least " +
+                                std::to_string(kMinReverseArrangementsSegments) + " segments, got " +
+                                std::to_string(segments));
   if (x.size() < segments)
-    throw std::invalid_argument("reverseArrangementsTest: " + std::to_string(x.size()) + " samples cannot fill " +
-                                std::to_string(segments) + " segments");
-  requireFinite(x, "reverseArrangementsTest");
+    throw std::invalid_argument("the reverse arrangements test cannot fill " + std::to_string(segments) +
+                                " segments with " + std::to_string(x.size()) + " samples");
+  requireFinite(x, "the reverse arrangements test");
   // Bendat & Piersol apply the test to the mean-square values of equal-length segments of a
   // record they take as zero-mean. The paper ran it on raw data whose mean (1.367) dwarfs the
   // fluctuations, where a plain mean square would be almost entirely the constant mean². The
@@ -151,8 +152,8 @@ ChiSquareNormalityTest chiSquareNormalityTest(std::span<const double> x, std::si
   constexpr std::size_t kMinBins = 4;  // dof = bins − 3 ≥ 1
   const std::size_t n = x.size();
   if (n < 5 * kMinExpectedPerBin)
-    throw std::invalid_argument("chiSquareNormalityTest: need at least 25 samples, got " + std::to_string(n));
-  requireFinite(x, "chiSquareNormalityTest");
+    throw std::invalid_argument("the chi-square normality test needs at least 25 samples, got " + std::to_string(n));
+  requireFinite(x, "the chi-square normality test");
   const std::size_t max_bins = n / kMinExpectedPerBin;
   if (bins == 0) {
     // Moore (1986): about 2·n^(2/5) equiprobable classes; bounded so that the test keeps
@@ -161,8 +162,8 @@ ChiSquareNormalityTest chiSquareNormalityTest(std::span<const double> x, std::si
     bins = std::clamp<std::size_t>(moore, 5, 100);
     bins = std::min(bins, max_bins);
   } else if (bins < kMinBins || bins > max_bins) {
-    throw std::invalid_argument("chiSquareNormalityTest: bins = " + std::to_string(bins) + " must be in [" +
-                                std::to_string(kMinBins) + ", n/5 = " + std::to_string(max_bins) + "]");
+    throw std::invalid_argument("the chi-square normality test needs a number of bins in [" + std::to_string(kMinBins) +
+                                ", n/5 = " + std::to_string(max_bins) + "], got " + std::to_string(bins));
   }
 
   // Maximum-likelihood estimates (divisor n), the usual choice for the χ² test with
@@ -171,7 +172,10 @@ ChiSquareNormalityTest chiSquareNormalityTest(std::span<const double> x, std::si
   double ss = 0.0;
   for (double v : x) ss += (v - mean) * (v - mean);
   const double sd = std::sqrt(ss / static_cast<double>(n));
-  if (!(sd > 0.0)) throw std::invalid_argument("chiSquareNormalityTest: the samples have zero variance");
+  if (!(sd > 0.0))
+    throw std::invalid_argument(
+        "the chi-square normality test needs samples that vary; these are constant (every value " +
+        std::to_string(mean) + ")");
 
   // Inner class boundaries mean + sd·Φ⁻¹(k/bins), k = 1..bins−1; each class has probability 1/bins.
   std::vector<double> edges(bins - 1);

@@ -337,7 +337,8 @@ SimulationModel comparisonSensor() {
 
 StreamComparison compareStreams(const StreamComparisonSetup& setup) {
   if (setup.rate.rate_hz != setup.sensor.rate_hz)
-    throw std::invalid_argument("compareStreams: the rate model is for a different rate than the sensor");
+    throw std::invalid_argument(
+        "the stream comparison cannot run: the rate model is for a different sample rate than the sensor");
   StreamComparison out;
   out.paper = identifyPaperChain(setup);
   measureSteps(setup, out.paper, out);

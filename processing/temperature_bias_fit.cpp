@@ -94,21 +94,26 @@ WeightedFit weightedLeastSquares(const Eigen::MatrixXd& x, const Eigen::VectorXd
 TemperatureBiasFit fitTemperatureBias(std::span<const double> secs, std::span<const double> rate_dps,
                                       std::span<const double> temp_c, double block_s) {
   if (secs.size() != rate_dps.size() || secs.size() != temp_c.size())
-    throw std::invalid_argument("fitTemperatureBias: times, rates and temperatures differ in length");
+    throw std::invalid_argument("the temperature bias fit needs as many times as rates and temperatures; there are " +
+                                std::to_string(secs.size()) + " times, " + std::to_string(rate_dps.size()) +
+                                " rates and " + std::to_string(temp_c.size()) + " temperatures");
   if (!(std::isfinite(block_s) && block_s > 0.0))
-    throw std::invalid_argument("fitTemperatureBias: block_s must be > 0");
+    throw std::invalid_argument("the temperature bias fit needs a block length > 0 s, got " + std::to_string(block_s));
   for (std::size_t i = 0; i < secs.size(); ++i) {
     if (!std::isfinite(secs[i]) || !std::isfinite(rate_dps[i]) || !std::isfinite(temp_c[i]))
-      throw std::invalid_argument("fitTemperatureBias: sample " + std::to_string(i) + " is not finite");
+      throw std::invalid_argument("the temperature bias fit cannot use sample " + std::to_string(i) +
+                                  ": it is not finite");
     if (i > 0 && secs[i] < secs[i - 1])
-      throw std::invalid_argument("fitTemperatureBias: time decreases at sample " + std::to_string(i));
+      throw std::invalid_argument(
+          "the temperature bias fit needs times that do not decrease; the time decreases at sample " +
+          std::to_string(i));
   }
   constexpr std::size_t kMinimumBlocks = 8;
   const Blocks b = secs.empty() ? Blocks{} : blockMeans(secs, rate_dps, temp_c, block_s);
   const std::size_t nb = b.t.size();
   if (nb < kMinimumBlocks)
-    throw std::invalid_argument("fitTemperatureBias: " + std::to_string(nb) + " blocks of " + std::to_string(block_s) +
-                                " s, need at least " + std::to_string(kMinimumBlocks));
+    throw std::invalid_argument("the temperature bias fit has " + std::to_string(nb) + " blocks of " +
+                                std::to_string(block_s) + " s, need at least " + std::to_string(kMinimumBlocks));
   const auto rows = static_cast<Eigen::Index>(nb);
   const Eigen::Map<const Eigen::VectorXd> y(b.rate.data(), rows), w(b.weight.data(), rows), temp(b.temp.data(), rows);
   TemperatureBiasFit out;

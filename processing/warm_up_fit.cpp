@@ -14,12 +14,12 @@ namespace gyrod::processing {
 
 TemperatureModel fitExponentialWarmUp(std::span<const double> secs, std::span<const double> temp) {
   if (secs.size() != temp.size() || temp.size() < 2)
-    throw std::invalid_argument("fitExponentialWarmUp: need at least 2 samples with a time each, got " +
+    throw std::invalid_argument("the warm-up fit needs at least 2 samples with a time each, got " +
                                 std::to_string(temp.size()) + " temperatures and " + std::to_string(secs.size()) +
                                 " times");
   for (std::size_t i = 0; i < temp.size(); ++i)
     if (!std::isfinite(temp[i]) || !std::isfinite(secs[i]))
-      throw std::invalid_argument("fitExponentialWarmUp: sample " + std::to_string(i) + " is not finite");
+      throw std::invalid_argument("the warm-up fit cannot use sample " + std::to_string(i) + ": it is not finite");
   TemperatureModel m;
   const std::size_t n = temp.size();
   long double sum = 0.0L;

@@ -57,24 +57,25 @@ ReplaySource::ReplaySource(std::vector<double> x_dps, std::vector<double> y_dps,
       temperature_(std::move(temperature_c)),
       tick_rate_hz_(tick_rate_hz),
       at_end_(at_end) {
-  if (x_.empty()) throw std::invalid_argument("ReplaySource: x_dps is empty");
+  if (x_.empty()) throw std::invalid_argument("the replayed signal has no x values");
   const auto check_length = [&](const std::vector<double>& v, const char* name) {
     if (v.size() != x_.size()) {
-      throw std::invalid_argument(std::string("ReplaySource: ") + name + " has " + std::to_string(v.size()) +
-                                  " values but x_dps has " + std::to_string(x_.size()));
+      throw std::invalid_argument(std::string("the replayed signal has ") + std::to_string(v.size()) + " " + name +
+                                  " values but " + std::to_string(x_.size()) + " x values");
     }
   };
   check_length(y_, "y_dps");
   check_length(z_, "z_dps");
   check_length(temperature_, "temperature_c");
   if (!(tick_rate_hz > 0.0) || !std::isfinite(tick_rate_hz)) {
-    throw std::invalid_argument("ReplaySource: tick_rate_hz must be finite and > 0, got " +
+    throw std::invalid_argument("the replayed signal needs a tick rate that is finite and > 0 Hz, got " +
                                 std::to_string(tick_rate_hz));
   }
   const auto check_finite = [](const std::vector<double>& v, const char* name) {
     for (std::size_t i = 0; i < v.size(); ++i) {
       if (!std::isfinite(v[i])) {
-        throw std::invalid_argument(std::string("ReplaySource: ") + name + "[" + std::to_string(i) + "] is not finite");
+        throw std::invalid_argument(std::string("the replayed signal's ") + name + " value " + std::to_string(i) +
+                                    " is not finite");
       }
     }
   };

@@ -9,7 +9,8 @@ namespace gyrod::driver {
 
 namespace {
 processing::SimulationModel modelAtInternalRate(processing::SimulationModel model, int dlpf_cfg) {
-  if (dlpf_cfg < 0 || dlpf_cfg > 7) throw std::invalid_argument("SimulatorSignalSource: DLPF_CFG must be 0..7");
+  if (dlpf_cfg < 0 || dlpf_cfg > 7)
+    throw std::invalid_argument("the simulated sensor needs DLPF_CFG 0..7, got " + std::to_string(dlpf_cfg));
   // The simulator's analog stream runs at the internal rate of its DLPF setting; with the
   // output rate set to that same rate, nextAnalog() delivers exactly one value per tick.
   // DLPF_CFG 7 ticks at 8 kHz like 0.

@@ -138,12 +138,13 @@ TEST_F(GyroctlTest, WatchShowsRawAndKalmanPerAxisAndGaps) {
   const CommandResult r = run({"watch", "--socket", socketPath(), "--count", "3", "--decimate", "2"});
   ASSERT_EQ(r.exit_status, 0) << r.err;
   const auto lines = splitLines(r.out);
-  ASSERT_EQ(lines.size(), 5u) << r.out;  // header, row, gap, row, row
+  ASSERT_EQ(lines.size(), 6u) << r.out;  // header, t legend, row, gap, row, row
   const auto header = words(lines[0]);
   EXPECT_EQ(header.front(), "seq");
   EXPECT_NE(lines[0].find("kalman z"), std::string::npos);
-  EXPECT_EQ(lines[2], "--- gap: 2 sample(s) missing from seq 1002 (fifo_overflow)");
-  const std::size_t rows[] = {1, 3, 4};
+  EXPECT_EQ(lines[1].rfind("t: CLOCK_MONOTONIC", 0), 0u) << lines[1];
+  EXPECT_EQ(lines[3], "--- gap: 2 sample(s) missing from seq 1002 (fifo_overflow)");
+  const std::size_t rows[] = {2, 4, 5};
   for (std::size_t i = 0; i < 3; ++i) {
     const protocol::RateSample s = syntheticSample(2 * i);  // decimate 2: samples 0, 2, 4
     const auto w = words(lines[rows[i]]);
@@ -174,19 +175,19 @@ TEST_F(GyroctlTest, WatchShowsRateFirstThenRawAndKalmanAndStillWhenGyrodSendsRat
   const CommandResult r = run({"watch", "--socket", socketPath(), "--count", "2"});
   ASSERT_EQ(r.exit_status, 0) << r.err;
   const auto lines = splitLines(r.out);
-  ASSERT_EQ(lines.size(), 3u) << r.out;
+  ASSERT_EQ(lines.size(), 4u) << r.out;  // header, t legend, row, row
   EXPECT_LT(lines[0].find("rate x"), lines[0].find("raw x")) << lines[0];
   EXPECT_LT(lines[0].find("raw z"), lines[0].find("kalman x")) << lines[0];
   EXPECT_NE(lines[0].find("still"), std::string::npos) << lines[0];
   for (std::size_t i = 0; i < 2; ++i) {
     const protocol::RateSample s = withRate(i);
-    const auto w = words(lines[1 + i]);
-    ASSERT_EQ(w.size(), 12u) << lines[1 + i];
+    const auto w = words(lines[2 + i]);
+    ASSERT_EQ(w.size(), 12u) << lines[2 + i];
     EXPECT_EQ(w[0], std::to_string(s.seq));
     for (std::size_t a = 0; a < 3; ++a) {
-      EXPECT_EQ(w[2 + a], fixed(s.rate_dps[a], 5)) << lines[1 + i];
-      EXPECT_EQ(w[5 + a], fixed(s.raw_dps[a], 5)) << lines[1 + i];
-      EXPECT_EQ(w[8 + a], fixed(s.kalman_dps[a], 5)) << lines[1 + i];
+      EXPECT_EQ(w[2 + a], fixed(s.rate_dps[a], 5)) << lines[2 + i];
+      EXPECT_EQ(w[5 + a], fixed(s.raw_dps[a], 5)) << lines[2 + i];
+      EXPECT_EQ(w[8 + a], fixed(s.kalman_dps[a], 5)) << lines[2 + i];
     }
     EXPECT_EQ(w[11], i % 2 == 0 ? "yes" : "no");
   }
@@ -208,11 +209,12 @@ TEST_F(GyroctlTest, WatchHeaderSaysWhatTIsAndMapsItToUtc) {
   const CommandResult r = run({"watch", "--socket", socketPath(), "--count", "1"});
   ASSERT_EQ(r.exit_status, 0) << r.err;
   const auto lines = splitLines(r.out);
-  ASSERT_EQ(lines.size(), 2u) << r.out;
-  EXPECT_NE(lines[0].find("t: CLOCK_MONOTONIC s of the data-ready edge; time: UTC, t 12345.678 = "
-                          "2026-11-18T11:06:40.250000Z"),
-            std::string::npos)
-      << lines[0];
+  ASSERT_EQ(lines.size(), 3u) << r.out;  // header, t legend, row
+  // The legend has a line of its own, so that the column header stays as wide as the columns.
+  EXPECT_EQ(lines[0].substr(lines[0].size() - 7), "[deg/s]") << lines[0];
+  EXPECT_EQ(lines[1],
+            "t: CLOCK_MONOTONIC s of the data-ready edge; time: UTC, t 12345.678 = "
+            "2026-11-18T11:06:40.250000Z");
 }
 
 TEST_F(GyroctlTest, StatusHumanAndJson) {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <fstream>
 #include <random>
+#include <regex>
 #include <sstream>
 #include <tuple>
 #include <vector>
@@ -38,7 +39,39 @@ void expectOneLineError(const gyrod::test::CommandResult& r, const std::string& 
   EXPECT_TRUE(r.out.empty()) << r.out;
 }
 
+// A name only a programmer knows, at the start of a message part: a camelCase or CamelCase
+// identifier (yuleWalker, EventLoop), a qualified name (portable::log) or a call (f()), then ": ".
+bool hasInternalName(const std::string& text) {
+  static const std::regex name(
+      R"(\b([a-z][a-z0-9_]*[A-Z]\w*|[A-Z][a-z0-9_]+[A-Z]\w*|[A-Za-z_]\w*(::\w+)+)(\(\))?: |\w\(\): )");
+  return std::regex_search(text, name);
+}
+
 }  // namespace
+
+TEST(GyroctlErrors, TheInternalNameCheckFindsNamesAndPassesWords) {
+  EXPECT_TRUE(hasInternalName("gyroctl: yuleWalker: the series has zero variance"));
+  EXPECT_TRUE(hasInternalName("x.csv: column 'gx': RollingOverlappingAllan::push: rate"));
+  EXPECT_TRUE(hasInternalName("EventLoop: empty callback"));
+  EXPECT_TRUE(hasInternalName("parse(): bad"));
+  EXPECT_FALSE(hasInternalName("gyroctl: x.csv: column 'gx': the AR model fit needs a series that varies"));
+  EXPECT_FALSE(hasInternalName("SIGHUP: keeping the running filter: /tmp/a.toml:8: key 'filter.model': "));
+}
+
+// A constant signal (a sensor stuck at one value) cannot be analysed: the message names the
+// file, the column, the computation in a user's words and the value, and the exit status is 65.
+TEST(GyroctlErrors, AConstantSignalIsRefusedInAUsersWords) {
+  ScratchDir d;
+  std::string text = "t,gx\n";
+  for (int i = 0; i < 500; ++i) text += std::to_string(i * 0.02) + ",0.0123\n";
+  const auto constant = d.write("stuck.csv", text);
+  for (const std::string json : {"", " --json"}) {
+    const auto r = runGyroctl("analyze " + constant.string() + json, d.path());
+    expectOneLineError(r, constant.string() + ": column 'gx': ");
+    EXPECT_NE(r.err.find("constant"), std::string::npos) << r.err;
+    EXPECT_FALSE(hasInternalName(r.err)) << r.err;
+  }
+}
 
 TEST(GyroctlErrors, MissingFile) {
   ScratchDir d;

@@ -43,8 +43,7 @@ AxisAnalysis analyzeColumn(recording::Recording& rec, std::size_t axis_index, co
     if (keep) return analyzeAxis(std::span<const double>(rec.axes[axis_index]), options);
     return analyzeAxis(std::move(rec.axes[axis_index]), options);
   } catch (const std::invalid_argument& e) {
-    throw recording::RecordingError(rec.path + ": column '" + rec.axis_names[axis_index] +
-                                    "': " + withoutFunctionName(e.what()));
+    throw recording::RecordingError(rec.path + ": column '" + rec.axis_names[axis_index] + "': " + e.what());
   }
 }
 
@@ -287,7 +286,7 @@ void calibrateAxisInto(recording::SensorModel& sensor, std::size_t slot, const s
   try {
     c = recording::calibrateAxis(secs, rec.axes[idx], rec.temp);
   } catch (const std::invalid_argument& e) {
-    notes.push_back(name + ": no calibration (" + withoutFunctionName(e.what()) + ")");
+    notes.push_back(name + ": no calibration (" + e.what() + ")");
     return;
   }
   sensor.calibration[slot] = c.calibration;

@@ -50,10 +50,10 @@ struct WatchOptions {
   std::optional<std::uint64_t> count;
 };
 
-// What `t` is, at the end of the header: the clock, and the UTC time (RATE "time") of the
-// sample the header is printed for, so the two can be lined up.
+// What `t` is, on its own line under the column header: the clock, and the UTC time (RATE
+// "time") of the sample the header is printed for, so the two can be lined up.
 std::string timeLegend(const protocol::RateSample& r) {
-  std::string legend = "  t: CLOCK_MONOTONIC s of the data-ready edge; time: UTC";
+  std::string legend = "t: CLOCK_MONOTONIC s of the data-ready edge; time: UTC";
   if (!std::isfinite(r.time_s) || !std::isfinite(r.t_s)) return legend + " (not sent by this gyrod)";
   const auto us = static_cast<std::int64_t>(std::llround(r.time_s * 1e6));
   const auto seconds = us / 1'000'000 - (us % 1'000'000 < 0 ? 1 : 0);
@@ -70,15 +70,14 @@ std::string timeLegend(const protocol::RateSample& r) {
 // the paper's kalman, then the still detector, with a new header where the switch happens;
 // until then (an older gyrod, or gyrod still estimating its start-up bias) raw and kalman.
 void printRateHeader(bool with_rate, const protocol::RateSample& first) {
-  const std::string legend = timeLegend(first);
   if (with_rate) {
-    std::printf("%10s %12s  %10s %10s %10s  %10s %10s %10s  %10s %10s %10s %6s  [deg/s]%s\n", "seq", "t [s]", "rate x",
-                "rate y", "rate z", "raw x", "raw y", "raw z", "kalman x", "kalman y", "kalman z", "still",
-                legend.c_str());
-    return;
+    std::printf("%10s %12s  %10s %10s %10s  %10s %10s %10s  %10s %10s %10s %6s  [deg/s]\n", "seq", "t [s]", "rate x",
+                "rate y", "rate z", "raw x", "raw y", "raw z", "kalman x", "kalman y", "kalman z", "still");
+  } else {
+    std::printf("%10s %12s  %10s %10s %10s  %10s %10s %10s  [deg/s]\n", "seq", "t [s]", "raw x", "raw y", "raw z",
+                "kalman x", "kalman y", "kalman z");
   }
-  std::printf("%10s %12s  %10s %10s %10s  %10s %10s %10s  [deg/s]%s\n", "seq", "t [s]", "raw x", "raw y", "raw z",
-              "kalman x", "kalman y", "kalman z", legend.c_str());
+  std::printf("%s\n", timeLegend(first).c_str());
 }
 
 // A value the line left out comes back from the parser as NaN and shows as "-".

@@ -148,7 +148,7 @@ int runFilter(const FilterOptions& opt) {
                                            KalmanOverrides{opt.ar_phi, opt.kalman_q, opt.kalman_r}));
     } catch (const std::invalid_argument& e) {
       throw recording::RecordingError(opt.file + ": column '" + rec.axis_names[axis] +
-                                      "': cannot identify the filter: " + withoutFunctionName(e.what()));
+                                      "': cannot identify the filter: " + e.what());
     }
     chain_input.push_back(std::move(x));
   }

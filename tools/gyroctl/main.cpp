@@ -1,7 +1,6 @@
 // gyroctl: offline analysis of gyro recordings and the gyrod client.
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <cctype>
 #include <exception>
 #include <iostream>
 #include <optional>
@@ -50,27 +49,10 @@ std::optional<std::string> unknownCommandMessage(CLI::App& app, int argc, char**
   return std::nullopt;
 }
 
-// A message from the library may start with the function that threw it ("fitLinearTrend: ",
-// "RollingOverlappingAllan::push: "): a name for a programmer, not for the person reading.
-// Only such names are removed: a camelCase word or a qualified name before ": ".
-std::string withoutInternalName(const std::string& message) {
-  const auto colon = message.find(": ");
-  if (colon == std::string::npos || colon == 0) return message;
-  const std::string prefix = message.substr(0, colon);
-  bool identifier = true, camel = false;
-  for (std::size_t i = 0; i < prefix.size(); ++i) {
-    const unsigned char c = static_cast<unsigned char>(prefix[i]);
-    identifier = identifier && (std::isalnum(c) || c == '_' || c == ':');
-    camel = camel || (i > 0 && std::isupper(c) && std::islower(static_cast<unsigned char>(prefix[i - 1])));
-  }
-  const bool internal = identifier && (camel || prefix.find("::") != std::string::npos);
-  return internal ? message.substr(colon + 2) : message;
-}
-
 // Prints the error in flight and returns its exit status (tools/gyroctl/exit_codes.hpp).
 int reportError() {
   auto fail = [](ExitCode code, const std::exception& e) {
-    std::cerr << "gyroctl: " << withoutInternalName(e.what()) << '\n';
+    std::cerr << "gyroctl: " << e.what() << '\n';
     return toInt(code);
   };
   try {

@@ -485,7 +485,7 @@ std::string extendedModelToml(const ModelCheckCliOptions& opt, const LoadedInput
     try {
       sensor.calibration[*slot] = recording::calibrateAxis(secs, rec.axes[in.axis_indices[k]], rec.temp).calibration;
     } catch (const std::invalid_argument& e) {
-      notes.push_back(name + ": no calibration (" + withoutFunctionName(e.what()) + ")");
+      notes.push_back(name + ": no calibration (" + e.what() + ")");
     }
   }
   validateSimulationModel(model);
@@ -529,8 +529,7 @@ int runModelCheck(const ModelCheckCliOptions& opt) {
     try {
       results.emplace_back(rec.axis_names[idx], checkAxisModel(axis, options));
     } catch (const std::invalid_argument& e) {
-      throw recording::RecordingError(opt.file + ": column '" + rec.axis_names[idx] +
-                                      "': " + withoutFunctionName(e.what()));
+      throw recording::RecordingError(opt.file + ": column '" + rec.axis_names[idx] + "': " + e.what());
     }
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -1,6 +1,5 @@
 #include "tools/gyroctl/series_checks.hpp"
 
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -56,16 +55,6 @@ void requireAnalysableValues(const recording::Recording& rec, std::size_t axis_i
       << " deg/s, more than any gyro measures (the statistics would overflow)";
     throw recording::RecordingError(s.str());
   }
-}
-
-std::string withoutFunctionName(const std::string& message) {
-  const auto colon = message.find(": ");
-  if (colon == std::string::npos || colon == 0) return message;
-  for (std::size_t i = 0; i < colon; ++i) {
-    const char c = message[i];
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == ':')) return message;
-  }
-  return message.substr(colon + 2);
 }
 
 TimingSummary checkTiming(const recording::Recording& rec, std::optional<double> rate_hz) {

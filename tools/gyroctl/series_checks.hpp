@@ -1,7 +1,6 @@
 #pragma once
 // Checks of a loaded recording that analyze, filter and model-check share: values the
-// statistics can carry, the series' timing (gaps, jitter, the GAP and DROPPED records), and
-// processing's messages turned into ones that name the file and the column.
+// statistics can carry and the series' timing (gaps, jitter, the GAP and DROPPED records).
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -19,10 +18,6 @@ inline constexpr double kLargestAnalysableRateDps = 1e12;
 
 // Throws RecordingError naming FILE:LINE and the column for a value beyond kLargestAnalysableRateDps.
 void requireAnalysableValues(const recording::Recording& rec, std::size_t axis_index);
-
-// A processing function's std::invalid_argument begins with its own name ("yuleWalker: ..."),
-// which means nothing to a user: this drops it, so that the tool can name file and column instead.
-std::string withoutFunctionName(const std::string& message);
 
 // The timing of a recording: its t column through processing::SampleTimingCheck and its
 // "# GAP" / "# DROPPED" records.
