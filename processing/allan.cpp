@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <iomanip>
 #include <limits>
 #include <memory>
@@ -82,8 +83,8 @@ class IntegratedPhase {
   IntegratedPhase(std::span<const double> rate, double mean)
       : rate_count_(rate.size()),
         mean_(mean),
-        hi_(std::make_unique_for_overwrite<double[]>(rate.size() + 1)),
-        lo_(std::make_unique_for_overwrite<float[]>(rate.size() + 1)) {
+        hi_(allan_kernels::allocatePhaseStorage<double>(rate.size() + 1)),
+        lo_(allan_kernels::allocatePhaseStorage<float>(rate.size() + 1)) {
     allan_kernels::integratePhase(rate.data(), rate.size(), mean_, hi_.get(), lo_.get());
   }
 
@@ -194,8 +195,8 @@ class IntegratedPhase {
   double mean_;
   // Written once in full by the constructor: not zero-filled first (one pass less over
   // 12 bytes a point).
-  std::unique_ptr<double[]> hi_;
-  std::unique_ptr<float[]> lo_;
+  allan_kernels::PhaseStorage<double> hi_;
+  allan_kernels::PhaseStorage<float> lo_;
 };
 
 // Lag-1 autocorrelation r1 = Σ (z_i − z̄)(z_{i+1} − z̄) / Σ (z_i − z̄)² and the spread

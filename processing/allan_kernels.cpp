@@ -1,10 +1,16 @@
 #include "processing/allan_kernels.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstring>
+#include <new>
 #include <vector>
 
 #include "processing/parallel_share.hpp"
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 // One clone per ISA where the compiler can dispatch at load time (x86-64 ELF); elsewhere
 // (arm64, armhf, sanitizer builds that lack ifunc) the one portable build.
@@ -198,6 +204,23 @@ void integratePhase(const double* rate, std::size_t count, double mean, double* 
   forEachRunGroup(rate, count, mean, totals, nullptr, nullptr);
   for (std::size_t r = 1; r < runs; ++r) starts[r] = doubleDoubleSum(starts[r - 1], totals[r - 1]);
   forEachRunGroup(rate, count, mean, starts, hi + 1, lo + 1);
+}
+
+void* allocatePhaseBytes(std::size_t bytes) {
+  constexpr std::size_t kHugePage = std::size_t{2} << 20;
+  bytes = std::max<std::size_t>(bytes, 1);
+  if (bytes < 2 * kHugePage) {
+    void* p = std::malloc(bytes);
+    if (p == nullptr) throw std::bad_alloc();
+    return p;
+  }
+  const std::size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+  void* p = std::aligned_alloc(kHugePage, rounded);
+  if (p == nullptr) throw std::bad_alloc();
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  madvise(p, rounded, MADV_HUGEPAGE);  // a hint: where it is refused, ordinary pages serve
+#endif
+  return p;
 }
 
 }  // namespace gyrod::processing::allan_kernels

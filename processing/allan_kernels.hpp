@@ -7,6 +7,8 @@
 // contracts nothing, and the AVX2 clone does not enable FMA), so every path gives the same
 // bits: the ISA changes the speed, never a result.
 #include <cstddef>
+#include <cstdlib>
+#include <memory>
 
 namespace gyrod::processing::allan_kernels {
 
@@ -28,5 +30,23 @@ double overlappingBlockTotal(const double* hi, const float* lo, std::size_t m, s
 // double-double additions (~ε²·|x| each, far below the float lo's 2⁻⁷⁷·|x|).
 inline constexpr std::size_t kPhaseRun = std::size_t{1} << 13;
 void integratePhase(const double* rate, std::size_t count, double mean, double* hi, float* lo);
+
+// Storage for a phase array, written once in full by its owner (not zero-filled). Blocks of
+// 4 MB or more are aligned to 2 MiB and, on Linux, marked for transparent huge pages: a
+// 10⁷-sample phase (120 MB) otherwise costs ~30 000 page faults on first touch, each clearing
+// its own page, a sizeable share of the whole sweep. Only the time changes, never a value.
+struct FreeDeleter {
+  void operator()(void* p) const { std::free(p); }
+};
+template <typename T>
+using PhaseStorage = std::unique_ptr<T[], FreeDeleter>;
+
+// `bytes` (at least 1) of uninitialised storage; throws std::bad_alloc when none is left.
+void* allocatePhaseBytes(std::size_t bytes);
+
+template <typename T>
+PhaseStorage<T> allocatePhaseStorage(std::size_t count) {
+  return PhaseStorage<T>(static_cast<T*>(allocatePhaseBytes(count * sizeof(T))));
+}
 
 }  // namespace gyrod::processing::allan_kernels
