@@ -27,6 +27,10 @@ using namespace std::chrono_literals;
 namespace {
 
 constexpr double kMotionStartS = 4.0;
+// With accel the still detector says "moving" until its accel window (250 samples, 5 s) is full
+// (docs/motion.md), so the rest before the turn must last longer to be seen.
+constexpr double kMotionStartWithAccelS = 9.0;
+double motionStartS(bool accel) { return accel ? kMotionStartWithAccelS : kMotionStartS; }
 constexpr double kMotionRateDps = 30.0;
 constexpr std::array<double, 3> kBias = {-3.34, 1.09, -0.5};  // the default mock model's
 constexpr double kModelBiasStdDps = 0.02;
@@ -47,19 +51,20 @@ std::string sensorModel() {
   return m.str();
 }
 
+// accel on (the default): the recording carries ax, ay, az and `gyroctl filter` gives them to the
+// still detector as gyrod does; accel off: neither has any, and the verdict is the gyro's alone.
+// Either way live and offline must be the same bits.
 std::string rateConfig(const std::filesystem::path& dir, const std::filesystem::path& model,
-                       const std::string& extra = "") {
+                       const std::string& extra = "", bool accel = true) {
   std::ostringstream c;
-  // accel off: the offline rate stream (gyroctl filter on the recording) has no accel to give
-  // the still detector, and live and offline must be the same bits.
-  c << "[device]\nbackend = \"mock\"\nrate_hz = 50\naccel = false\n"
+  c << "[device]\nbackend = \"mock\"\nrate_hz = 50\naccel = " << (accel ? "true" : "false") << "\n"
     << "[bias]\nsource = \"config\"\nvalues = [-3.34, 1.09, -0.5]\n"
     << "[filter]\nmodel = \"" << model.string() << "\"\n"
     << "[filter.kalman]\na = 0.9\nq = 0.0001\nr = 0.01\n"
     << "[socket]\npath = \"" << (dir / "gyrod.sock").string() << "\"\n"
     << "[record]\npath = \"" << (dir / "rec.csv").string() << "\"\nflush_interval_s = 0.1\n"
-    << "[mock]\nspeed = 50\nseed = 9\nmotion = \"constant:axis=z,rate=" << kMotionRateDps << ",start=" << kMotionStartS
-    << "\"\n"
+    << "[mock]\nspeed = 50\nseed = 9\nmotion = \"constant:axis=z,rate=" << kMotionRateDps
+    << ",start=" << motionStartS(accel) << "\"\n"
     << extra;
   return c.str();
 }
@@ -134,19 +139,18 @@ std::vector<OfflineRate> offlineRate(const std::string& rec_path, const std::fil
   return out;
 }
 
-}  // namespace
-
-TEST(GyrodRate, RateFollowsTheMotionAndIsTheOfflineRateStreamOfTheRecording) {
+void expectRateFollowsTheMotionAndIsTheOfflineRateStream(bool accel) {
   ScratchDir d;
   const auto model = d.write("sensor.toml", sensorModel());
-  const auto cfg = d.write("gyrod.toml", rateConfig(d.path(), model));
+  const auto cfg = d.write("gyrod.toml", rateConfig(d.path(), model, "", accel));
   GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt");
   LineClient watcher((d.path() / "gyrod.sock").string());
   ASSERT_TRUE(watcher.connected()) << readWholeFile(d.path() / "log.txt");
   ASSERT_TRUE(watcher.readLine());  // VERSION
   ASSERT_TRUE(watcher.send("{\"cmd\":\"watch\"}\n"));
   std::vector<json> rates;
-  while (rates.size() < 600) {  // 12 s of sensor time
+  const std::size_t samples = accel ? 800 : 600;  // 16 or 12 s of sensor time
+  while (rates.size() < samples) {
     const auto line = watcher.readLine(20s);
     ASSERT_TRUE(line.has_value()) << readWholeFile(d.path() / "log.txt");
     json j = json::parse(*line);
@@ -184,8 +188,8 @@ TEST(GyrodRate, RateFollowsTheMotionAndIsTheOfflineRateStreamOfTheRecording) {
   std::size_t still_before = 0, n_before = 0, still_during = 0;
   for (const OfflineRate& r : offline) {
     const double t = r.t;
-    const bool before = t > 1.0 && t < kMotionStartS - 0.5;
-    const bool during = t > kMotionStartS + 1.0;
+    const bool before = t > (accel ? 5.5 : 1.0) && t < motionStartS(accel) - 0.5;
+    const bool during = t > motionStartS(accel) + 1.0;
     for (int a = 0; a < 3; ++a) {
       if (before) rate_still[a].push_back(r.rate[a]);
       if (during) rate_turning[a].push_back(r.rate[a]);
@@ -211,6 +215,16 @@ TEST(GyrodRate, RateFollowsTheMotionAndIsTheOfflineRateStreamOfTheRecording) {
   }
   // The paper's filter, a low-pass of DC gain well below 1 (docs/motion.md), shrinks the turn.
   EXPECT_LT(meanOf(kalman_turning[2]), 0.6 * kMotionRateDps);
+}
+
+}  // namespace
+
+TEST(GyrodRate, RateFollowsTheMotionAndIsTheOfflineRateStreamOfTheRecording) {
+  expectRateFollowsTheMotionAndIsTheOfflineRateStream(true);
+}
+
+TEST(GyrodRate, WithAccelOffRateFollowsTheMotionAndIsTheOfflineRateStreamOfTheRecording) {
+  expectRateFollowsTheMotionAndIsTheOfflineRateStream(false);
 }
 
 TEST(GyrodRate, BadRateLowPassExitsWithExConfigNamingFileLineAndKey) {
@@ -284,10 +298,13 @@ TEST(GyrodRate, RateLowPassWithoutAModelIsAConfigError) {
 // The rate estimator is not restarted at a GAP (b̂ is the model's function of temperature and
 // time plus a residual that does not need contiguous samples), and the recording holds every
 // sample it was fed, in order: the offline stream matches across gaps as well.
-TEST(GyrodRate, TheOfflineRateStreamMatchesAcrossGaps) {
+namespace {
+
+void expectTheOfflineRateStreamMatchesAcrossGaps(bool accel) {
   ScratchDir d;
   const auto model = d.write("sensor.toml", sensorModel());
-  const auto cfg = d.write("gyrod.toml", rateConfig(d.path(), model, "[mock.faults]\nfifo_overflow_at_s = [6, 9]\n"));
+  const auto cfg =
+      d.write("gyrod.toml", rateConfig(d.path(), model, "[mock.faults]\nfifo_overflow_at_s = [6, 9]\n", accel));
   GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt");
   LineClient watcher((d.path() / "gyrod.sock").string());
   ASSERT_TRUE(watcher.connected()) << readWholeFile(d.path() / "log.txt");
@@ -342,6 +359,16 @@ TEST(GyrodRate, TheOfflineRateStreamMatchesAcrossGaps) {
     return l.kind == gyrod::recording::LostSamples::Kind::Gap;
   });
   ASSERT_EQ(static_cast<std::size_t>(gap_lines), gaps.size());
+  // The recording carries the accel exactly when the device gave it (what the offline still detector used).
+  for (const auto& column : recorded.accel_g) EXPECT_EQ(column.size(), accel ? recorded.size() : 0u);
+}
+
+}  // namespace
+
+TEST(GyrodRate, TheOfflineRateStreamMatchesAcrossGaps) { expectTheOfflineRateStreamMatchesAcrossGaps(true); }
+
+TEST(GyrodRate, WithAccelOffTheOfflineRateStreamMatchesAcrossGaps) {
+  expectTheOfflineRateStreamMatchesAcrossGaps(false);
 }
 
 TEST(GyrodRate, AModelFileThatIsNotOneExitsWithExConfigNamingItsLine) {

@@ -1,5 +1,6 @@
 // gyroctl filter: the daemon's per-sample chain, offline: (detrend) → mean filter → Kalman;
 // with --model also the rate stream (raw − b̂(t), processing::RateEstimator).
+#include <algorithm>
 #include <array>
 #include <charconv>
 #include <cmath>
@@ -51,7 +52,9 @@ struct FilterOptions {
 constexpr std::size_t kMinSamplesToIdentify = 100;
 
 // The rate stream of a recording (--model): processing::RateEstimator fed with the raw
-// columns, the t column and the temp column, as gyrod feeds it.
+// columns, the t column, the temp column and, when the file has ax, ay and az, the accel, as
+// gyrod feeds it (observeAccel, then update, per sample: daemon/sample_pipeline.cpp). Without
+// the accel columns the still detector judges by the gyro alone, as gyrod with accel = false.
 class RateColumns {
  public:
   RateColumns(const FilterOptions& opt, const recording::Recording& rec, double rate_hz)
@@ -75,8 +78,10 @@ class RateColumns {
       std::fprintf(stderr, "%s has no temp column: the rate stream takes the model's reference temperature, %g C\n",
                    opt.file.c_str(), fixed_temperature_c_);
     }
+    has_accel_ = std::all_of(rec.accel_g.begin(), rec.accel_g.end(), [&](const auto& c) { return !c.empty(); });
     estimator_.emplace(p);
   }
+  bool usesAccel() const { return has_accel_; }
   static void appendHeader(std::string& out, const recording::Recording& rec) {
     for (const auto& name : rec.axis_names) out += "," + name + "_rate," + name + "_bias";
     out += ",still";
@@ -85,6 +90,7 @@ class RateColumns {
     AngularRate raw{};
     for (std::size_t slot = 0; slot < kMotionAxes; ++slot) raw[slot] = (*columns_[slot])[i];
     const double t = rec_.t.empty() ? static_cast<double>(i) * dt_ : rec_.t[i];
+    if (has_accel_) estimator_->observeAccel({rec_.accel_g[0][i], rec_.accel_g[1][i], rec_.accel_g[2][i]});
     const RateSample s = estimator_->update(t, raw, rec_.temp.empty() ? fixed_temperature_c_ : rec_.temp[i]);
     for (const auto& name : rec_.axis_names) {
       const std::size_t slot = *recording::axisOfColumn(name);
@@ -102,6 +108,7 @@ class RateColumns {
   double dt_;
   std::array<const std::vector<double>*, kMotionAxes> columns_{};
   double fixed_temperature_c_ = 0.0;
+  bool has_accel_ = false;
   std::optional<RateEstimator> estimator_;
 };
 
@@ -187,8 +194,10 @@ int runFilter(const FilterOptions& opt) {
                                                             : " (identified from the file)");
   }
   if (rate_columns)
-    std::fprintf(stderr, "rate stream from %s: %zu of %zu samples still (they updated the residual bias)\n",
-                 opt.model.c_str(), rate_columns->stillSamples(), n);
+    std::fprintf(stderr, "rate stream from %s: %zu of %zu samples still (they updated the residual bias); %s\n",
+                 opt.model.c_str(), rate_columns->stillSamples(), n,
+                 rate_columns->usesAccel() ? "the still detector used the ax, ay, az columns"
+                                           : "no ax, ay, az columns: the still detector judged by the gyro alone");
   std::fprintf(stderr, "wrote %zu samples to %s\n", n, opt.output.c_str());
   return kExitOk;
 }

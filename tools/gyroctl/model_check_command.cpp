@@ -509,6 +509,12 @@ int runModelCheck(const ModelCheckCliOptions& opt) {
   if (!opt.write_model.empty()) requireWritableTarget(opt.write_model, opt.file);
   const LoadedInput in = loadInput(opt.file, opt.rate_hz, opt.axis);
   const auto& rec = in.recording;
+  // The noise model is the gyro's: an accel column is read but not checked, which the user should not have to guess.
+  if (std::any_of(rec.accel_g.begin(), rec.accel_g.end(), [](const auto& c) { return !c.empty(); }))
+    std::fprintf(stderr,
+                 "%s: the accelerometer columns (ax, ay, az) are not checked: the model check analyses the "
+                 "gyro columns only\n",
+                 opt.file.c_str());
   if (rec.size() < kModelCheckMinSamples) {
     std::ostringstream s;
     s << opt.file << ": " << rec.size() << " samples are too few for the model check (need at least "
