@@ -58,6 +58,12 @@ TEST(GyroctlModelCheck, JsonNamesTheHiddenSinusoidOnItsAxisOnly) {
     EXPECT_NEAR(effects[0].at("params").at("freq_hz").get<double>(), g.hidden[0].freq_hz, 0.5 / 300.0);
     EXPECT_NEAR(effects[0].at("params").at("amp_dps").get<double>(), g.hidden[0].amp_dps, 0.1 * g.hidden[0].amp_dps);
     EXPECT_FALSE(effects[0].at("evidence").get<std::string>().empty());
+    // Its stated 95 % interval (docs/model-check.md, "Intervals"): [lo, hi] around the estimate.
+    const auto& amp95 = effects[0].at("params").at("amp_dps_95");
+    ASSERT_EQ(amp95.size(), 2u) << amp95.dump();
+    const double amp = effects[0].at("params").at("amp_dps").get<double>();
+    EXPECT_LT(amp95[0].get<double>(), amp);
+    EXPECT_GT(amp95[1].get<double>(), amp);
   }
 }
 
