@@ -19,11 +19,14 @@ out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 start=$(date +%s)
 printf '%s\n' 6 5 4 0 3 1 2 | xargs -P "$jobs" -I{} sh -c \
-  "$bin --cfg {} --seeds $seeds --duration $duration --replicas 40 --threads 1 --rows-only 1 > $out/{}.txt"
+  "$bin --cfg {} --seeds $seeds --duration $duration --replicas 40 --threads 1 --rows-only 1 > $out/{}.txt" ||
+  echo "model-check-dlpf-fdr: a setting's run failed or was stopped; its row is missing" >&2
 echo "clean ${duration} s-at-50-Hz-length records (same sample count at every rate), $seeds seeds x 3 axes per setting"
 echo
 echo "| DLPF_CFG | rate [Hz] | axes | false discoveries | per axis | 95 % upper bound | effects named |"
 echo "|---|---|---|---|---|---|---|"
-for cfg in 0 1 2 3 4 5 6; do cat "$out/$cfg.txt"; done
+for cfg in 0 1 2 3 4 5 6; do
+  if [ -s "$out/$cfg.txt" ]; then cat "$out/$cfg.txt"; else echo "| $cfg | | | | | | not finished |"; fi
+done
 echo
 echo "wall time $(( $(date +%s) - start )) s"
