@@ -102,6 +102,7 @@ HiddenEffect HiddenEffectGenerator::drawEffect(ModelEffect e, double duration_s,
       h.count = integer(outlier_count_lo, outlier_count_hi);
       extra.outlier_count += h.count;
       extra.outlier_amplitude_dps = uniform(outlier_size_lo, outlier_size_hi) * white_std[h.axis];
+      h.amp_dps = extra.outlier_amplitude_dps;  // the size of every spike (the coverage bench checks it)
       break;
     case ModelEffect::SampleGaps:
       h.count = integer(1, 5);

@@ -26,7 +26,7 @@ struct HiddenEffect {
   ModelEffect effect = ModelEffect::Unexplained;
   std::size_t axis = 0;  // 0..2 (sample_gaps: all axes)
   double k_dps_per_c = 0.0;
-  double freq_hz = 0.0, amp_dps = 0.0;
+  double freq_hz = 0.0, amp_dps = 0.0;  // sinusoid; outliers: amp_dps the size of each spike
   double tau_s = 0.0, sigma_dps = 0.0;
   std::vector<double> times_s, sizes_dps;  // bias steps
   std::size_t count = 0;                   // steps, outliers, gaps

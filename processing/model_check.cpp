@@ -119,7 +119,7 @@ void refitThroughChain(std::span<const double> xc, const Context& c, bool determ
   for (const AllanPoint& p : clean_curve) variance.push_back(p.oadev * p.oadev);
   NoiseTerms terms = gm.clean_fit.value;
   for (int pass = 0; pass < 4; ++pass) {
-    const std::vector<double> corrected = chainCorrectedVariances(variance, c, whiteCoefficientOf(terms));
+    const std::vector<double> corrected = chainCorrectedVariances(variance, c, terms);
     const std::vector<double> t_fixed{gm.fit.tau_s};
     const GaussMarkovCurveFit refit = fitGaussMarkovToAllan(c.taus, corrected, c.edf, t_fixed);
     terms = refit.terms_with_gm;

@@ -81,6 +81,17 @@ struct EffectEvidence {
   bool operator==(const EffectEvidence&) const = default;
 };
 
+// A stated 95 % interval of a parameter (docs/model-check.md, "Intervals"): from the
+// extended model's replicas (a parametric bootstrap under the fitted coloured noise), or
+// exact for a count. `stated` false: none (the effect has no such parameter, or too few
+// replicas had it).
+struct ParameterInterval {
+  bool stated = false;
+  double lo = 0.0, hi = 0.0;
+  bool contains(double v) const { return stated && v >= lo && v <= hi; }
+  bool operator==(const ParameterInterval&) const = default;
+};
+
 struct DetectedEffect {
   ModelEffect effect = ModelEffect::Unexplained;
   // Parameters; only those of `effect` are meaningful.
@@ -95,6 +106,13 @@ struct DetectedEffect {
   double outlier_median_amplitude_dps = 0.0;  // outliers: median |excursion|
   double where_lo = 0.0, where_hi = 0.0;      // unexplained: τ range [s] (Allan)
   EffectEvidence evidence;                    // statistic, value, threshold
+  // 95 % intervals of the parameters above (only those of `effect` are stated).
+  ParameterInterval k_interval;                    // temperature_bias
+  ParameterInterval amp_interval;                  // sinusoid
+  ParameterInterval tau_interval, sigma_interval;  // gauss_markov
+  std::vector<ParameterInterval> size_intervals;   // bias_steps, one per step
+  ParameterInterval count_interval;                // outliers
+  ParameterInterval outlier_amplitude_interval;    // outliers (of the median excursion)
   // false: seen (its statistic fired) but not explained: the extended model with it did not
   // gain out of sample (AxisModelCheck::verdict says which measures).
   bool explained = true;
@@ -213,11 +231,16 @@ std::vector<double> chainWhiteNoiseShape(const AcquisitionChain& chain, double r
 struct DlpfCandidate {
   std::optional<int> dlpf_cfg;
   double chi2 = 0.0;
+  // Axes on which this DLPF fits clearly better than none on its own (χ² at most 0.8 of
+  // none's): a line or a bump on one axis can lower the summed χ² of a roll-off it does not
+  // have (seen: a 1.7 Hz sinusoid on one of three white-noise axes chose DLPF_CFG 5).
+  std::size_t axes_preferring = 0;
 };
 std::vector<DlpfCandidate> dlpfCandidates(double rate_hz);
 void scoreDlpfCandidates(std::span<const double> rate_dps, double rate_hz, std::vector<DlpfCandidate>& candidates);
 // The estimate from candidates scored on `axes_scored` axes: the best DLPF when it fits
-// clearly better than none (χ² at most 0.8 of none's, and lower by more than 3 per axis), else none.
+// clearly better than none (χ² at most 0.8 of none's, and lower by more than 3 per axis) and
+// is preferred on at least half the axes, else none.
 std::optional<int> chooseDlpf(const std::vector<DlpfCandidate>& scored, std::size_t axes_scored);
 
 // ---- parts, public for the tests and the report ---------------------------------------

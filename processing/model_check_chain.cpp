@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 
 #include "processing/detrend.hpp"
@@ -98,6 +99,64 @@ std::vector<double> movingAverageFactor(const std::vector<double>& gamma) {
   return g;
 }
 
+// |G(f)|² of the chain for flicker (1/f) rate noise at output frequencies `freqs` (0 < f <
+// rate/2): the output spectrum over the input's, Σ_k |H(f + k·rate)|²·f/|f + k·rate| over the
+// aliases the decimation folds back from the internal band. 1 at f → 0.
+std::vector<double> flickerGain(int cfg, double rate_hz, std::span<const double> freqs) {
+  const DigitalLowPassFilter f(cfg);
+  const double nyquist_in = f.setting().internal_rate_hz / 2.0;
+  const auto d = static_cast<long>(sampleRateDivisor(cfg, rate_hz));
+  std::vector<double> gain(freqs.size(), 0.0);
+  for (std::size_t i = 0; i < freqs.size(); ++i) {
+    for (long k = -d; k <= d; ++k) {
+      const double fk = std::fabs(freqs[i] + static_cast<double>(k) * rate_hz);
+      if (fk > nyquist_in || fk == 0.0) continue;
+      gain[i] += std::norm(f.frequencyResponse(fk)) * freqs[i] / fk;
+    }
+  }
+  return gain;
+}
+
+constexpr std::size_t kFlickerGrid = 8192;       // midpoints on (0, rate/2)
+constexpr std::size_t kFlickerMaxLag = 64;       // of the output-rate filter's autocovariance
+constexpr std::size_t kFlickerMaxCluster = 256;  // the shape is 1 beyond (or once it is within 1e-6)
+
+// The flicker (bias instability) term through the chain: its Allan shape s_B(m), the ratio of
+// the filtered flicker's Allan variance to the unfiltered one's at the output rate (the
+// replicas' flicker), and an output-rate moving average g whose |G|² is the chain's gain, by
+// which the replicas' flicker is filtered. Both from the same |G|², by midpoint sums.
+void addFlickerChain(int cfg, double rate_hz, std::span<const std::size_t> ms, ChainModel& m) {
+  std::vector<double> freqs(kFlickerGrid);
+  const double df = rate_hz / 2.0 / static_cast<double>(kFlickerGrid);
+  for (std::size_t i = 0; i < kFlickerGrid; ++i) freqs[i] = (static_cast<double>(i) + 0.5) * df;
+  const std::vector<double> gain = flickerGain(cfg, rate_hz, freqs);
+  m.flicker_shape.assign(ms.size(), 1.0);
+  for (std::size_t j = 0; j < ms.size() && ms[j] <= kFlickerMaxCluster; ++j) {
+    // Discrete Allan kernel 2·sin⁴(πfmτ0)/(m·sin(πfτ0))² against S(f) = 1/f.
+    double filtered = 0.0, plain = 0.0;
+    const auto mm = static_cast<double>(ms[j]);
+    for (std::size_t i = 0; i < kFlickerGrid; ++i) {
+      const double x = std::numbers::pi * freqs[i] / rate_hz;
+      const double sm = std::sin(mm * x), s1 = std::sin(x);
+      const double kernel = 2.0 * sm * sm * sm * sm / (mm * mm * s1 * s1) / freqs[i];
+      plain += kernel;
+      filtered += kernel * gain[i];
+    }
+    m.flicker_shape[j] = filtered / plain;
+    if (std::fabs(m.flicker_shape[j] - 1.0) < 1e-6) break;
+  }
+  // γ(ℓ) = (2/rate)·∫ |G|² cos(2πfℓ/rate) df, tapered where it has decayed.
+  std::vector<double> gamma;
+  for (std::size_t lag = 0; lag <= kFlickerMaxLag; ++lag) {
+    double acc = 0.0;
+    for (std::size_t i = 0; i < kFlickerGrid; ++i)
+      acc += gain[i] * std::cos(2.0 * std::numbers::pi * freqs[i] * static_cast<double>(lag) / rate_hz);
+    gamma.push_back(acc * df * 2.0 / rate_hz);
+    if (lag > 0 && std::fabs(gamma.back()) < 1e-7 * gamma[0]) break;
+  }
+  m.flicker_ma = movingAverageFactor(gamma);
+}
+
 }  // namespace
 
 ChainModel makeChainModel(const AcquisitionChain& chain, double rate_hz, std::span<const std::size_t> ms) {
@@ -106,6 +165,7 @@ ChainModel makeChainModel(const AcquisitionChain& chain, double rate_hz, std::sp
   m.fs_sel = chain.fs_sel;
   const double tau0 = 1.0 / rate_hz;
   m.white_shape.assign(ms.size(), 1.0);
+  m.flicker_shape.assign(ms.size(), 1.0);
   if (chain.fs_sel) {
     m.lsb_dps = 1.0 / gyroSensitivityLsbPerDps(*chain.fs_sel);
     m.quantisation_white = m.lsb_dps * m.lsb_dps * tau0 / 12.0;
@@ -119,6 +179,7 @@ ChainModel makeChainModel(const AcquisitionChain& chain, double rate_hz, std::sp
   for (double& g : gamma) g /= sum * tau0;
   for (std::size_t j = 0; j < ms.size(); ++j) m.white_shape[j] = allanTimesTau(gamma, ms[j], tau0);
   m.white_ma = movingAverageFactor(gamma);
+  addFlickerChain(*chain.dlpf_cfg, rate_hz, ms, m);
   return m;
 }
 
@@ -127,44 +188,27 @@ double whiteCoefficientOf(const NoiseTerms& terms) {
 }
 
 std::vector<double> chainCorrectedVariances(std::span<const double> variance, const Context& c,
-                                            double white_coefficient) {
+                                            const NoiseTerms& terms) {
   std::vector<double> v(variance.begin(), variance.end());
-  const double filtered = std::max(0.0, white_coefficient - c.chain.quantisation_white);
-  for (std::size_t j = 0; j < v.size(); ++j) v[j] += filtered * (1.0 - c.chain.white_shape[j]) / c.taus[j];
+  const double filtered = std::max(0.0, whiteCoefficientOf(terms) - c.chain.quantisation_white);
+  const double flicker = allanVarianceCoefficient(NoiseTerm::BiasInstability, terms.get(NoiseTerm::BiasInstability));
+  for (std::size_t j = 0; j < v.size(); ++j)
+    v[j] += filtered * (1.0 - c.chain.white_shape[j]) / c.taus[j] + flicker * (1.0 - c.chain.flicker_shape[j]);
   return v;
 }
 
 NoiseTermFit fitChainTerms(const std::vector<AllanPoint>& curve, const Context& c) {
-  NoiseTermFit fit = fitNoiseTerms(curve);
-  if (!c.chain.dlpf_cfg) return fit;
-  // The missing white power at short τ is added back with a white coefficient c; the fit of
-  // the corrected curve gives a white coefficient g(c), and the answer is the fixed point
-  // g(c) = c (the correction vanishes at long τ). g is nearly linear with a slope up to ~0.9
-  // for the narrowest DLPF, so the fixed point is found by the secant method, not by
-  // iterating g.
-  std::vector<double> variance;
-  variance.reserve(curve.size());
-  for (const AllanPoint& p : curve) variance.push_back(p.oadev * p.oadev);
-  auto refit = [&](double white) {
-    const std::vector<double> corrected = chainCorrectedVariances(variance, c, white);
-    std::vector<AllanPoint> adjusted = curve;
-    for (std::size_t j = 0; j < adjusted.size(); ++j) adjusted[j].oadev = std::sqrt(corrected[j]);
-    return fitNoiseTerms(adjusted);
-  };
-  double ca = whiteCoefficientOf(fit.value);
-  fit = refit(ca);
-  double ha = whiteCoefficientOf(fit.value) - ca;
-  double cb = whiteCoefficientOf(fit.value);
-  for (int pass = 0; pass < 12; ++pass) {
-    fit = refit(cb);
-    const double hb = whiteCoefficientOf(fit.value) - cb;
-    if (std::fabs(hb) <= 1e-7 * std::max(cb, 1e-300) || hb == ha) break;
-    const double next = std::max(0.0, cb - hb * (cb - ca) / (hb - ha));
-    ca = cb;
-    ha = hb;
-    cb = next;
-  }
-  return fit;
+  if (!c.chain.dlpf_cfg) return fitNoiseTerms(curve);
+  // Through a DLPF the white and flicker terms reach the output with their chain shapes (the
+  // model stays linear in the coefficients); the quantisation's white noise is not filtered,
+  // so what it adds beyond the filtered white term's share is a known variance.
+  NoiseTermShapes shapes;
+  shapes[static_cast<std::size_t>(NoiseTerm::AngleRandomWalk)] = c.chain.white_shape;
+  shapes[static_cast<std::size_t>(NoiseTerm::BiasInstability)] = c.chain.flicker_shape;
+  std::vector<double> known(curve.size(), 0.0);
+  for (std::size_t j = 0; j < curve.size() && j < c.taus.size(); ++j)
+    known[j] = c.chain.quantisation_white * (1.0 - c.chain.white_shape[j]) / c.taus[j];
+  return fitShapedNoiseTerms(curve, &shapes, known);
 }
 
 double chainFitChi2(const std::vector<AllanPoint>& curve, const Context& c) {
@@ -187,6 +231,15 @@ void addChainWhiteNoise(std::vector<double>& x, const ChainModel& chain, double 
       y += g[j] * history[p];
     xi += scale * y;
   }
+}
+
+std::vector<double> filterChainFlicker(std::span<const double> x, const ChainModel& chain, std::size_t n) {
+  const std::vector<double>& g = chain.flicker_ma;
+  const std::size_t lead = g.size() - 1;
+  std::vector<double> y(n, 0.0);
+  for (std::size_t k = 0; k < n; ++k)
+    for (std::size_t j = 0; j < g.size(); ++j) y[k] += g[j] * x[k + lead - j];
+  return y;
 }
 
 void quantiseLikeTheChip(std::vector<double>& x, const ChainModel& chain, std::uint64_t seed) {
@@ -229,11 +282,17 @@ void scoreDlpfCandidates(std::span<const double> rate_dps, double rate_hz, std::
   removeLinearTrend(xd, 1.0 / rate_hz);
   std::vector<AllanPoint> curve;
   Context c = makeContext(in, xd, curve);
+  std::vector<double> axis_chi2;
+  double none = std::numeric_limits<double>::infinity();
   for (DlpfCandidate& cand : candidates) {
     c.chain = makeChainModel({cand.dlpf_cfg, std::nullopt}, rate_hz, c.ms);
     const double chi2 = chainFitChi2(curve, c);
-    cand.chi2 += std::isfinite(chi2) ? chi2 : std::numeric_limits<double>::infinity();
+    axis_chi2.push_back(std::isfinite(chi2) ? chi2 : std::numeric_limits<double>::infinity());
+    cand.chi2 += axis_chi2.back();
+    if (!cand.dlpf_cfg) none = axis_chi2.back();
   }
+  for (std::size_t k = 0; k < candidates.size(); ++k)
+    if (candidates[k].dlpf_cfg && axis_chi2[k] <= 0.8 * none) ++candidates[k].axes_preferring;
 }
 
 std::optional<int> chooseDlpf(const std::vector<DlpfCandidate>& scored, std::size_t axes_scored) {
@@ -249,7 +308,9 @@ std::optional<int> chooseDlpf(const std::vector<DlpfCandidate>& scored, std::siz
   // weights assume white noise, whose short-τ estimates are more precise than filtered
   // noise's), so the rule is relative: the best must beat none clearly.
   const auto axes = static_cast<double>(std::max<std::size_t>(1, axes_scored));
-  if (best && best->chi2 <= 0.8 * none && none - best->chi2 > 3.0 * axes) return best->dlpf_cfg;
+  if (best && best->chi2 <= 0.8 * none && none - best->chi2 > 3.0 * axes &&
+      2 * best->axes_preferring >= std::max<std::size_t>(1, axes_scored))
+    return best->dlpf_cfg;
   return std::nullopt;
 }
 

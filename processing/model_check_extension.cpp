@@ -8,6 +8,7 @@
 
 #include "processing/ar_model.hpp"
 #include "processing/detrend.hpp"
+#include "processing/model_check_intervals.hpp"
 #include "processing/model_check_pipeline.hpp"
 
 namespace gyrod::processing::model_check_detail {
@@ -43,7 +44,7 @@ SimulationModel extendedSimulationModel(const ExtensionInputs& in, double rate, 
 
 // The Allan band of the extended model's replicas (the base band when nothing was named).
 AllanNull extendedAllanNull(const ExtensionInputs& in, bool any_model_effect, const Context& c,
-                            const ModelCheckOptions& o, AxisModelCheck& out) {
+                            const ModelCheckOptions& o, AxisModelCheck& out, EffectIntervals& intervals) {
   if (!any_model_effect) return *in.base_allan;
   const SimulationModel ext = extendedSimulationModel(in, c.rate, c.tau0);
   // The measured temperature drives the replicas' temperature term: the simulator's own
@@ -53,9 +54,15 @@ AllanNull extendedAllanNull(const ExtensionInputs& in, bool any_model_effect, co
     added.resize(c.n);
     for (std::size_t i = 0; i < c.n; ++i) added[i] = in.removal->k * (*in.temp_detrended)[i];
   }
+  // The same replicas bootstrap the parameters' intervals (model_check_intervals.hpp).
+  const ReplicaSeriesHook measure = [&intervals](std::size_t i, std::span<const double> x) {
+    intervals.measureReplica(i, x);
+  };
   const std::vector<SeriesStats> reps =
-      runReplicas(ext, statisticalUncertainty(in.gauss_markov->clean_fit), c, added, o, 3, kStatAllan);
+      runReplicas(ext, statisticalUncertainty(in.gauss_markov->clean_fit), c, added, o, 3, kStatAllan,
+                  intervals.empty() ? ReplicaSeriesHook{} : measure);
   out.replicas_simulated += o.replicas;
+  if (in.gauss_markov->found) intervals.measureGaussMarkov(reps, c);
   return allanNull(reps, *in.measured_log_adev, c, o.false_alarm);
 }
 
@@ -200,7 +207,9 @@ std::vector<double> deterministicPart(const Removal& r, std::size_t n, double ra
 
 void checkExtendedModel(const ExtensionInputs& in, const Context& c, const ModelCheckOptions& o, AxisModelCheck& out) {
   const bool any_model_effect = in.deterministic_found || in.gauss_markov->found;
-  const AllanNull ext_allan = extendedAllanNull(in, any_model_effect, c, o, out);
+  EffectIntervals intervals(*in.removal, c, *in.temp_detrended, o.replicas);
+  const AllanNull ext_allan = extendedAllanNull(in, any_model_effect, c, o, out, intervals);
+  intervals.state(out, in.xc);
   out.allan_extended = ext_allan.band;
 
   bandFigures(out.allan_base, out.gain.adev_log_error_base, out.gain.in_band_base);

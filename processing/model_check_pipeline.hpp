@@ -9,6 +9,7 @@
 // model_check_extension.cpp (the extended model, what it leaves unexplained, the gain).
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <span>
@@ -30,10 +31,12 @@ inline constexpr std::size_t kOutlierHalfWindow = 10;
 
 struct ChainModel {
   std::optional<int> dlpf_cfg, fs_sel;
-  std::vector<double> white_shape;  // s(m) per Allan point (1 without a DLPF)
-  std::vector<double> white_ma;     // MA coefficients of unit long-τ white coefficient (empty: no DLPF)
-  double lsb_dps = 0.0;             // 0: no quantisation
-  double quantisation_white = 0.0;  // white coefficient the rounding adds: LSB²·τ0/12
+  std::vector<double> white_shape;    // s(m) per Allan point (1 without a DLPF)
+  std::vector<double> white_ma;       // MA coefficients of unit long-τ white coefficient (empty: no DLPF)
+  std::vector<double> flicker_shape;  // s_B(m): the flicker (bias instability) term's, 1 without a DLPF
+  std::vector<double> flicker_ma;     // output-rate filter of the chain's gain for flicker (empty: no DLPF)
+  double lsb_dps = 0.0;               // 0: no quantisation
+  double quantisation_white = 0.0;    // white coefficient the rounding adds: LSB²·τ0/12
 };
 
 // ---- what every replica (and the measured series) is measured by ----------------------
@@ -55,14 +58,18 @@ struct Context {
 ChainModel makeChainModel(const AcquisitionChain& chain, double rate_hz, std::span<const std::size_t> ms);
 // The white coefficient c (σ² = c/τ) of a set of terms.
 double whiteCoefficientOf(const NoiseTerms& terms);
-// Allan variances with the white power the DLPF took at short τ added back (white coefficient
-// given, less the quantisation's, which is not filtered): what the five terms describe.
+// Allan variances with the white and flicker power the DLPF took at short τ added back (for
+// the white and bias-instability terms given; the quantisation's white share is not
+// filtered): what the five terms describe.
 std::vector<double> chainCorrectedVariances(std::span<const double> variance, const Context& c,
-                                            double white_coefficient);
+                                            const NoiseTerms& terms);
 // The five terms of an Allan curve made through c.chain (fitNoiseTerms when there is no DLPF).
 NoiseTermFit fitChainTerms(const std::vector<AllanPoint>& curve, const Context& c);
 // The chain's white noise of coefficient c (less the quantisation's) added to x, its own stream.
 void addChainWhiteNoise(std::vector<double>& x, const ChainModel& chain, double white_coefficient, std::uint64_t seed);
+// n samples of x filtered by the chain's flicker filter (x has n + flicker_ma.size() − 1
+// samples: the first ones only fill the filter).
+std::vector<double> filterChainFlicker(std::span<const double> x, const ChainModel& chain, std::size_t n);
 // Rounded to the chain's LSB at a random offset (nothing without FS_SEL).
 void quantiseLikeTheChip(std::vector<double>& x, const ChainModel& chain, std::uint64_t seed);
 
@@ -119,10 +126,12 @@ SimulationModel pureModel(double rate, const NoiseTerms& terms);
 // The 1-σ uncertainty of a fit without noise_fit's reduced-χ² scale.
 NoiseTerms statisticalUncertainty(const NoiseTermFit& fit);
 // o.replicas replicas of `model` (terms perturbed by `uncertainty`) plus `added`, measured by
-// `mask`; replica i of `round` is seeded from (o.seed, round, i) alone.
+// `mask`; replica i of `round` is seeded from (o.seed, round, i) alone. `per_series`, when
+// given, also sees each replica series (with its index; called from the pool's threads).
+using ReplicaSeriesHook = std::function<void(std::size_t, std::span<const double>)>;
 std::vector<SeriesStats> runReplicas(const SimulationModel& model, const NoiseTerms& uncertainty, const Context& c,
                                      std::span<const double> added, const ModelCheckOptions& o, std::uint64_t round,
-                                     unsigned mask);
+                                     unsigned mask, const ReplicaSeriesHook& per_series = {});
 
 // The Allan band of the replicas around the measured curve and the null of its largest |z|.
 struct AllanNull {

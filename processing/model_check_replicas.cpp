@@ -39,9 +39,24 @@ std::vector<double> simulateReplica(const SimulationModel& model, const Context&
   else if (c.chain.lsb_dps > 0.0)
     terms.set(NoiseTerm::AngleRandomWalk,
               noiseTermFromCoefficient(NoiseTerm::AngleRandomWalk, std::max(0.0, white - c.chain.quantisation_white)));
+  // Through a DLPF the flicker (bias instability) is filtered too: drawn by a simulator of
+  // its own (its own seed), through the chain's output-rate filter for flicker.
+  const double flicker = terms.get(NoiseTerm::BiasInstability);
+  const bool filter_flicker = c.chain.dlpf_cfg && !c.chain.flicker_ma.empty() && flicker > 0.0;
+  if (filter_flicker) terms.set(NoiseTerm::BiasInstability, 0.0);
   NoiseSimulator sim(pure, static_cast<double>(n) / model.rate_hz, seed);
   std::vector<double> x(n);
   for (std::size_t i = 0; i < n; ++i) x[i] = sim.next().rate_dps[0];
+  if (filter_flicker) {
+    SimulationModel flicker_only = pureModel(model.rate_hz, {});
+    flicker_only.axes[0].terms.set(NoiseTerm::BiasInstability, flicker);
+    const std::size_t padded = n + c.chain.flicker_ma.size() - 1;
+    NoiseSimulator flicker_sim(flicker_only, static_cast<double>(padded) / model.rate_hz, seed ^ 0x7F4A7C159E3779B9ULL);
+    std::vector<double> raw(padded);
+    for (double& v : raw) v = flicker_sim.next().rate_dps[0];
+    const std::vector<double> filtered = filterChainFlicker(raw, c.chain, n);
+    for (std::size_t i = 0; i < n; ++i) x[i] += filtered[i];
+  }
   if (c.chain.dlpf_cfg) addChainWhiteNoise(x, c.chain, white, seed);
   if (!added.empty())
     for (std::size_t i = 0; i < n; ++i) x[i] += added[i];
@@ -112,12 +127,13 @@ NoiseTerms statisticalUncertainty(const NoiseTermFit& fit) {
 
 std::vector<SeriesStats> runReplicas(const SimulationModel& model, const NoiseTerms& uncertainty, const Context& c,
                                      std::span<const double> added, const ModelCheckOptions& o, std::uint64_t round,
-                                     unsigned mask) {
+                                     unsigned mask, const ReplicaSeriesHook& per_series) {
   std::vector<SeriesStats> out(o.replicas);
   parallelFor(o.replicas, o.threads, [&](std::size_t i) {
     const std::uint64_t seed = replicaSeed(o.seed, round, i);
     const std::vector<double> x = simulateReplica(replicaModel(model, uncertainty, seed), c, seed, added);
     out[i] = measureSeries(x, c, mask);
+    if (per_series) per_series(i, x);
   });
   return out;
 }

@@ -20,6 +20,7 @@ struct CurvePoint {
   double tau_s;
   double variance;  // σ̂², (°/s)²
   double edf;
+  std::size_t index;  // in the curve
 };
 
 std::string describeTau(double tau_s) {
@@ -57,7 +58,7 @@ std::vector<CurvePoint> usablePoints(std::span<const AllanPoint> curve, std::siz
       for (int alpha : {0, -1, -2}) fm_edf = std::max(fm_edf, overlappingAllanEdf(alpha, phase_points, p.m));
       edf = std::min(edf, fm_edf);
     }
-    points.push_back({p.tau_s, p.oadev * p.oadev, edf});
+    points.push_back({p.tau_s, p.oadev * p.oadev, edf, static_cast<std::size_t>(&p - curve.data())});
   }
   if (points.empty()) {
     throw std::invalid_argument(std::string(where) + " has no usable point (each needs at least " +
@@ -66,9 +67,17 @@ std::vector<CurvePoint> usablePoints(std::span<const AllanPoint> curve, std::siz
   return points;
 }
 
-double modelVariance(const Eigen::VectorXd& c, double tau_s) {
+// Term i's basis function at a point: τ^p, times the term's shape there when one is given.
+double basisAt(const NoiseTermShapes* shapes, int i, const CurvePoint& p) {
+  const double power = std::pow(p.tau_s, noiseTermVariancePower(kAllNoiseTerms[i]));
+  if (!shapes) return power;
+  const std::vector<double>& s = (*shapes)[static_cast<std::size_t>(i)];
+  return s.empty() ? power : power * s[p.index];
+}
+
+double modelVariance(const Eigen::VectorXd& c, const CurvePoint& p, const NoiseTermShapes* shapes) {
   double v = 0.0;
-  for (int i = 0; i < kTermCount; ++i) v += c(i) * std::pow(tau_s, noiseTermVariancePower(kAllNoiseTerms[i]));
+  for (int i = 0; i < kTermCount; ++i) v += c(i) * basisAt(shapes, i, p);
   return v;
 }
 
@@ -155,7 +164,14 @@ NonNegativeLeastSquares solveNonNegativeLeastSquares(const Eigen::MatrixXd& a, c
 }
 
 NoiseTermFit fitNoiseTerms(std::span<const AllanPoint> curve, std::size_t min_terms) {
-  const std::vector<CurvePoint> points = usablePoints(curve, min_terms, true, "the noise term fit");
+  return fitShapedNoiseTerms(curve, nullptr, {}, min_terms);
+}
+
+NoiseTermFit fitShapedNoiseTerms(std::span<const AllanPoint> curve, const NoiseTermShapes* shapes,
+                                 std::span<const double> known_variance, std::size_t min_terms) {
+  std::vector<CurvePoint> points = usablePoints(curve, min_terms, true, "the noise term fit");
+  if (!known_variance.empty())
+    for (CurvePoint& p : points) p.variance = std::max(p.variance - known_variance[p.index], 0.01 * p.variance);
   const auto n = static_cast<Eigen::Index>(points.size());
 
   // Row j of the weighted system is divided by the standard deviation of σ̂²_j,
@@ -171,7 +187,7 @@ NoiseTermFit fitNoiseTerms(std::span<const AllanPoint> curve, std::size_t min_te
       const CurvePoint& p = points[static_cast<std::size_t>(j)];
       const double row_weight = std::sqrt(p.edf / 2.0) / reference[static_cast<std::size_t>(j)];
       for (int i = 0; i < kTermCount; ++i) {
-        a(j, i) = std::pow(p.tau_s, noiseTermVariancePower(kAllNoiseTerms[i])) * row_weight;
+        a(j, i) = basisAt(shapes, i, p) * row_weight;
       }
       b(j) = p.variance * row_weight;
     }
@@ -180,7 +196,7 @@ NoiseTermFit fitNoiseTerms(std::span<const AllanPoint> curve, std::size_t min_te
     // Next pass weights from the model value. It is kept ≥ 1/10 of the measured value so
     // that a point the model misses badly cannot take over the fit.
     for (std::size_t j = 0; j < points.size(); ++j) {
-      const double model = modelVariance(solution.x, points[j].tau_s);
+      const double model = modelVariance(solution.x, points[j], shapes);
       reference[j] = std::max(model, 0.1 * points[j].variance);
     }
   }

@@ -6,7 +6,9 @@
 //  - readNoiseTermsFromSlopes: the classical reading of IEEE 952: for each term the line
 //    of its slope that touches the curve from below, read at the conventional τ.
 #include <Eigen/Dense>
+#include <array>
 #include <span>
+#include <vector>
 
 #include "processing/allan.hpp"
 #include "processing/noise_terms.hpp"
@@ -30,6 +32,14 @@ struct NoiseTermFit {
 // Throws std::invalid_argument when no point qualifies, or a qualifying point has
 // τ ≤ 0, oadev ≤ 0 or a non-finite / non-positive edf.
 NoiseTermFit fitNoiseTerms(std::span<const AllanPoint> curve, std::size_t min_terms = 2);
+
+// The same fit of σ²(τ) = Σ cᵢ·sᵢ(τ)·τ^pᵢ + k(τ): term i's basis times its shape sᵢ at each
+// point of the curve (an empty shape: 1), after a known variance k per point is taken off
+// (empty: none; a point keeps at least 1 % of its variance). The model check's base model
+// uses it for the terms a filter in the acquisition chain shapes at short τ.
+using NoiseTermShapes = std::array<std::vector<double>, kNoiseTermCount>;
+NoiseTermFit fitShapedNoiseTerms(std::span<const AllanPoint> curve, const NoiseTermShapes* shapes,
+                                 std::span<const double> known_variance, std::size_t min_terms = 2);
 
 // For each term of log-log slope s: b = minᵢ(ln σᵢ − s·ln τᵢ), i.e. c = e^{2b} in σ² = c·τ^p.
 // On an exact curve this is an upper bound of every term (each term's own line lies below

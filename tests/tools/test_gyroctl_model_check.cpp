@@ -58,6 +58,12 @@ TEST(GyroctlModelCheck, JsonNamesTheHiddenSinusoidOnItsAxisOnly) {
     EXPECT_NEAR(effects[0].at("params").at("freq_hz").get<double>(), g.hidden[0].freq_hz, 0.5 / 300.0);
     EXPECT_NEAR(effects[0].at("params").at("amp_dps").get<double>(), g.hidden[0].amp_dps, 0.1 * g.hidden[0].amp_dps);
     EXPECT_FALSE(effects[0].at("evidence").get<std::string>().empty());
+    // Its stated 95 % interval (docs/model-check.md, "Intervals"): [lo, hi] around the estimate.
+    const auto& amp95 = effects[0].at("params").at("amp_dps_95");
+    ASSERT_EQ(amp95.size(), 2u) << amp95.dump();
+    const double amp = effects[0].at("params").at("amp_dps").get<double>();
+    EXPECT_LT(amp95[0].get<double>(), amp);
+    EXPECT_GT(amp95[1].get<double>(), amp);
   }
 }
 
@@ -223,6 +229,39 @@ TEST(GyroctlModelCheckWriteModel, NamesTheHiddenSinusoidAndSimulateAcceptsTheFil
   ASSERT_EQ(r.exit_status, 0) << r.err;
   const std::string csv = readWholeFile(again);
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 60 * 50);
+}
+
+// The acquisition chain the check modelled goes into the written model (dlpf, fs_sel, the
+// rate), so that `gyroctl simulate --model` makes the noise through the same DLPF and rounding;
+// the rounding's white noise, which the fitted white term holds, is taken out of it.
+TEST(GyroctlModelCheckWriteModel, WritesTheAcquisitionChain) {
+  ScratchDir d;
+  const auto rec = d.path() / "rec.csv";
+  auto r =
+      runGyroctl("simulate --arw 0.5 --bias-instability 5 --duration 300 --rate 50 --dlpf 4 --fs-sel 0 --seed 5 -o " +
+                     rec.string(),
+                 d.path());
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const auto out = d.path() / "m.toml";
+  r = runGyroctl(
+      "model-check " + rec.string() + " --dlpf 4 --fs-sel 0 --replicas 8 --threads 2 --write-model " + out.string(),
+      d.path());
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const std::string text = readWholeFile(out);
+  EXPECT_NE(text.find("dlpf = 4\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("fs_sel = 0\n"), std::string::npos) << text;
+  const gyrod::processing::SimulationModel m = gyrod::recording::parseModelToml(text, out.string());
+  EXPECT_EQ(m.dlpf_cfg, 4);
+  EXPECT_EQ(m.fs_sel, 0);
+  EXPECT_NEAR(m.rate_hz, 50.0, 1e-9);
+  // 0.5 °/√h less the rounding's share (LSB²·τ0/12 against N²: 0.2 % of it). Through DLPF_CFG
+  // 4 the white and flicker terms are told apart by their short-τ shapes in 300 s: measured
+  // 0.540–0.545 on the three axes (seed 5), so within 12 %.
+  for (std::size_t a = 0; a < 3; ++a) EXPECT_NEAR(m.axes[a].terms.arw_deg_per_sqrt_h, 0.5, 0.06) << "axis " << a;
+  const auto again = d.path() / "again.csv";
+  r = runGyroctl("simulate --model " + out.string() + " --duration 60 --seed 4 -o " + again.string(), d.path());
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE((r.out + r.err).find("DLPF_CFG 4, FS_SEL 0"), std::string::npos) << r.out << r.err;
 }
 
 TEST(GyroctlModelCheckWriteModel, SampleGapsAreACommentNotAnEffect) {

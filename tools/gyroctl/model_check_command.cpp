@@ -61,13 +61,39 @@ std::string fmt(const char* f, double v) {
   return buf;
 }
 
+// A stated 95 % interval as [lo, hi] under `<parameter>_95` (docs/model-check.md, "Intervals").
+void addInterval(json& params, const std::string& parameter, const ParameterInterval& i) {
+  if (i.stated) params[parameter + "_95"] = {i.lo, i.hi};
+}
+
 json effectParams(const DetectedEffect& e) {
+  json p = json::object();
   switch (e.effect) {
-    case ModelEffect::TemperatureBias: return {{"k_dps_per_c", e.k_dps_per_c}};
-    case ModelEffect::Sinusoid: return {{"freq_hz", e.freq_hz}, {"amp_dps", e.amp_dps}};
-    case ModelEffect::GaussMarkov: return {{"tau_s", e.tau_s}, {"sigma_dps", e.sigma_dps}};
-    case ModelEffect::BiasSteps: return {{"count", e.count}, {"times_s", e.times_s}};
-    case ModelEffect::Outliers: return {{"count", e.count}};
+    case ModelEffect::TemperatureBias:
+      p = {{"k_dps_per_c", e.k_dps_per_c}};
+      addInterval(p, "k_dps_per_c", e.k_interval);
+      return p;
+    case ModelEffect::Sinusoid:
+      p = {{"freq_hz", e.freq_hz}, {"amp_dps", e.amp_dps}};
+      addInterval(p, "amp_dps", e.amp_interval);
+      return p;
+    case ModelEffect::GaussMarkov:
+      p = {{"tau_s", e.tau_s}, {"sigma_dps", e.sigma_dps}};
+      addInterval(p, "tau_s", e.tau_interval);
+      addInterval(p, "sigma_dps", e.sigma_interval);
+      return p;
+    case ModelEffect::BiasSteps: {
+      p = {{"count", e.count}, {"times_s", e.times_s}, {"sizes_dps", e.sizes_dps}};
+      json sizes = json::array();
+      for (const ParameterInterval& i : e.size_intervals) sizes.push_back(i.stated ? json{i.lo, i.hi} : json(nullptr));
+      if (!e.size_intervals.empty()) p["sizes_dps_95"] = sizes;
+      return p;
+    }
+    case ModelEffect::Outliers:
+      p = {{"count", e.count}, {"median_amplitude_dps", e.outlier_median_amplitude_dps}};
+      addInterval(p, "count", e.count_interval);
+      addInterval(p, "median_amplitude_dps", e.outlier_amplitude_interval);
+      return p;
     case ModelEffect::SampleGaps: return {{"count", e.count}, {"lost", e.lost}};
     case ModelEffect::Unexplained:
       return {{"where", "tau " + fmt("%.4g", e.where_lo) + " to " + fmt("%.4g", e.where_hi) + " s"},
@@ -486,6 +512,23 @@ std::string extendedModelToml(const ModelCheckCliOptions& opt, const LoadedInput
       sensor.calibration[*slot] = recording::calibrateAxis(secs, rec.axes[in.axis_indices[k]], rec.temp).calibration;
     } catch (const std::invalid_argument& e) {
       notes.push_back(name + ": no calibration (" + e.what() + ")");
+    }
+  }
+  // The acquisition chain the check modelled (the same for every axis): the simulator then
+  // makes the noise through the same DLPF and rounding. The rounding's white noise is part of
+  // the fitted white term, and the simulator adds it again, so that much is taken out of it.
+  if (!results.empty()) {
+    const AcquisitionChain& chain = results.front().second.chain;
+    model.dlpf_cfg = chain.dlpf_cfg;
+    model.fs_sel = chain.fs_sel;
+    if (chain.fs_sel) {
+      const double lsb = 1.0 / processing::gyroSensitivityLsbPerDps(*chain.fs_sel);
+      const double rounding = lsb * lsb / (12.0 * in.rate_hz);
+      for (AxisNoiseModel& axis : model.axes) {
+        const double c = allanVarianceCoefficient(NoiseTerm::AngleRandomWalk, axis.terms.arw_deg_per_sqrt_h);
+        axis.terms.arw_deg_per_sqrt_h =
+            c > 0.0 ? noiseTermFromCoefficient(NoiseTerm::AngleRandomWalk, std::max(0.0, c - rounding)) : 0.0;
+      }
     }
   }
   validateSimulationModel(model);

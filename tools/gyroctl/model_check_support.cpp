@@ -78,7 +78,10 @@ ChainChoice settleChain(const std::string& file, std::optional<int> dlpf_cfg, st
       } catch (const std::invalid_argument&) {
         continue;
       }
-      for (std::size_t k = 0; k < axis_scores.size(); ++k) c.scores[k].chi2 += axis_scores[k].chi2;
+      for (std::size_t k = 0; k < axis_scores.size(); ++k) {
+        c.scores[k].chi2 += axis_scores[k].chi2;
+        c.scores[k].axes_preferring += axis_scores[k].axes_preferring;
+      }
       ++scored;
     }
     c.chain.dlpf_cfg = scored > 0 ? chooseDlpf(c.scores, scored) : std::nullopt;
