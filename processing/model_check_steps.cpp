@@ -172,7 +172,7 @@ std::size_t refineStepSample(std::span<const double> r, std::size_t block_start,
 // and then the refit changes little. Returns the nulls to test against; `looked` tells
 // whether they come from a further look.
 LowFrequencyNulls nullsAfterFurtherLooks(const std::vector<double>& xc, const Context& c,
-                                         const std::vector<double>& temp_detrended, LowFrequencyNulls lf,
+                                         const std::vector<double>& temp_smoothed, LowFrequencyNulls lf,
                                          const ModelCheckOptions& o, AxisModelCheck& out, bool& looked) {
   const bool have_temp = !c.temp_blocks.empty();
   const bool have_steps = !c.scales.empty();
@@ -196,7 +196,7 @@ LowFrequencyNulls nullsAfterFurtherLooks(const std::vector<double>& xc, const Co
     previous_signature = signature;
     std::vector<double> alt = xc;
     if (temp_suggestive)
-      for (std::size_t i = 0; i < alt.size(); ++i) alt[i] -= k * temp_detrended[i];
+      for (std::size_t i = 0; i < alt.size(); ++i) alt[i] -= k * temp_smoothed[i];
     for (const BlockStep& st : candidates)
       for (std::size_t i = st.block * c.block; i < alt.size(); ++i) alt[i] -= st.size;
     removeLinearTrend(alt, c.tau0);
@@ -304,8 +304,11 @@ LowFrequencyChoice chooseTemperatureOrSteps(const std::vector<double>& y0, const
 
 // The chosen temperature coefficient and step sizes fitted jointly on the low-passed
 // residual, each step placed at its sample, into `removal`.
+// The temperature part is subtracted with the smoothed channel (the extended model's
+// regressor): the raw column's noise and 1/340 °C steps times k would add noise to r and
+// move the refined step samples.
 void fitChosenEffects(const std::vector<double>& y0, const std::vector<double>& xc, const Context& c,
-                      const std::vector<double>& temp_detrended, LowFrequencyChoice& ch, Removal& removal) {
+                      const std::vector<double>& temp_smoothed, LowFrequencyChoice& ch, Removal& removal) {
   double rss = 0.0;
   const std::vector<double> coef = blockRegression(y0, ch.temperature ? &c.temp_blocks : nullptr, ch.steps, rss);
   std::size_t next = 0;
@@ -317,7 +320,7 @@ void fitChosenEffects(const std::vector<double>& y0, const std::vector<double>& 
   // Each step's sample, from the series with the temperature part and the other steps removed.
   std::vector<double> r = xc;
   if (ch.temperature)
-    for (std::size_t i = 0; i < r.size(); ++i) r[i] -= removal.k * temp_detrended[i];
+    for (std::size_t i = 0; i < r.size(); ++i) r[i] -= removal.k * temp_smoothed[i];
   for (const BlockStep& s : ch.steps)
     for (std::size_t i = s.block * c.block; i < r.size(); ++i) r[i] -= s.size;
   for (const BlockStep& s : ch.steps) {
@@ -347,7 +350,7 @@ bool checkTemperatureAndSteps(const AxisModelCheckInput& input, std::vector<doub
   const bool have_steps = !c.scales.empty();
   bool second_look = false;
   const LowFrequencyNulls lf = nullsAfterFurtherLooks(
-      xc, c, temp.detrended, lowFrequencyNulls(base_reps, o.false_alarm, have_temp, have_steps), o, out, second_look);
+      xc, c, temp.smoothed, lowFrequencyNulls(base_reps, o.false_alarm, have_temp, have_steps), o, out, second_look);
   const std::vector<double> y0 = lowPassedResidual(xc, c);
   out.block_residual_dps = y0;
   out.block_temperature_c = temp.raw_blocks;
@@ -361,7 +364,7 @@ bool checkTemperatureAndSteps(const AxisModelCheckInput& input, std::vector<doub
   LowFrequencyChoice ch = chooseTemperatureOrSteps(y0, {c, lf, have_temp, have_steps});
   if (!ch.temperature && ch.steps.empty()) return false;
 
-  fitChosenEffects(y0, xc, c, temp.detrended, ch, removal);
+  fitChosenEffects(y0, xc, c, temp.smoothed, ch, removal);
   if (ch.temperature) {
     DetectedEffect e;
     e.effect = ModelEffect::TemperatureBias;
@@ -381,9 +384,8 @@ bool checkTemperatureAndSteps(const AxisModelCheckInput& input, std::vector<doub
     e.evidence = lowFrequencyEvidence(s_stat, lf.steps, o.replicas, ch);
     out.effects.push_back(e);
   }
-  const std::vector<double> d =
-      deterministicPart({{}, removal.k, removal.temperature, removal.step_samples, removal.step_sizes}, xc.size(),
-                        c.rate, temp.detrended);
+  const std::vector<double> d = deterministicPart(
+      {{}, removal.k, removal.temperature, removal.step_samples, removal.step_sizes}, xc.size(), c.rate, temp.smoothed);
   for (std::size_t i = 0; i < xc.size(); ++i) xc[i] -= d[i];
   return true;
 }
