@@ -75,11 +75,10 @@ gcc -static -O2 -Wall -Wextra -Werror -o "$r/usr/local/bin/vm_chip" "$root/tests
 install -m 755 "$root/tests/vm/systemd-checks.sh" "$r/usr/local/bin/vm-systemd-checks"
 cat >"$r/etc/gyrod/gyrod.toml" <<'EOF'
 # The VM's board: i2c-stub's /dev/i2c-0, no INT line (polling), a fixed bias and filter
-# (vm_chip's frames never change, so no still period could identify one). vm_chip serves the
-# 8-byte gyro-only frame: accel off.
+# (vm_chip's frames never change, so no still period could identify one). Accel on (the
+# default, +-2 g): vm_chip serves the 14-byte frames FIFO_EN asks for.
 [device]
 bus = 0
-accel = false
 [bias]
 source = "config"
 [filter.kalman]

@@ -38,12 +38,14 @@ vm_chip preload /dev/i2c-0 || { fail preload "vm_chip preload failed"; finish; }
 vm_chip emulate /dev/i2c-0 &
 
 # --- helpers ---
-# conf NAME BUS ADDRESS [GPIO_CHIP]: /tmp/NAME.toml (bias from the config; the Kalman filter
-# is identified over a still period of 200 samples, which vm_chip's constant frames refuse)
+# conf NAME BUS ADDRESS [GPIO_CHIP [DEVICE_LINES]]: /tmp/NAME.toml (bias from the config; the
+# Kalman filter is identified over a still period of 200 samples, which vm_chip's constant
+# frames refuse). DEVICE_LINES go into [device]: accel is on unless they say otherwise, and
+# vm_chip serves the frames FIFO_EN asks for (14 bytes with accel, 8 without).
 conf() {
   {
     printf '[device]\nbackend = "i2c"\nbus = %s\naddress = %s\n' "$2" "$3"
-    printf 'accel = false\n' # vm_chip serves the 8-byte gyro-only frame (FIFO_COUNT held at 8)
+    [ -n "$5" ] && printf '%s\n' "$5"
     printf '[gpio]\nchip = "%s"\n' "$4"
     [ -n "$4" ] && printf 'line = 0\n'
     printf '[bias]\nsource = "config"\nstill_seconds = 4\n'
@@ -103,41 +105,82 @@ t0=$(uptime_s)
 if out=$(vm_chip rdwr /dev/i2c-0); then pass smbus-only "$out"; else fail smbus-only "$out"; fi
 
 # --- probe, register table, exact values (no INT line: polling) ---
-conf poll 0 0x68
-start poll
-poll_pid=$gyrod_pid
-if wait_samples poll 5 60; then
-  st=$(status poll)
-  if has poll "looking for the MPU6050 at 0x68 on /dev/i2c-0" && has poll "streaming from the MPU6050 at 0x68" &&
-    [ "$(echo "$st" | field device_state)" = streaming ]; then
-    pass probe "$(logline poll 'streaming from')"
+# read_table REG...: the registers' bytes as (busybox's) i2cget reads them now
+read_table() {
+  t=""
+  for reg in "$@"; do t="$t $(i2cget -y 0 0x68 "$reg")"; done
+  echo "$t"
+}
+table_names="PWR_MGMT_1 PWR_MGMT_2 SMPLRT_DIV CONFIG GYRO_CONFIG ACCEL_CONFIG INT_ENABLE FIFO_EN USER_CTRL"
+# poll_run NAME FRAME_BYTES WANT_TABLE WANT_RATE DETAIL: gyrod without an INT line on
+# /tmp/NAME.toml; the probe (first run only), the register table read back after one Configure
+# pass, and 5 RATE lines that must all contain WANT_RATE exactly (the frame vm_chip preloaded).
+poll_run() {
+  start "$1"
+  run_pid=$gyrod_pid
+  if wait_samples "$1" 5 60; then
+    st=$(status "$1")
+    if [ "$1" = poll ]; then
+      if has poll "looking for the MPU6050 at 0x68 on /dev/i2c-0" && has poll "streaming from the MPU6050 at 0x68" &&
+        [ "$(echo "$st" | field device_state)" = streaming ]; then
+        pass probe "$(logline poll 'streaming from')"
+      else
+        fail probe "$(tail -n 5 /tmp/poll.log)"
+      fi
+    fi
+    # One Configure pass means StartFifo read the whole table back without a mismatch.
+    configures=$(echo "$st" | field configures)
+    table=$(read_table 0x6b 0x6c 0x19 0x1a 0x1b 0x1c 0x38 0x23 0x6a)
+    if [ "$configures" = 1 ] && [ "$table" = "$3" ]; then
+      pass "register-table-$2" "configures=1; $table_names =$table"
+    else
+      fail "register-table-$2" "configures=$configures; read$table; want$3"
+    fi
+    watch_json "$1" 5 "/tmp/$1-watch.json"
+    n=$(grep -c '"class":"RATE"' "/tmp/$1-watch.json")
+    exact=$(grep '"class":"RATE"' "/tmp/$1-watch.json" | grep -c -F "$4")
+    # A burst of the wrong frame size fails gyrod's temperature check: misaligned_bursts.
+    misaligned=$(status "$1" | field misaligned_bursts)
+    if [ "$n" = 5 ] && [ "$exact" = 5 ] && [ "$misaligned" = 0 ]; then
+      pass "exact-values-$2" "5 of 5 RATE lines ($2-byte frames): $5; misaligned_bursts=0"
+    else
+      fail "exact-values-$2" "$exact of $n exact, misaligned_bursts=$misaligned; want $4: $(grep -m1 RATE "/tmp/$1-watch.json" | cut -c1-400)"
+      show "$1"
+    fi
   else
-    fail probe "$(tail -n 5 /tmp/poll.log)"
+    fail "probe-$2" "no samples in 60 s: $(tail -n 5 /tmp/$1.log)"
   fi
-  # One Configure pass means StartFifo read the whole table back without a mismatch.
-  configures=$(echo "$st" | field configures)
-  table=""
-  for reg in 0x6b 0x6c 0x19 0x1a 0x1b 0x38 0x23 0x6a; do table="$table $(i2cget -y 0 0x68 $reg)"; done
-  want=" 0x01 0x00 0x13 0x04 0x00 0x11 0xf0 0x40"
-  if [ "$configures" = 1 ] && [ "$table" = "$want" ]; then
-    pass register-table "configures=1; PWR_MGMT_1 PWR_MGMT_2 SMPLRT_DIV CONFIG GYRO_CONFIG INT_ENABLE FIFO_EN USER_CTRL =$table"
-  else
-    fail register-table "configures=$configures; read$table; want$want"
-  fi
-  # The frame vm_chip preloaded: 131, -262, 655 LSB at 131 LSB/(deg/s); TEMP -1944 LSB.
-  watch_json poll 5 /tmp/watch.json
-  n=$(grep -c '"class":"RATE"' /tmp/watch.json)
-  exact=$(grep '"class":"RATE"' /tmp/watch.json | grep -c '"temp":30.81235294117647,"raw":\[1,-2,5\]')
-  if [ "$n" = 5 ] && [ "$exact" = 5 ]; then
-    pass exact-values "5 of 5 RATE lines: temp 30.81235294117647, raw [1,-2,5]"
-  else
-    fail exact-values "$exact of $n exact: $(grep -m1 RATE /tmp/watch.json | cut -c1-200)"
-    show poll
-  fi
+  stop $run_pid
+}
+
+# gyrod's default: accel on, here at +-8 g (AFS_SEL 2, 4096 LSB/g): 14-byte frames, FIFO_EN
+# 0xF8, ACCEL_CONFIG 0x10, PWR_MGMT_2 0 (no axis in standby). vm_chip's 14-byte frame: accel
+# 32616, -6144, -32768 LSB = 7.962890625, -1.5, -8 g (near and at full scale, negative words
+# sign-extended); gyro -393, 32750, -32750 LSB = -3, 250, -250 deg/s at 131 LSB/(deg/s); TEMP
+# -1944 LSB = 30.81235294117647 deg C.
+conf poll 0 0x68 "" "accel_range_g = 8"
+poll_run poll 14 " 0x01 0x00 0x13 0x04 0x00 0x10 0x11 0xf8 0x40" \
+  '"temp":30.81235294117647,"raw":[-3,250,-250],' \
+  'temp 30.81235294117647, raw [-3,250,-250] deg/s, accel [7.962890625,-1.5,-8] g'
+# The accel fields of the same lines (after the gyro streams and "time").
+exact=$(grep '"class":"RATE"' /tmp/poll-watch.json | grep -c -F '"accel":[7.962890625,-1.5,-8],')
+if [ "$exact" = 5 ]; then
+  pass exact-accel-14 "5 of 5 RATE lines: accel [7.962890625,-1.5,-8] g at AFS_SEL 2"
 else
-  fail probe "no samples in 60 s: $(tail -n 5 /tmp/poll.log)"
+  fail exact-accel-14 "$exact of 5 with accel [7.962890625,-1.5,-8]: $(grep -m1 RATE /tmp/poll-watch.json | cut -c1-400)"
 fi
-stop $poll_pid
+
+# accel = false: the gyro-only driver's table (ACCEL_CONFIG neither written nor checked: it
+# keeps the 0x10 of the run before), FIFO_EN 0xF0, and vm_chip's 8-byte frame: 131, -262,
+# 655 LSB = 1, -2, 5 deg/s; no accel field.
+conf poll8 0 0x68 "" "accel = false"
+poll_run poll8 8 " 0x01 0x00 0x13 0x04 0x00 0x10 0x11 0xf0 0x40" \
+  '"temp":30.81235294117647,"raw":[1,-2,5],' 'temp 30.81235294117647, raw [1,-2,5] deg/s, no accel'
+if [ -s /tmp/poll8-watch.json ] && ! grep -q '"accel' /tmp/poll8-watch.json; then
+  pass no-accel-8 "no accel or accel_ms2 field in the RATE lines"
+else
+  fail no-accel-8 "an accel field without accel (or no lines): $(grep -m1 RATE /tmp/poll8-watch.json | cut -c1-400)"
+fi
 
 # --- edges through libgpiod and the epoll loop ---
 conf gpio 0 0x68 "$chip"
@@ -151,7 +194,7 @@ if wait_samples gpio 20 60; then
   r=$(rate gpio 4)
   m1=$(status gpio | field data_ready_missed)
   s1=$(samples gpio)
-  # One frame per wake-up (vm_chip holds FIFO_COUNT at 8): ~50/s on edges, at most ~11/s from
+  # One frame per wake-up (vm_chip holds FIFO_COUNT at one 14-byte frame): ~50/s on edges, at most ~11/s from
   # the watchdog alone (every 88 ms). On a loaded host the guest's edges come late and the
   # watchdog takes a few: most samples must still have been announced by an edge.
   watchdog=$((m1 - m0))

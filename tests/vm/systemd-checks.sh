@@ -59,6 +59,20 @@ else
   fail client "gyroctl status on $sock: $status"
 fi
 
+# The default configuration's 14-byte frames (accel on, +-2 g: AFS_SEL 0, 16384 LSB/g) through
+# the real kernel's SMBus, exactly as vm_chip preloaded them: gyro -393, 32750, -32750 LSB at
+# 131 LSB/(deg/s); accel 32616, -6144, -32768 LSB; TEMP -1944 LSB.
+want_raw='"temp":30.81235294117647,"raw":[-3,250,-250],'
+want_accel='"accel":[1.99072265625,-0.375,-2],'
+timeout 60 gyroctl watch --socket $sock --json --count 5 >/tmp/watch.json 2>&1
+n=$(grep -c '"class":"RATE"' /tmp/watch.json)
+exact=$(grep '"class":"RATE"' /tmp/watch.json | grep -F "$want_raw" | grep -c -F "$want_accel")
+if [ "$n" = 5 ] && [ "$exact" = 5 ]; then
+  pass exact-values-14 "5 of 5 RATE lines: temp 30.81235294117647, raw [-3,250,-250] deg/s, accel [1.99072265625,-0.375,-2] g"
+else
+  fail exact-values-14 "$exact of $n exact: $(grep -m1 RATE /tmp/watch.json | cut -c1-400)"
+fi
+
 # CPUSchedulingPolicy=fifo is applied by systemd before RestrictRealtime=yes takes effect.
 policy=$(chrt -p "$pid" 2>&1 | tr '\n' ' ')
 if echo "$policy" | grep -q "SCHED_FIFO" && echo "$policy" | grep -q "priority: 10"; then

@@ -1,8 +1,10 @@
-// The guest helper of scripts/vm-kernel-test.sh: what a real MPU6050 does by itself that
-// i2c-stub's plain register cells do not, plus the few things the busybox init cannot do.
+// The guest helper of scripts/vm-kernel-test.sh and scripts/vm-systemd-test.sh: what a real
+// MPU6050 does by itself that i2c-stub's plain register cells do not, plus the few things the
+// busybox init cannot do.
 //
 //   vm_chip preload BUS            WHO_AM_I, TEMP_OUT, FIFO_COUNT and FIFO frames (values below)
-//   vm_chip emulate BUS            forever: clear DEVICE_RESET after a reset write, keep the cells
+//   vm_chip emulate BUS            forever: clear DEVICE_RESET after a reset write, serve the
+//                                  frames FIFO_EN asks for, keep the cells
 //   vm_chip silence BUS            FIFO_COUNT = 0: the chip stops producing samples (stop emulate first)
 //   vm_chip edges PULL_FILE N US   N rising edges on a gpio-sim line, one every US microseconds
 //   vm_chip rdwr BUS               exit 0 if I2C_RDWR fails with EOPNOTSUPP (an SMBus-only adapter)
@@ -10,10 +12,20 @@
 //   vm_chip exit CODE              power off through QEMU's isa-debug-exit (status 2*CODE+1)
 //
 // i2c-stub (SMBus only) keeps one 16-bit cell per register: byte transfers use its low byte,
-// word transfers the whole cell, I2C-block transfers the low bytes of consecutive cells. So a
-// FIFO burst at FIFO_R_W (0x74) reads the cells 0x74, 0x75, ... again and again: the frames
-// stay, FIFO_COUNT stays, and every wake-up reads the same known frame. WHO_AM_I (0x75) is
-// also byte 1 of the first frame, so every frame's temperature word ends in 0x68.
+// word transfers the whole cell, I2C-block transfers the low bytes of consecutive cells (at
+// most 32, and never past cell 0xFF). So a FIFO burst at FIFO_R_W (0x74) reads the cells 0x74,
+// 0x75, ... again and again: the frames stay, FIFO_COUNT stays, and every wake-up reads the
+// same known frame. vm_chip lays the cells 0x74 .. 0x93 out as whole frames repeated (byte i
+// = frame byte i mod the frame size) and holds FIFO_COUNT at one frame, so every burst gyrod
+// makes (one frame, or up to 32 bytes of whole frames) starts at a frame boundary.
+//
+// The frame size follows FIFO_EN, as the chip's does: with ACCEL_FIFO_EN (gyrod's default,
+// FIFO_EN 0xF8) 14-byte frames ACCEL_X, ACCEL_Y, ACCEL_Z, TEMP, GYRO_X, GYRO_Y, GYRO_Z;
+// without it (`accel = false`, FIFO_EN 0xF0, or before gyrod has written FIFO_EN) 8-byte
+// frames TEMP, GYRO_X, GYRO_Y, GYRO_Z. `emulate` reads FIFO_EN every turn (2 ms) and lays the
+// cells out again when the size changes; gyrod waits 50 ms between writing the table and
+// reading the FIFO. WHO_AM_I (0x75) is also byte 1 of the first frame: the low byte of the
+// temperature word in an 8-byte frame, of ACCEL_X in a 14-byte one; both end in 0x68.
 #define _GNU_SOURCE
 #include <errno.h>
 #include <fcntl.h>
@@ -32,21 +44,32 @@
 enum {
   kAddress = 0x68,
   kTempOut = 0x41,
+  kFifoEn = 0x23,
+  kAccelFifoEn = 0x08,
   kPwrMgmt1 = 0x6B,
   kFifoCount = 0x72,
   kFifoRw = 0x74,
   kWhoAmI = 0x75,
   kDeviceReset = 0x80,
   kSleep = 0x40,
-  kFrameBytes = 8,
-  kFrames = 4,  // one SMBus I2C-block read (32 bytes) of frames
+  kGyroFrameBytes = 8,    // TEMP, GYRO_X/Y/Z
+  kAccelFrameBytes = 14,  // ACCEL_X/Y/Z, TEMP, GYRO_X/Y/Z
+  kFifoCells = 32,        // one SMBus I2C-block read: 4 whole 8-byte frames, 2 whole 14-byte ones
 };
 
-// The frame every wake-up reads: TEMP, XG, YG, ZG, big-endian. The init script checks that
-// gyrod publishes exactly these: 131 LSB per deg/s at FS_SEL 0, deg C = word / 340 + 36.53.
-static const int16_t kTemp = (int16_t)0xF868;        // -1944: 30.8124 deg C; low byte = WHO_AM_I
-static const int16_t kGyro[3] = {131, -262, 655};    // 1, -2, 5 deg/s
-static const uint16_t kHeldFifoCount = kFrameBytes;  // one frame per wake-up, like one edge per sample
+// The frames every wake-up reads, big-endian words. The init scripts check that gyrod
+// publishes exactly these: deg C = word / 340 + 36.53; 131 LSB per deg/s at FS_SEL 0;
+// 16384 / 8192 / 4096 / 2048 LSB per g at AFS_SEL 0..3.
+static const int16_t kTemp = (int16_t)0xF868;  // -1944: 30.8124 deg C; low byte = WHO_AM_I
+// 8-byte frames (accel off): 1, -2, 5 deg/s.
+static const int16_t kGyro[3] = {131, -262, 655};
+// 14-byte frames (accel on): other values, so a frame of the wrong size cannot pass.
+// ACCEL_X 0x7F68 = 32616 (99.5 % of full scale; low byte = WHO_AM_I), ACCEL_Y 0xE800 = -6144,
+// ACCEL_Z 0x8000 = -32768 (negative full scale): 1.99072265625, -0.375, -2 g at AFS_SEL 0,
+// 7.962890625, -1.5, -8 g at AFS_SEL 2. Gyro 0xFE77 = -393, 0x7FEE = 32750, 0x8012 = -32750:
+// -3, 250, -250 deg/s (250 deg/s is 99.9 % of FS_SEL 0's full scale).
+static const int16_t kAccelFrameAccel[3] = {(int16_t)0x7F68, -6144, (int16_t)0x8000};
+static const int16_t kAccelFrameGyro[3] = {-393, 32750, -32750};
 
 static _Noreturn void die(const char* what) {
   fprintf(stderr, "vm_chip: %s: %s\n", what, strerror(errno));
@@ -92,27 +115,43 @@ static void writeWord(int fd, uint8_t reg, uint16_t cell) {
   if (smbus(fd, I2C_SMBUS_WRITE, reg, I2C_SMBUS_WORD_DATA, &d) < 0) die("write word");
 }
 
-static void frameBytes(uint8_t out[kFrameBytes]) {
-  const int16_t words[4] = {kTemp, kGyro[0], kGyro[1], kGyro[2]};
-  for (int i = 0; i < 4; ++i) {
-    out[2 * i] = (uint8_t)((uint16_t)words[i] >> 8);
-    out[2 * i + 1] = (uint8_t)((uint16_t)words[i] & 0xFF);
+static int frameSizeFor(int fifo_en) { return (fifo_en & kAccelFifoEn) ? kAccelFrameBytes : kGyroFrameBytes; }
+
+static void putWord(uint8_t* out, int16_t word) {
+  out[0] = (uint8_t)((uint16_t)word >> 8);
+  out[1] = (uint8_t)((uint16_t)word & 0xFF);
+}
+
+// One frame of `size` bytes (8 or 14) in FIFO order (register order, RM 4.31).
+static void frameBytes(int size, uint8_t out[kAccelFrameBytes]) {
+  if (size == kAccelFrameBytes) {
+    for (int i = 0; i < 3; ++i) putWord(out + 2 * i, kAccelFrameAccel[i]);
+    putWord(out + 6, kTemp);
+    for (int i = 0; i < 3; ++i) putWord(out + 8 + 2 * i, kAccelFrameGyro[i]);
+  } else {
+    putWord(out, kTemp);
+    for (int i = 0; i < 3; ++i) putWord(out + 2 + 2 * i, kGyro[i]);
   }
 }
 
-// Rewrites whatever differs from what the chip would hold; returns how many cells it fixed.
-static int keepCells(int fd) {
+// Rewrites whatever differs from what the chip would hold with `size`-byte frames; returns
+// how many cells it fixed.
+static int keepCells(int fd, int size) {
   int fixed = 0;
-  uint8_t frame[kFrameBytes];
-  frameBytes(frame);
-  for (int i = 0; i < kFrames * kFrameBytes; ++i) {
-    const uint8_t want = frame[i % kFrameBytes];
+  uint8_t frame[kAccelFrameBytes];
+  frameBytes(size, frame);
+  if (frame[1] != 0x68) {  // the frame's byte 1 is the WHO_AM_I cell (see the header)
+    fprintf(stderr, "vm_chip: a %d-byte frame's byte 1 must be WHO_AM_I (0x68)\n", size);
+    exit(2);
+  }
+  for (int i = 0; i < kFifoCells; ++i) {
+    const uint8_t want = frame[i % size];
     if (readByte(fd, (uint8_t)(kFifoRw + i)) != want) writeByte(fd, (uint8_t)(kFifoRw + i), want), ++fixed;
   }
   if (readByte(fd, kWhoAmI) != 0x68) writeByte(fd, kWhoAmI, 0x68), ++fixed;
   const uint16_t temp_cell = smbusCellFor((uint16_t)kTemp);
   if (readWord(fd, kTempOut) != temp_cell) writeWord(fd, kTempOut, temp_cell), ++fixed;
-  const uint16_t count_cell = smbusCellFor(kHeldFifoCount);
+  const uint16_t count_cell = smbusCellFor((uint16_t)size);  // one frame per wake-up, like one edge per sample
   if (readWord(fd, kFifoCount) != count_cell) writeWord(fd, kFifoCount, count_cell), ++fixed;
   return fixed;
 }
@@ -124,10 +163,20 @@ static void sleepUs(long us) {
 
 static int emulate(const char* bus) {
   const int fd = openBus(bus);
+  int size = 0;
   for (unsigned long turn = 0;; ++turn) {
     // A real part clears DEVICE_RESET itself and comes up asleep (PWR_MGMT_1 = 0x40).
     if (readByte(fd, kPwrMgmt1) & kDeviceReset) writeByte(fd, kPwrMgmt1, kSleep);
-    if (turn % 50 == 0) keepCells(fd);  // nothing but a reset should change them: look now and then
+    const int fifo_en = readByte(fd, kFifoEn);
+    if (frameSizeFor(fifo_en) != size) {  // gyrod wrote FIFO_EN: the frames change size now
+      size = frameSizeFor(fifo_en);
+      const int fixed = keepCells(fd, size);
+      printf("VMTEST vm_chip: FIFO_EN 0x%02x: serving %d-byte frames, FIFO_COUNT %d (%d cells written)\n", fifo_en,
+             size, size, fixed);
+      fflush(stdout);
+    } else if (turn % 50 == 0) {
+      keepCells(fd, size);  // nothing but a reset should change them: look now and then
+    }
     sleepUs(2000);
   }
   return 0;
@@ -180,7 +229,8 @@ int main(int argc, char** argv) {
   if (!strcmp(mode, "preload") && argc == 3) {
     const int fd = openBus(argv[2]);
     writeByte(fd, kPwrMgmt1, kSleep);
-    printf("vm_chip: preloaded (%d cells written)\n", keepCells(fd));
+    const int size = frameSizeFor(readByte(fd, kFifoEn));
+    printf("vm_chip: preloaded %d-byte frames (%d cells written)\n", size, keepCells(fd, size));
     return 0;
   }
   if (!strcmp(mode, "emulate") && argc == 3) return emulate(argv[2]);
