@@ -29,22 +29,21 @@ void requireClusterSize(std::size_t m, const char* where) {
   if (m == 0) throw std::invalid_argument(std::string(where) + " needs an averaging factor m of at least 1 (got 0)");
 }
 
-// Mean of the series by Neumaier-compensated summation; throws on a non-finite sample
-// so that no estimator ever silently turns a NaN reading into a number.
+// Mean of the series by Neumaier-compensated summation (four lanes: allan_kernels); throws
+// on a non-finite sample so that no estimator ever silently turns a NaN reading into a
+// number. Only a non-finite lane sum sends it through the serial loop that names the sample.
 double compensatedMean(std::span<const double> rate, const char* where) {
-  double sum = 0.0;
-  double compensation = 0.0;
+  if (rate.empty()) return 0.0;
+  const double sum = allan_kernels::compensatedSum(rate.data(), rate.size());
+  if (std::isfinite(sum)) return sum / static_cast<double>(rate.size());
   for (std::size_t i = 0; i < rate.size(); ++i) {
     const double v = rate[i];
     if (!std::isfinite(v)) {
       throw std::invalid_argument(std::string(where) + " cannot use rate sample " + std::to_string(i) +
                                   ": it is not finite (" + formatNumber(v) + ")");
     }
-    const double t = sum + v;
-    compensation += std::abs(sum) >= std::abs(v) ? (sum - t) + v : (v - t) + sum;
-    sum = t;
   }
-  return rate.empty() ? 0.0 : (sum + compensation) / static_cast<double>(rate.size());
+  return sum / static_cast<double>(rate.size());  // finite samples whose sum overflows
 }
 
 // Sum of squares accumulated in blocks: four interleaved partial sums inside a block
@@ -65,6 +64,9 @@ class SumOfSquares {
 };
 
 constexpr std::size_t kSumBlock = 4096;
+// Relative change of a block's sum of squares up to which the multi-m sweep may leave the
+// phase's lo parts out (IntegratedPhase::highOnlySuffices).
+constexpr double kHighOnlyTolerance = 1e-13;
 
 // The phase (integrated rate, NIST SP 1065 x_k with x₀ = 0 and τ0 = 1 sample) of the
 // mean-removed series, held as an unevaluated sum hi[k] + lo[k]. Removing the mean keeps
@@ -85,7 +87,10 @@ class IntegratedPhase {
         mean_(mean),
         hi_(allan_kernels::allocatePhaseStorage<double>(rate.size() + 1)),
         lo_(allan_kernels::allocatePhaseStorage<float>(rate.size() + 1)) {
-    allan_kernels::integratePhase(rate.data(), rate.size(), mean_, hi_.get(), lo_.get());
+    const float max_abs_lo = allan_kernels::integratePhase(rate.data(), rate.size(), mean_, hi_.get(), lo_.get());
+    // Each lo combination (lc − lb) − (lb − la) of four floats is at most 4·max|lo| (its
+    // two roundings in double add at most 2⁻⁵² of that; the margin covers them).
+    lo_term_bound_ = 4.0 * static_cast<double>(max_abs_lo) * (1.0 + 1e-12);
   }
 
   std::size_t rateCount() const { return rate_count_; }
@@ -138,22 +143,61 @@ class IntegratedPhase {
     return (p0 + p1) + (p2 + p3);
   }
 
+  // Whether a block's hi-only total (`high`, of `terms` squared differences) may stand for
+  // its full total: leaving the lo parts out moves each difference by at most E =
+  // lo_term_bound_, so ‖d − d̂‖ ≤ e = √terms·E and ‖d‖ ≥ ‖d̂‖ − e; with a = ‖d̂‖ = √high,
+  // |‖d‖² − ‖d̂‖²| ≤ 2ae + e². Accepted when that is at most kHighOnlyTolerance·(a − e)²,
+  // i.e. kHighOnlyTolerance of the block's exact total.
+  bool highOnlySuffices(double high, std::size_t terms) const {
+    const double e = std::sqrt(static_cast<double>(terms)) * lo_term_bound_;
+    const double a = std::sqrt(high);
+    if (!(a > e)) return false;
+    const double gap = a - e;
+    return 2.0 * a * e + e * e <= kHighOnlyTolerance * gap * gap;
+  }
+
+  // One block's total for the multi-m sweep: the hi-only total where highOnlySuffices says
+  // it may stand for the full one, else the full total (overlappingBlockTotal's bits). The
+  // hi-only total is the same bits from either kernel, so the result depends only on the
+  // block, never on `try_high_first` (a guess from the share's previous block that spares
+  // the lo reads when the hi-only total is likely to suffice).
+  double sweepBlockTotal(std::size_t m, std::size_t k, std::size_t block_end, bool& try_high_first) const {
+    const std::size_t terms = block_end - k;
+    if (try_high_first) {
+      const double high = allan_kernels::overlappingHighTotal(hi_.get(), m, k, block_end);
+      if (highOnlySuffices(high, terms)) return high;
+      try_high_first = false;
+      return overlappingBlockTotal(m, k, block_end);
+    }
+    const allan_kernels::BlockTotals t = allan_kernels::overlappingBlockTotals(hi_.get(), lo_.get(), m, k, block_end);
+    if (highOnlySuffices(t.high, terms)) {
+      try_high_first = true;
+      return t.high;
+    }
+    return t.full;
+  }
+
   // The overlapping variances at every m of `ms` in one cache-blocked sweep: for each block
   // of kSumBlock start indices, every m reads the phase at the block, m and 2m further on.
   // For octave m the offsets coincide (2·m_k = m_{k+1}), so the block and the nearer
   // offsets are still in cache when the next m needs them. The blocks are shared among
-  // threads; each block's total is kept and the totals are added in block order, so the
-  // result is the same bits as the one-m-at-a-time sum, for any number of threads.
+  // threads; each block's total (sweepBlockTotal: hi-only where that is proven within
+  // kHighOnlyTolerance) is kept and the totals are added in block order, so the result is
+  // the same bits for any number of threads.
   std::vector<double> overlappingAllanVariances(std::span<const std::size_t> ms) const {
     const std::size_t block_count = (rate_count_ + kSumBlock - 1) / kSumBlock;
     std::vector<double> block_totals(ms.size() * block_count, 0.0);
     const auto sweep = [&](std::size_t first_block, std::size_t end_block) {
+      std::vector<char> try_high_first(ms.size(), 0);
       for (std::size_t b = first_block; b < end_block; ++b) {
         const std::size_t k = b * kSumBlock;
         for (std::size_t j = 0; j < ms.size(); ++j) {
           const std::size_t terms = overlappingTerms(ms[j]);
-          if (k < terms)
-            block_totals[j * block_count + b] = overlappingBlockTotal(ms[j], k, std::min(terms, k + kSumBlock));
+          if (k < terms) {
+            bool guess = try_high_first[j] != 0;
+            block_totals[j * block_count + b] = sweepBlockTotal(ms[j], k, std::min(terms, k + kSumBlock), guess);
+            try_high_first[j] = guess ? 1 : 0;
+          }
         }
       }
     };
@@ -197,6 +241,7 @@ class IntegratedPhase {
   // 12 bytes a point).
   allan_kernels::PhaseStorage<double> hi_;
   allan_kernels::PhaseStorage<float> lo_;
+  double lo_term_bound_ = 0.0;  // bound on |(lc − lb) − (lb − la)| over the phase
 };
 
 // Lag-1 autocorrelation r1 = Σ (z_i − z̄)(z_{i+1} − z̄) / Σ (z_i − z̄)² and the spread

@@ -19,6 +19,25 @@ namespace gyrod::processing::allan_kernels {
 // the total is (lane0 + lane1) + (lane2 + lane3).
 double overlappingBlockTotal(const double* hi, const float* lo, std::size_t m, std::size_t k, std::size_t block_end);
 
+// The same sum twice in one pass: `full` as overlappingBlockTotal (the same bits), `high`
+// with the lo parts left out (d_i = (hi[i+2m] − hi[i+m]) − (hi[i+m] − hi[i]), the same lanes
+// and order).
+struct BlockTotals {
+  double full = 0.0;
+  double high = 0.0;
+};
+BlockTotals overlappingBlockTotals(const double* hi, const float* lo, std::size_t m, std::size_t k,
+                                   std::size_t block_end);
+// The hi-only sum alone, reading hi only: the same bits as BlockTotals::high.
+double overlappingHighTotal(const double* hi, std::size_t m, std::size_t k, std::size_t block_end);
+
+// Σ rate[i] by Neumaier-compensated summation in four lanes (lane j takes i ≡ j mod 4, the
+// tail lane 0), the lanes' sums then added in order with compensation and the four
+// compensations added last: error ≲ 2ε·|Σ| + O(ε²)·Σ|rate|, like one serial compensated
+// sum, and the same bits on every ISA. A non-finite sample makes the result non-finite
+// (so can an overflow).
+double compensatedSum(const double* rate, std::size_t count);
+
 // The phase of the mean-removed rate as the unevaluated sum hi[k] + lo[k], k = 0 … count
 // (hi[0] = lo[0] = 0): the double-double running sum of (rate[i] − mean), lo rounded to
 // float. Formed in fixed runs of kPhaseRun samples: every run's double-double total (pass 1),
@@ -28,8 +47,9 @@ double overlappingBlockTotal(const double* hi, const float* lo, std::size_t m, s
 // runs among threads. The run length is fixed, so the phase is the same bits for any number
 // of threads and any ISA; it differs from one serial running sum only by the errors of the
 // double-double additions (~ε²·|x| each, far below the float lo's 2⁻⁷⁷·|x|).
+// Returns the largest |lo[k]| written (a float, exact).
 inline constexpr std::size_t kPhaseRun = std::size_t{1} << 13;
-void integratePhase(const double* rate, std::size_t count, double mean, double* hi, float* lo);
+float integratePhase(const double* rate, std::size_t count, double mean, double* hi, float* lo);
 
 // Storage for a phase array, written once in full by its owner (not zero-filled). Blocks of
 // 4 MB or more are aligned to 2 MiB and, on Linux, marked for transparent huge pages: a
