@@ -94,7 +94,9 @@ struct SeriesStats {
   double spectral_log_ratio = kNaN;
   std::size_t spectral_bin = 0;
   double temp_slope = kNaN;
-  double step_stat = kNaN;  // stepStatistic of the low-passed residual
+  // Per Haar scale of c.scales: the largest |D_W| of the low-passed residual and the mean of
+  // D_W² over its positions (the replicas' pooled mean square standardises the scan).
+  std::vector<double> step_scale_max, step_scale_ms;
   double gm_statistic = kNaN;
   std::vector<double> psd, psd_max;
 };
@@ -107,10 +109,8 @@ double temperatureSlope(const std::vector<double>& y, const std::vector<double>&
 double gaussMarkovStatistic(const GaussMarkovCurveFit& fit);
 // Block means of x with their least-squares line removed.
 std::vector<double> lowPassedResidual(std::span<const double> x, const Context& c);
-// max over scales and positions of the standardised Haar difference of y; where, at which
-// scale and its signed size go to the optional outputs.
-double stepStatistic(const std::vector<double>& y, const Context& c, std::size_t* t_out, std::size_t* w_out,
-                     double* d_out);
+// The step scan's per-scale measures of y (model_check_steps.cpp) into s.step_scale_*.
+void measureStepScales(const std::vector<double>& y, const Context& c, SeriesStats& s);
 
 // ---- nulls and what the result reports of a statistic ----------------------------------
 

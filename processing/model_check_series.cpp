@@ -40,8 +40,7 @@ Context makeContext(const AxisModelCheckInput& in, std::span<const double> xd, s
   c.block = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(in.rate_hz)));
   if (c.n / c.block > kMaxBlocks) c.block = (c.n + kMaxBlocks - 1) / kMaxBlocks;
   c.blocks = c.n / c.block;
-  // Haar scales up to 1/16 of the record, so that a few steps leave most positions of every
-  // scale untouched and the median scale of stepStatistic stays that of the noise.
+  // Haar scales of the step scan (model_check_steps.cpp): 2, 4, … blocks, up to 1/16 of the record.
   for (std::size_t w = 2; 16 * w <= c.blocks; w *= 2) c.scales.push_back(w);
 
   const std::size_t nfft = fftLength(c.n);
@@ -80,26 +79,6 @@ std::vector<double> lowPassedResidual(std::span<const double> x, const Context& 
   return y;
 }
 
-// max over scales W and positions t of |D_W(t)| / σ̂_W, σ̂_W = median|D_W|/0.6745 over the
-// positions of the same series: a robust scale that a few sparse steps hardly move, so the
-// statistic does not depend on how much slow noise the fitted model has (only on its shape).
-double stepStatistic(const std::vector<double>& y, const Context& c, std::size_t* t_out, std::size_t* w_out,
-                     double* d_out) {
-  double best = 0.0;
-  for (std::size_t w : c.scales) {
-    const HaarScan h = haarScan(y, w);
-    const double sigma = h.median_abs / 0.6745;
-    const double v = sigma > 0.0 ? h.max_abs / sigma : 0.0;
-    if (v > best) {
-      best = v;
-      if (t_out) *t_out = h.argmax;
-      if (w_out) *w_out = w;
-      if (d_out) *d_out = h.value_at_max;
-    }
-  }
-  return best;
-}
-
 SeriesStats measureSeries(std::span<const double> xd, const Context& c, unsigned mask) {
   SeriesStats s;
   if (mask & (kStatAllan | kStatGaussMarkov)) {
@@ -127,7 +106,7 @@ SeriesStats measureSeries(std::span<const double> xd, const Context& c, unsigned
   if (mask & (kStatTemperature | kStatSteps)) {
     const std::vector<double> y = lowPassedResidual(xd, c);
     if ((mask & kStatTemperature) && !c.temp_blocks.empty()) s.temp_slope = temperatureSlope(y, c.temp_blocks);
-    if (mask & kStatSteps) s.step_stat = stepStatistic(y, c, nullptr, nullptr, nullptr);
+    if (mask & kStatSteps) measureStepScales(y, c, s);
   }
   return s;
 }

@@ -13,11 +13,9 @@ namespace {
 constexpr std::size_t kMaxSteps = 8;
 // The per-axis false-alarm budget (issue 13: at most 1 % of clean axes with any effect) is
 // spent where power is short: the step statistic gets 10 × the nominal α of a statistic
-// (1e-3 at the default 1e-4). Its null is the maximum over scales and positions of a
-// self-normalised Haar difference, which the Gumbel model of the thresholds fits well
-// (clean-data rates in docs/model-check.md). Measured on the detection curves: a step of
-// 8 × the Allan floor in an hour is a statistic of about 5.9 against a 1e-4 threshold of
-// 6.3 and a 1e-3 threshold of 5.7.
+// (1e-3 at the default 1e-4). Its null is the maximum over scales and positions of a Haar
+// difference standardised by the base model's sd at its scale (stepScanStatistic), which
+// the Gumbel model of the thresholds fits (clean-data rates in docs/model-check.md).
 constexpr double kStepAlphaFactor = 10.0;
 // Once one step is established, each further one is a question of how many, not whether:
 // it passes at 1 % (against the same null, on the series with the steps found so far
@@ -46,33 +44,31 @@ std::vector<double> withoutSteps(const std::vector<double>& y, std::vector<Block
   return r;
 }
 
-// stepStatistic with the positions within W blocks of a step already found left out (at
-// scale W): what a found step leaves behind (its size and place are estimates) must not
-// count as a further step. The standardisation is stepStatistic's, over every position.
-double furtherStepStatistic(const std::vector<double>& y, const Context& c, const std::vector<BlockStep>& found,
-                            BlockStep& where) {
+// The step scan: max over scales W and positions t of |D_W(t)| / sd_W, D_W(t) the mean of the
+// W blocks from t minus the mean of the W before, sd_W its standard deviation under the base
+// model (the root of the replicas' pooled mean square at that scale): the GLR of one step of
+// unknown time and height at each scale, each difference standardised by the noise the
+// model has at that scale (white, flicker, random walk, the chain; the line removal
+// included), not by the series' own spread. Positions within W blocks of a step in `found`
+// are left out at scale W: what a found step leaves behind (its size and place are
+// estimates) must not count as a further step. Returns 0 without a scale of positive sd.
+double stepScanStatistic(const std::vector<double>& y, const Context& c, const std::vector<double>& sd,
+                         const std::vector<BlockStep>& found, BlockStep* where) {
   std::vector<double> prefix(y.size() + 1, 0.0);
   for (std::size_t i = 0; i < y.size(); ++i) prefix[i + 1] = prefix[i] + y[i];
   double best = 0.0;
-  std::vector<double> d, abs_d;
-  for (std::size_t w : c.scales) {
-    if (2 * w > y.size()) continue;
-    d.clear();
-    for (std::size_t t = w; t + w <= y.size(); ++t)
-      d.push_back(((prefix[t + w] - prefix[t]) - (prefix[t] - prefix[t - w])) / static_cast<double>(w));
-    abs_d.resize(d.size());
-    for (std::size_t i = 0; i < d.size(); ++i) abs_d[i] = std::fabs(d[i]);
-    const auto mid = abs_d.begin() + static_cast<std::ptrdiff_t>(abs_d.size() / 2);
-    std::nth_element(abs_d.begin(), mid, abs_d.end());
-    const double sigma = *mid / 0.6745;
-    if (!(sigma > 0.0)) continue;
-    for (std::size_t i = 0; i < d.size(); ++i) {
-      const std::size_t t = i + w;
+  for (std::size_t j = 0; j < c.scales.size() && j < sd.size(); ++j) {
+    const std::size_t w = c.scales[j];
+    if (2 * w > y.size() || !(sd[j] > 0.0)) continue;
+    const double scale = 1.0 / (static_cast<double>(w) * sd[j]);
+    for (std::size_t t = w; t + w <= y.size(); ++t) {
+      const double d = (prefix[t + w] - 2.0 * prefix[t] + prefix[t - w]) * scale;
+      if (std::fabs(d) <= best) continue;
       bool near = false;
       for (const BlockStep& f : found) near = near || (t + w > f.block && t < f.block + w);
-      if (near || std::fabs(d[i]) / sigma <= best) continue;
-      best = std::fabs(d[i]) / sigma;
-      where = {t, w, d[i]};
+      if (near) continue;
+      best = std::fabs(d);
+      if (where) *where = {t, w, d * sd[j]};
     }
   }
   return best;
@@ -82,14 +78,13 @@ double furtherStepStatistic(const std::vector<double>& y, const Context& c, cons
 // (the first) or `further` (the others, away from those found), all sizes refitted jointly
 // and removed from y before looking for the next: a Haar difference alone misjudges a step
 // that has another within its window, and what it leaves behind looks like a further step.
-std::vector<BlockStep> findBlockSteps(const std::vector<double>& y, const Context& c, const NullSummary& null,
-                                      const NullSummary& further) {
+std::vector<BlockStep> findBlockSteps(const std::vector<double>& y, const Context& c, const std::vector<double>& sd,
+                                      const NullSummary& null, const NullSummary& further) {
   std::vector<BlockStep> steps;
   std::vector<double> r = y;
   while (steps.size() < kMaxSteps) {
     BlockStep next;
-    const double s = steps.empty() ? stepStatistic(r, c, &next.block, &next.scale, &next.size)
-                                   : furtherStepStatistic(r, c, steps, next);
+    const double s = stepScanStatistic(r, c, sd, steps, &next);
     if (!(steps.empty() ? null : further).fires(s)) break;
     steps.push_back(next);
     r = withoutSteps(y, steps);
@@ -122,17 +117,38 @@ std::vector<double> blockRegression(const std::vector<double>& y, const std::vec
 
 struct LowFrequencyNulls {
   NullSummary temp;
-  NullSummary steps;          // of stepStatistic, at the steps' share of the budget
-  NullSummary further_steps;  // the same null at kFurtherStepAlpha
+  std::vector<double> step_sd;  // sd of D_W per scale under the base model (the replicas')
+  NullSummary steps;            // of stepScanStatistic, at the steps' share of the budget
+  NullSummary further_steps;    // the same null at kFurtherStepAlpha
 };
 
-LowFrequencyNulls lowFrequencyNulls(const std::vector<SeriesStats>& reps, double alpha, bool temp, bool steps) {
+LowFrequencyNulls lowFrequencyNulls(const std::vector<SeriesStats>& reps, const Context& c, double alpha, bool temp,
+                                    bool steps) {
   LowFrequencyNulls n;
   if (temp) n.temp = summarizeNull(column(reps, &SeriesStats::temp_slope), alpha, true);
   if (!steps) return n;
+  // Pooled over the replicas and positions: the sd of D_W is then known to a few per cent
+  // (40 replicas × 100–3000 positions) where one series' own spread is not at the wide
+  // scales (a few dozen independent differences in 10 minutes, some of them the step's).
+  n.step_sd.assign(c.scales.size(), 0.0);
+  for (std::size_t j = 0; j < c.scales.size(); ++j) {
+    double sum = 0.0;
+    std::size_t count = 0;
+    for (const SeriesStats& r : reps)
+      if (j < r.step_scale_ms.size() && std::isfinite(r.step_scale_ms[j])) {
+        sum += r.step_scale_ms[j];
+        ++count;
+      }
+    n.step_sd[j] = count > 0 ? std::sqrt(sum / static_cast<double>(count)) : 0.0;
+  }
   std::vector<double> maxes;
   maxes.reserve(reps.size());
-  for (const SeriesStats& r : reps) maxes.push_back(r.step_stat);
+  for (const SeriesStats& r : reps) {
+    double m = 0.0;
+    for (std::size_t j = 0; j < n.step_sd.size() && j < r.step_scale_max.size(); ++j)
+      if (n.step_sd[j] > 0.0) m = std::max(m, r.step_scale_max[j] / n.step_sd[j]);
+    maxes.push_back(m);
+  }
   n.steps = summarizeNull(maxes, alpha * kStepAlphaFactor, false);
   // The Gumbel quantile alone: at 1 % the largest of a few dozen replicas would set it instead.
   n.further_steps = n.steps;
@@ -188,7 +204,7 @@ LowFrequencyNulls nullsAfterFurtherLooks(const std::vector<double>& xc, const Co
       std::vector<double> r = y;
       if (temp_suggestive)
         for (std::size_t i = 0; i < r.size(); ++i) r[i] -= k * c.temp_blocks[i];
-      candidates = findBlockSteps(r, c, lowered, lowered);
+      candidates = findBlockSteps(r, c, lf.step_sd, lowered, lowered);
     }
     const std::size_t signature = (temp_suggestive ? 1 : 0) + 2 * (candidates.size() + 1);
     if (!temp_suggestive && candidates.empty()) break;
@@ -204,7 +220,7 @@ LowFrequencyNulls nullsAfterFurtherLooks(const std::vector<double>& xc, const Co
     const std::vector<SeriesStats> reps = runReplicas(pureModel(c.rate, alt_fit.value), statisticalUncertainty(alt_fit),
                                                       c, {}, o, 4 + look, kStatTemperature | kStatSteps);
     out.replicas_simulated += o.replicas;
-    lf = lowFrequencyNulls(reps, o.false_alarm, have_temp, have_steps);
+    lf = lowFrequencyNulls(reps, c, o.false_alarm, have_temp, have_steps);
     looked = true;
   }
   return lf;
@@ -220,7 +236,7 @@ struct LowFrequencyTests {
     return have_temp && nulls.temp.fires(temperatureSlope(y, c.temp_blocks));
   }
   bool stepsFire(const std::vector<double>& y) const {
-    return have_steps && nulls.steps.fires(stepStatistic(y, c, nullptr, nullptr, nullptr));
+    return have_steps && nulls.steps.fires(stepScanStatistic(y, c, nulls.step_sd, {}, nullptr));
   }
   std::vector<double> minusTemperature(const std::vector<double>& y) const {
     std::vector<double> r = y;
@@ -237,7 +253,7 @@ struct LowFrequencyTests {
     return r;
   }
   std::vector<BlockStep> steps(const std::vector<double>& y) const {
-    return findBlockSteps(y, c, nulls.steps, nulls.further_steps);
+    return findBlockSteps(y, c, nulls.step_sd, nulls.steps, nulls.further_steps);
   }
 };
 
@@ -343,6 +359,17 @@ EffectEvidence lowFrequencyEvidence(double value, const NullSummary& null, std::
 
 }  // namespace
 
+void measureStepScales(const std::vector<double>& y, const Context& c, SeriesStats& s) {
+  s.step_scale_max.assign(c.scales.size(), 0.0);
+  s.step_scale_ms.assign(c.scales.size(), kNaN);
+  for (std::size_t j = 0; j < c.scales.size(); ++j) {
+    const HaarScan h = haarScan(y, c.scales[j]);
+    if (h.count == 0) continue;
+    s.step_scale_max[j] = h.max_abs;
+    s.step_scale_ms[j] = h.sum_squares / static_cast<double>(h.count);
+  }
+}
+
 bool checkTemperatureAndSteps(const AxisModelCheckInput& input, std::vector<double>& xc, const Context& c,
                               const TemperatureChannel& temp, const std::vector<SeriesStats>& base_reps,
                               const ModelCheckOptions& o, Removal& removal, AxisModelCheck& out) {
@@ -350,17 +377,17 @@ bool checkTemperatureAndSteps(const AxisModelCheckInput& input, std::vector<doub
   const bool have_steps = !c.scales.empty();
   bool second_look = false;
   const LowFrequencyNulls lf = nullsAfterFurtherLooks(
-      xc, c, temp.smoothed, lowFrequencyNulls(base_reps, o.false_alarm, have_temp, have_steps), o, out, second_look);
+      xc, c, temp.smoothed, lowFrequencyNulls(base_reps, c, o.false_alarm, have_temp, have_steps), o, out, second_look);
   const std::vector<double> y0 = lowPassedResidual(xc, c);
   out.block_residual_dps = y0;
   out.block_temperature_c = temp.raw_blocks;
   out.block_temperature_c.resize(std::min(temp.raw_blocks.size(), y0.size()));
 
   const double t_stat = have_temp ? temperatureSlope(y0, c.temp_blocks) : kNaN;
-  const double s_stat = have_steps ? stepStatistic(y0, c, nullptr, nullptr, nullptr) : kNaN;
+  const double s_stat = have_steps ? stepScanStatistic(y0, c, lf.step_sd, {}, nullptr) : kNaN;
   const std::string look = second_look ? " (second look)" : "";
   if (have_temp) out.statistics.push_back(makeStatistic("temperature_slope_dps_per_c" + look, t_stat, lf.temp));
-  if (have_steps) out.statistics.push_back(makeStatistic("step_haar_max_z" + look, s_stat, lf.steps));
+  if (have_steps) out.statistics.push_back(makeStatistic("step_scan_max_z" + look, s_stat, lf.steps));
   LowFrequencyChoice ch = chooseTemperatureOrSteps(y0, {c, lf, have_temp, have_steps});
   if (!ch.temperature && ch.steps.empty()) return false;
 
