@@ -5,21 +5,26 @@
 # printed before every row: on a shared machine compare CPU seconds and memory, not wall.
 # Not run by ctest.
 #
-#   bench/measure_analyze.sh [--gyroctl BIN] [--baseline BIN] FILE[:AXES]...
+#   bench/measure_analyze.sh [--gyroctl BIN] [--baseline BIN] [--steps] FILE[:AXES]...
 #     FILE:1 analyses --axis gx (the default), FILE:3 every axis.
+#     --steps: then each file once more with GYROD_ANALYZE_TIMING=1, the wall and CPU seconds
+#     of every step of this build (reading, checks, each axis's tests, Allan, mean filter, ...).
 set -eu
 repo=$(cd "$(dirname "$0")/.." && pwd)
 gyroctl="$repo/build/bin/gyroctl"
 baseline=""
+steps=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --gyroctl) gyroctl=$2; shift 2 ;;
     --baseline) baseline=$2; shift 2 ;;
+    --steps) steps=1; shift ;;
     --) shift; break ;;
-    -*) echo "usage: $0 [--gyroctl BIN] [--baseline BIN] FILE[:AXES]..." >&2; exit 2 ;;
+    -*) echo "usage: $0 [--gyroctl BIN] [--baseline BIN] [--steps] FILE[:AXES]..." >&2; exit 2 ;;
     *) break ;;
   esac
 done
+specs="$*"  # file names without spaces (the loop below reuses "$@")
 if [ ! -x /usr/bin/time ]; then echo "skipped: /usr/bin/time is missing (apt-get install time)"; exit 0; fi
 timing=$(mktemp)
 trap 'rm -f "$timing"' EXIT
@@ -48,6 +53,18 @@ for spec in "$@"; do
     row "$name analyze $(basename "$file") $* ($samples samples)" "$samples" "$axes" "$bin" analyze "$file" "$@"
   done
 done
+if [ -n "$steps" ]; then
+  for spec in $specs; do
+    file=${spec%:*}
+    echo
+    case "$spec" in
+      *:3) echo "steps of $(basename "$gyroctl") analyze $(basename "$file") (load $(cut -d' ' -f1 /proc/loadavg)):"
+           GYROD_ANALYZE_TIMING=1 "$gyroctl" analyze "$file" 2>&1 > /dev/null ;;
+      *) echo "steps of $(basename "$gyroctl") analyze $(basename "$file") --axis gx (load $(cut -d' ' -f1 /proc/loadavg)):"
+         GYROD_ANALYZE_TIMING=1 "$gyroctl" analyze "$file" --axis gx 2>&1 > /dev/null ;;
+    esac
+  done
+fi
 bench="$(dirname "$gyroctl")/bench_allan"
 if [ -x "$bench" ]; then
   echo

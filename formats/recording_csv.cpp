@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -14,6 +15,7 @@
 #include <span>
 #include <sstream>
 #include <string_view>
+#include <system_error>
 
 #include <sys/stat.h>
 
@@ -209,6 +211,16 @@ struct SliceResult {
   std::size_t lines = 0;                      // lines read (up to and including an error's)
   std::size_t samples = 0;
   std::string error;  // the cause of the first bad line (the slice's last), empty when none
+
+  // Empty again, keeping the columns' memory for the next slice.
+  void clear() {
+    for (auto& column : columns) column.clear();
+    line_runs.clear();
+    sample_lines.clear();
+    lost.clear();
+    lines = samples = 0;
+    error.clear();
+  }
 };
 
 // The sample lines' rules, the same for every slice: field count, numbers, comments and
@@ -227,6 +239,10 @@ struct SliceParser {
     std::array<std::string_view, kKnownColumns.size() + kStreamColumns.size()> fields;
     std::size_t start = 0;
     while (start < text.size()) {
+      if (const std::size_t next = parsePlainLine(text, start, out); next != 0) {
+        start = next;
+        continue;
+      }
       const auto nl = text.find('\n', start);
       const std::size_t end = nl == std::string_view::npos ? text.size() : nl;
       const std::string_view raw = text.substr(start, end - start);
@@ -251,6 +267,47 @@ struct SliceParser {
       }
       if (!consume(line, fields, out)) return;
     }
+  }
+
+  // The common line, in one pass: exactly one plain number per column (no sign '+', no
+  // spaces, nothing empty), separated by single commas, ending in '\n' or the text's end,
+  // within the length limit. Each field is then exactly what from_chars read up to the
+  // comma, which is what the general path below would parse from it: the same values. The
+  // sample is stored and the start of the next line returned; 0 (nothing stored) for any
+  // other line, left to the general path with its messages.
+  std::size_t parsePlainLine(std::string_view text, std::size_t start, SliceResult& out) const {
+    std::array<double, kKnownColumns.size() + kStreamColumns.size()> values{};
+    const char* p = text.data() + start;
+    const char* const end = text.data() + text.size();
+    const std::size_t columns = column_names.size();
+    if (columns > values.size()) return 0;
+    for (std::size_t c = 0; c < columns; ++c) {
+      if (p == end || *p == '+') return 0;
+      const auto [after, ec] = std::from_chars(p, end, values[c]);
+      if (ec != std::errc() || after == p || !std::isfinite(values[c])) return 0;
+      p = after;
+      if (c + 1 < columns) {
+        if (p == end || *p != ',') return 0;
+        ++p;
+      } else if (p != end && *p != '\n') {
+        return 0;
+      }
+    }
+    const auto line_end = static_cast<std::size_t>(p - text.data());
+    if (line_end - start > max_bytes) return 0;
+    ++out.lines;
+    for (std::size_t c = 0; c < columns; ++c) out.columns[c].push_back(values[c]);
+    recordSample(out);
+    return line_end + 1;  // past the '\n' (or the end of the text)
+  }
+
+  // The line and run bookkeeping of a sample just stored.
+  void recordSample(SliceResult& out) const {
+    if (line_numbers) out.sample_lines.push_back(out.lines);
+    if (out.line_runs.empty() ||
+        out.line_runs.back().first_line + (out.samples - out.line_runs.back().first_sample) != out.lines)
+      out.line_runs.push_back({out.samples, out.lines});
+    ++out.samples;
   }
 
   bool consume(std::string_view line, std::span<std::string_view> fields, SliceResult& out) const {
@@ -278,11 +335,7 @@ struct SliceParser {
       }
       out.columns[c].push_back(*value);
     }
-    if (line_numbers) out.sample_lines.push_back(out.lines);
-    if (out.line_runs.empty() ||
-        out.line_runs.back().first_line + (out.samples - out.line_runs.back().first_sample) != out.lines)
-      out.line_runs.push_back({out.samples, out.lines});
-    ++out.samples;
+    recordSample(out);
     return true;
   }
 };
@@ -462,6 +515,7 @@ Recording parseRecordingFile(std::FILE* file, const std::string& path, const Rea
   }
   // The rest in batches of whole lines (about a chunk each), each cut in two slices that are
   // parsed on both cores and appended in file order: the first bad line is still the one named.
+  SliceResult front_slice, back_slice;  // reused: their columns are allocated once
   while (true) {
     const auto result = reader.nextLines();
     if (result == ChunkedLineReader::Result::End) break;
@@ -469,7 +523,8 @@ Recording parseRecordingFile(std::FILE* file, const std::string& path, const Rea
     const std::string_view text = reader.line();
     const std::uint64_t text_start = reader.bytesConsumed() - text.size();
     const auto [front, back] = splitAtLineNearMiddle(text);
-    SliceResult front_slice, back_slice;
+    front_slice.clear();
+    back_slice.clear();
     if (back.empty())
       parser.parse(front, front_slice);
     else

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <stdexcept>
 
 #include "processing/parallel_share.hpp"
@@ -52,26 +54,90 @@ double peakDeviationFromMean(std::span<const double> x) {
 
 namespace {
 
-// GrossErrorMeanFilter's output over x, in contiguous shares on the cores. Its output is a
-// function of the window's samples in time order only, so a share starting at i0 first feeds
-// its own filter the L − 1 samples before i0 (or all from 0 while the window is filling) and
-// then gives the same bits as one filter run from the start. x is finite (the tests on the
-// raw series have checked it), so no share throws.
-std::vector<double> meanFiltered(std::span<const double> x, std::size_t window, double threshold) {
+// GrossErrorMeanFilter's outputs out[i], first ≤ i < end, for full windows (i ≥ L − 1):
+// the window of out[i] is x[i − L + 1 .. i], contiguous in x. The filter sums the window in
+// time order, then the kept samples in time order; here four outputs are formed at once,
+// each lane doing exactly those additions in that order (four independent chains instead of
+// one: the same bits, about four times the speed). A rejected sample adds +0.0 to its lane's
+// kept sum, which changes no bit: that sum starts at +0.0 and so is never −0.0.
+void meanFilterFullWindows(const double* x, std::size_t window, double threshold, double* out, std::size_t first,
+                           std::size_t end) {
+  // Four lanes as two pairs in GCC/Clang vector types (one SSE2 or NEON register each;
+  // elementwise IEEE operations, no fused multiply-add: the bits of the scalar code).
+  using Pair = double __attribute__((vector_size(16)));
+  using PairBits = std::int64_t __attribute__((vector_size(16)));
+  constexpr std::size_t kLanes = 4;
+  const auto n = static_cast<double>(window);
+  const Pair n_pair = {n, n}, threshold_pair = {threshold, threshold}, ones = {1.0, 1.0};
+  const PairBits no_sign = {INT64_MAX, INT64_MAX};
+  std::size_t i = first;
+  for (; i + kLanes <= end; i += kLanes) {
+    const double* w = x + (i + 1 - window);  // lane k's window starts at w + k
+    Pair sum_lo = {}, sum_hi = {};
+    for (std::size_t j = 0; j < window; ++j) {
+      Pair lo, hi;
+      std::memcpy(&lo, w + j, sizeof lo);
+      std::memcpy(&hi, w + j + 2, sizeof hi);
+      sum_lo += lo;
+      sum_hi += hi;
+    }
+    const Pair m_lo = sum_lo / n_pair, m_hi = sum_hi / n_pair;
+    Pair kept_sum_lo = {}, kept_sum_hi = {}, kept_lo = {}, kept_hi = {};
+    for (std::size_t j = 0; j < window; ++j) {
+      Pair lo, hi;
+      std::memcpy(&lo, w + j, sizeof lo);
+      std::memcpy(&hi, w + j + 2, sizeof hi);
+      // keep: |v − m| ≤ r, all ones or zero; a kept v adds itself, a rejected one +0.0.
+      const PairBits keep_lo =
+          reinterpret_cast<Pair>(reinterpret_cast<PairBits>(lo - m_lo) & no_sign) <= threshold_pair;
+      const PairBits keep_hi =
+          reinterpret_cast<Pair>(reinterpret_cast<PairBits>(hi - m_hi) & no_sign) <= threshold_pair;
+      kept_sum_lo += reinterpret_cast<Pair>(reinterpret_cast<PairBits>(lo) & keep_lo);
+      kept_sum_hi += reinterpret_cast<Pair>(reinterpret_cast<PairBits>(hi) & keep_hi);
+      kept_lo += reinterpret_cast<Pair>(reinterpret_cast<PairBits>(ones) & keep_lo);
+      kept_hi += reinterpret_cast<Pair>(reinterpret_cast<PairBits>(ones) & keep_hi);
+    }
+    const Pair mean_lo = kept_sum_lo / kept_lo, mean_hi = kept_sum_hi / kept_hi;
+    out[i] = kept_lo[0] == 0.0 ? m_lo[0] : mean_lo[0];
+    out[i + 1] = kept_lo[1] == 0.0 ? m_lo[1] : mean_lo[1];
+    out[i + 2] = kept_hi[0] == 0.0 ? m_hi[0] : mean_hi[0];
+    out[i + 3] = kept_hi[1] == 0.0 ? m_hi[1] : mean_hi[1];
+  }
+  for (; i < end; ++i) {  // the last few, one at a time, the same operations
+    const double* w = x + (i + 1 - window);
+    double sum = 0.0;
+    for (std::size_t j = 0; j < window; ++j) sum += w[j];
+    const double m = sum / n;
+    double kept_sum = 0.0, kept = 0.0;
+    for (std::size_t j = 0; j < window; ++j)
+      if (std::abs(w[j] - m) <= threshold) {
+        kept_sum += w[j];
+        kept += 1.0;
+      }
+    out[i] = kept == 0.0 ? m : kept_sum / kept;
+  }
+}
+
+}  // namespace
+
+// In contiguous shares on the cores: the first L − 1 outputs (the window filling) from the
+// filter itself, the rest from full windows read in place.
+std::vector<double> grossErrorMeanFiltered(std::span<const double> x, std::size_t window, double threshold) {
   std::vector<double> out(x.size());
-  const GrossErrorMeanFilter validated(window, threshold);  // throws for bad parameters here, not in a thread
+  GrossErrorMeanFilter filling(window, threshold);  // throws for bad parameters or samples here, not in a thread
+  const std::size_t filled_from = std::min(x.size(), window - 1);
+  for (std::size_t i = 0; i < filled_from; ++i) out[i] = filling.update(x[i]);
+  for (double v : x.subspan(filled_from))
+    if (!std::isfinite(v)) filling.update(v);  // throws, naming the value
+  const std::size_t rest = x.size() - filled_from;
   forEachShare(
-      x.size(),
+      rest,
       [&](std::size_t first, std::size_t end) {
-        GrossErrorMeanFilter mean(window, threshold);
-        for (std::size_t i = first >= window - 1 ? first - (window - 1) : 0; i < first; ++i) mean.update(x[i]);
-        for (std::size_t i = first; i < end; ++i) out[i] = mean.update(x[i]);
+        meanFilterFullWindows(x.data(), window, threshold, out.data(), filled_from + first, filled_from + end);
       },
       std::size_t{1} << 16);
   return out;
 }
-
-}  // namespace
 
 AxisAnalysis analyzeAxis(std::span<const double> rate_dps, const AnalysisOptions& options) {
   return analyzeAxis(std::vector<double>(rate_dps.begin(), rate_dps.end()), options);
@@ -85,6 +151,9 @@ AxisAnalysis analyzeAxis(std::vector<double>&& rate_dps, const AnalysisOptions& 
     throw std::invalid_argument("the axis analysis needs a sample rate that is a positive number of Hz, got " +
                                 std::to_string(options.rate_hz));
   const double tau0 = 1.0 / options.rate_hz;
+  const auto step = [&](const char* name) {
+    if (options.step_done) options.step_done(name);
+  };
   AxisAnalysis a;
   a.samples = rate_dps.size();
 
@@ -96,21 +165,25 @@ AxisAnalysis analyzeAxis(std::vector<double>&& rate_dps, const AnalysisOptions& 
         a.reverse_arrangements = reverseArrangementsTest(rate_dps, options.reverse_arrangements_segments);
       },
       [&] { a.normality = chiSquareNormalityTest(rate_dps); });
+  step("tests");
 
   // 2. Preprocessing (§3.2.2), in place: the raw series is not needed again.
   std::vector<double> x = std::move(rate_dps);
   if (options.detrend) a.trend_removed = removeLinearTrend(x, tau0);
+  step("detrend");
 
   // 3. Allan deviation and noise terms (§3.2.3, Table 2).
   std::vector<std::size_t> ms = options.cluster_sizes.empty() ? octaveClusterSizes(x.size()) : options.cluster_sizes;
   a.allan = allanDeviationTable(x, tau0, ms);
   a.noise = fitNoiseTerms(a.allan);
   a.noise_from_slopes = readNoiseTermsFromSlopes(a.allan);
+  step("allan and fit");
 
   // 4–6. Mean filter, AR models of its output, Kalman on AR(1) (§4–5). The mean filter runs
   // once: its output identifies the Kalman and then feeds it, exactly as AxisFilterChain
   // (mean filter, then Kalman) would on the same series.
-  std::vector<double> filtered = meanFiltered(x, options.mean_window, options.mean_threshold_dps);
+  std::vector<double> filtered = grossErrorMeanFiltered(x, options.mean_window, options.mean_threshold_dps);
+  step("mean filter");
   // The identification and the AR models beside the spreads: all only read x and filtered.
   double peak_raw = 0.0;
   runBoth(
@@ -128,11 +201,13 @@ AxisAnalysis analyzeAxis(std::vector<double>&& rate_dps, const AnalysisOptions& 
         peak_raw = raw.peak;
         a.variance.mean = varianceAboutMean(filtered);
       });
+  step("identification, AR, spreads");
   x = std::vector<double>();  // the Kalman output takes the mean-filter output's place
 
   ScalarKalmanFilter kalman(a.filter.kalman);
   for (double& v : filtered) v = kalman.update(v);
   const std::vector<double>& kalman_filtered = filtered;
+  step("kalman");
 
   // Table 4: the same Allan analysis on the Kalman output, beside its spread.
   runBoth([&] { a.allan_after_kalman = allanDeviationTable(kalman_filtered, tau0, ms); },
@@ -142,6 +217,7 @@ AxisAnalysis analyzeAxis(std::vector<double>&& rate_dps, const AnalysisOptions& 
             a.peak_ratio = peak_raw > 0.0 ? after.peak / peak_raw : 0.0;
           });
   a.noise_after_kalman = fitNoiseTerms(a.allan_after_kalman);
+  step("allan after kalman");
   return a;
 }
 

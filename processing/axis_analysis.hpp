@@ -4,6 +4,7 @@
 // terms (Table 2) → mean filter → AR(1..p) by Yule–Walker with AIC (Table 3) →
 // Kalman on AR(1) → variances and peak ratio → noise terms after Kalman (Table 4).
 #include <cstddef>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "processing/ar_model.hpp"
 #include "processing/detrend.hpp"
 #include "processing/filter_chain.hpp"
+#include "processing/mean_filter.hpp"
 #include "processing/noise_fit.hpp"
 #include "processing/statistics_tests.hpp"
 
@@ -25,6 +27,9 @@ struct AnalysisOptions {
   std::size_t max_ar_order = 3;
   std::size_t reverse_arrangements_segments = 100;
   KalmanOverrides kalman_overrides;
+  // Called with the name of each step as it ends ("tests", "allan", ...): for timing the
+  // steps (gyroctl analyze, GYROD_ANALYZE_TIMING); empty, nothing is called.
+  std::function<void(const char*)> step_done;
 };
 
 struct VarianceComparison {
@@ -54,6 +59,10 @@ AxisAnalysis analyzeAxis(std::span<const double> rate_dps, const AnalysisOptions
 // The same, consuming the series (it becomes the detrended working copy): peak memory of
 // three series' worth of doubles, 24 bytes a sample, instead of four.
 AxisAnalysis analyzeAxis(std::vector<double>&& rate_dps, const AnalysisOptions& options);
+
+// GrossErrorMeanFilter(window, threshold) run over x from its start: its outputs, the same
+// bits, computed on the cores and several windows at a time. Throws as the filter does.
+std::vector<double> grossErrorMeanFiltered(std::span<const double> x, std::size_t window, double threshold);
 
 // Population variance about the mean, and max |x − mean|.
 double varianceAboutMean(std::span<const double> x);

@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <bit>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -169,6 +172,76 @@ TEST(RecordingReading, ProgressIsReportedEveryMillionLines) {
   EXPECT_EQ(rec.size(), count);
   EXPECT_EQ(reported_lines, (std::vector<std::size_t>{kProgressLines, 2 * kProgressLines}));
   EXPECT_EQ(reported_bytes, (std::vector<std::uint64_t>{2 * kProgressLines, 4 * kProgressLines}));
+}
+
+// Plain lines ("number,number\n") are read in one pass by from_chars; any other form (spaces,
+// a '+', CRLF, an empty stream field) by the general path. Both must give the same bits:
+// here every value is written plainly in one file and decorated, every other line, in the
+// other, across several 1 MiB chunks, and the two readings must agree bit for bit.
+TEST(RecordingReading, PlainAndDecoratedLinesGiveTheSameValues) {
+  std::ostringstream plain, mixed;
+  plain.precision(17);
+  mixed.precision(17);
+  plain << "t,gx,gy\n";
+  mixed << "t,gx,gy\n";
+  std::uint64_t state = 20261125;
+  const auto next = [&] {  // a deterministic spread of magnitudes and signs
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    const double unit = static_cast<double>(state >> 11) / 9007199254740992.0;
+    return (unit - 0.5) * std::pow(10.0, static_cast<double>(state % 13) - 6.0);
+  };
+  const std::size_t count = 90'000;
+  for (std::size_t i = 0; i < count; ++i) {
+    const double t = 0.02 * static_cast<double>(i), gx = next(), gy = next();
+    plain << t << ',' << gx << ',' << gy << '\n';
+    if (i % 2 == 0)
+      mixed << t << ',' << gx << ',' << gy << '\n';
+    else if (i % 6 == 1)
+      mixed << ' ' << t << " ,\t" << gx << ", " << gy << " \r\n";
+    else if (i % 6 == 3)
+      mixed << t << ',' << (gx >= 0 ? "+" : "") << gx << ',' << gy << "\r\n";
+    else
+      mixed << t << ',' << gx << ',' << (gy >= 0 ? "+" : "") << gy << '\n';
+  }
+  ASSERT_GT(plain.str().size(), 3u << 20);
+  std::vector<Recording> read;
+  for (const std::string& text : {plain.str(), mixed.str()}) {
+    TempFile f(text);
+    read.push_back(readRecordingCsv(f.path()));
+  }
+  ASSERT_EQ(read[0].size(), count);
+  ASSERT_EQ(read[1].size(), count);
+  for (std::size_t i = 0; i < count; ++i) {
+    ASSERT_EQ(std::bit_cast<std::uint64_t>(read[0].t[i]), std::bit_cast<std::uint64_t>(read[1].t[i])) << i;
+    for (std::size_t a = 0; a < 2; ++a)
+      ASSERT_EQ(std::bit_cast<std::uint64_t>(read[0].axes[a][i]), std::bit_cast<std::uint64_t>(read[1].axes[a][i]))
+          << "sample " << i << ", axis " << a;
+    ASSERT_EQ(read[0].lineOfSample(i), i + 2);
+    ASSERT_EQ(read[1].lineOfSample(i), i + 2);
+  }
+  // And the values are the numbers written (17 digits: the doubles themselves).
+  state = 20261125;
+  for (std::size_t i = 0; i < count; ++i) {
+    ASSERT_EQ(read[0].axes[0][i], next()) << i;
+    ASSERT_EQ(read[0].axes[1][i], next()) << i;
+  }
+}
+
+// A bad value in a plain-looking line is still named with its file:line by the general path.
+TEST(RecordingReading, ABadValueAmongPlainLinesIsNamed) {
+  std::string text = "t,gx\n";
+  for (int i = 0; i < 1000; ++i) text += std::to_string(i) + ".5,0.25\n";
+  text += "1000.5,0.2x5\n";
+  TempFile f(text);
+  try {
+    readRecordingCsv(f.path());
+    FAIL() << "no error";
+  } catch (const RecordingError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(f.path() + ":1002: column 'gx': "), std::string::npos) << message;
+    EXPECT_NE(message.find("0.2x5"), std::string::npos) << message;
+    EXPECT_NE(message.find("is not a number"), std::string::npos) << message;
+  }
 }
 
 }  // namespace

@@ -3,7 +3,11 @@
 // copying overload.
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <cstdint>
+#include <limits>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 #include "processing/axis_analysis.hpp"
@@ -59,3 +63,37 @@ TEST(AxisAnalysis, FilterFiguresAreThoseOfTheFilterChain) {
 }
 
 }  // namespace
+
+// The mean filter of analyzeAxis (four windows at a time, in shares on the cores) gives the
+// bits of GrossErrorMeanFilter run sample by sample, for windows short and long, lengths
+// that are not a multiple of four, and gross errors that the rejection drops.
+TEST(AxisAnalysis, MeanFilterOutputIsTheFiltersBitForBit) {
+  const std::vector<double> raw = stillAxis(150'003, 11);
+  for (const std::size_t window : {std::size_t{1}, std::size_t{2}, std::size_t{3}, std::size_t{20}, std::size_t{57}})
+    for (const double threshold : {0.3, 0.02}) {
+      GrossErrorMeanFilter filter(window, threshold);
+      const std::vector<double> out = grossErrorMeanFiltered(raw, window, threshold);
+      ASSERT_EQ(out.size(), raw.size());
+      std::size_t rejected_somewhere = 0;
+      for (std::size_t i = 0; i < raw.size(); ++i) {
+        const double expected = filter.update(raw[i]);
+        rejected_somewhere += filter.lastRejected() > 0 ? 1 : 0;
+        ASSERT_EQ(std::bit_cast<std::uint64_t>(out[i]), std::bit_cast<std::uint64_t>(expected))
+            << "window " << window << ", threshold " << threshold << ", sample " << i;
+      }
+      if (window > 1) {  // the rejection was exercised
+        EXPECT_GT(rejected_somewhere, 0u) << "window " << window;
+      }
+    }
+  // Shorter than a window: only the filling outputs.
+  const std::vector<double> few(raw.begin(), raw.begin() + 7);
+  GrossErrorMeanFilter filter(20, 0.3);
+  const std::vector<double> out = grossErrorMeanFiltered(few, 20, 0.3);
+  for (std::size_t i = 0; i < few.size(); ++i) EXPECT_EQ(out[i], filter.update(few[i]));
+}
+
+TEST(AxisAnalysis, MeanFilterRefusesANonFiniteSampleAsTheFilterDoes) {
+  std::vector<double> raw = stillAxis(1000, 12);
+  raw[700] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(grossErrorMeanFiltered(raw, 20, 0.3), std::invalid_argument);
+}

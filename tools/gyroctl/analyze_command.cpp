@@ -2,6 +2,8 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <ctime>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -54,6 +56,35 @@ void releaseColumnsNotAnalysed(recording::Recording& rec) {
   rec.temp = std::vector<double>();
   for (auto& truth : rec.true_rate) truth = std::vector<double>();
 }
+
+// GYROD_ANALYZE_TIMING=1: each step's wall and process CPU seconds on stderr, as it ends
+// (bench/measure_analyze.sh --steps), to see where the time goes and where a core idles.
+class StepTimer {
+ public:
+  StepTimer() : enabled_(std::getenv("GYROD_ANALYZE_TIMING") != nullptr) { last_ = now(); }
+  bool enabled() const { return enabled_; }
+  void operator()(const std::string& step) {
+    if (!enabled_) return;
+    const Times t = now();
+    const double wall = t.wall - last_.wall, cpu = t.cpu - last_.cpu;
+    std::fprintf(stderr, "step %-36s wall %7.3f s  cpu %7.3f s  cpu/wall %4.2f\n", step.c_str(), wall, cpu,
+                 wall > 0.0 ? cpu / wall : 0.0);
+    last_ = t;
+  }
+
+ private:
+  struct Times {
+    double wall = 0.0, cpu = 0.0;
+  };
+  static double seconds(clockid_t clock) {
+    timespec ts{};
+    clock_gettime(clock, &ts);
+    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+  }
+  static Times now() { return {seconds(CLOCK_MONOTONIC), seconds(CLOCK_PROCESS_CPUTIME_ID)}; }
+  bool enabled_;
+  Times last_;
+};
 
 // The unit of a column's values, for key names ("dps", "g") and for text ("deg/s", "g").
 const char* unitKey(SensorKind s) { return s == SensorKind::Accel ? "g" : "dps"; }
@@ -340,12 +371,14 @@ int runAnalyze(const AnalyzeOptions& opt) {
       if (active) std::fputs("\r\033[K", stderr);
     }
   } const clear_progress{stderrIsTerminal()};
+  StepTimer step_timer;
   recording::ReadOptions read;
   read.line_numbers = false;  // the line runs name any sample's line: 8 bytes a sample saved
   read.progress = readingProgress(opt.file);
   // An accelerometer column is not among the gyro axes loadInput picks from.
   LoadedInput in = loadInput(opt.file, opt.rate_hz, isAccelColumn(opt.axis) ? "all" : opt.axis, read);
   selectAccelColumns(in, opt.axis);
+  step_timer("read");
   auto& rec = in.recording;
   const std::size_t samples = rec.size();
   if (rec.size() < kMinimumSamples) {
@@ -365,6 +398,7 @@ int runAnalyze(const AnalyzeOptions& opt) {
   reportTiming(opt.file, timing, opt.strict_timing);
   const bool writes_model = !opt.write_model.empty();
   if (!writes_model) releaseColumnsNotAnalysed(rec);
+  step_timer("checks");
   std::vector<AxisAnalysis> analyses;
   analyses.reserve(in.axis_indices.size());
   const bool show_progress = samples >= kProgressSamples && stderrIsTerminal();
@@ -376,6 +410,10 @@ int runAnalyze(const AnalyzeOptions& opt) {
     AnalysisOptions column_options = options;
     if (sensorOfColumn(rec.axis_names[idx]) == SensorKind::Accel)
       column_options.mean_threshold_dps = opt.accel_mean_threshold_g;
+    if (step_timer.enabled())
+      column_options.step_done = [&step_timer, &name = rec.axis_names[idx]](const char* step) {
+        step_timer(name + " " + step);
+      };
     analyses.push_back(analyzeColumn(rec, idx, column_options, writes_model));
   }
   if (show_progress) std::fprintf(stderr, "\r\033[K");
@@ -424,6 +462,8 @@ int runAnalyze(const AnalyzeOptions& opt) {
   }
   if (!opt.kalibr.output.empty()) writeKalibrImu(opt, in, analyses);
   if (opt.json) std::cout << doc.dump(1) << '\n';
+  std::cout.flush();
+  step_timer("output");
   return kExitOk;
 }
 
