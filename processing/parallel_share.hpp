@@ -3,6 +3,7 @@
 // Callers write each share's results to their own slots and combine them in index order
 // afterwards, so a result never depends on the number of threads.
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
 #include <exception>
 #include <thread>
@@ -13,7 +14,16 @@ namespace gyrod::processing {
 // Threads worth starting: the cores, at most kMaxShareThreads (the loops it serves are
 // memory-bound beyond a few cores).
 inline constexpr std::size_t kMaxShareThreads = 4;
+
+// A fixed thread count instead of the cores' (0: the cores), so that a test can show a result
+// is the same bits with 1, 2, 3 or more threads whatever machine it runs on.
+inline std::atomic<std::size_t>& shareThreadOverride() {
+  static std::atomic<std::size_t> threads{0};
+  return threads;
+}
 inline std::size_t shareThreadCount() {
+  const std::size_t fixed = shareThreadOverride().load(std::memory_order_relaxed);
+  if (fixed != 0) return fixed;
   return std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, kMaxShareThreads);
 }
 

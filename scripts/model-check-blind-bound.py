@@ -28,7 +28,7 @@ rows = []
 # steps: two-sided, 7 dyadic scales known-form; blind x positions (n_blocks/W effective: 100..600)
 for npos in (100, 600):
     r = z(1e-3 / (2 * 7 * npos)) / z(0.01 / (2 * 7))
-    rows.append(("bias_steps N_pos=%d" % npos, 3.6, 12.7, r))
+    rows.append(("bias_steps N_pos=%d" % npos, 3.6, 9.75, r))  # check: session 7
 # sinusoid: chi2(2); known 1 %; blind over 15000 bins at 1e-4
 kn = lam50(-2 * math.log(0.01)); bl = lam50(-2 * math.log(1e-4 / 15000))
 rows.append(("sinusoid N=15000", 0.025, 0.080, math.sqrt(bl / kn)))

@@ -1,0 +1,100 @@
+// "Same bits for any thread count" (docs/method.md, "Long recordings"): the Allan sweep, the
+// phase integration in runs, the mean filter's shares and analyzeAxis's steps side by side give
+// the same bits with 1, 2, 3 and 5 threads. The thread count is fixed through
+// shareThreadOverride, so the test means the same on a 2-core CI machine and a 64-core one.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "processing/allan.hpp"
+#include "processing/axis_analysis.hpp"
+#include "processing/parallel_share.hpp"
+
+using namespace gyrod::processing;
+
+namespace {
+
+class FixedThreads {
+ public:
+  explicit FixedThreads(std::size_t n) { shareThreadOverride().store(n); }
+  ~FixedThreads() { shareThreadOverride().store(0); }
+  FixedThreads(const FixedThreads&) = delete;
+  FixedThreads& operator=(const FixedThreads&) = delete;
+};
+
+std::uint64_t bitsOf(double v) {
+  std::uint64_t b = 0;
+  std::memcpy(&b, &v, sizeof b);
+  return b;
+}
+
+// A still gyro's rate: a bias, white noise and a slow random walk, from a seed. Long enough
+// for many 4096-index sweep blocks, several 8192-sample integration runs and octave m past
+// 4096 (where the sweep may read the phase's double part only).
+std::vector<double> stillGyroRate(std::size_t n, std::uint32_t seed) {
+  std::mt19937_64 gen(seed);
+  std::normal_distribution<double> white(0.0, 0.05);
+  std::normal_distribution<double> walk(0.0, 2e-5);
+  std::vector<double> x(n);
+  double drift = 0.0;
+  for (double& v : x) {
+    drift += walk(gen);
+    v = 0.8 + drift + white(gen);
+  }
+  return x;
+}
+
+constexpr std::size_t kThreadCounts[] = {1, 2, 3, 5};
+
+}  // namespace
+
+TEST(ParallelShares, OverlappingAllanVariancesAreTheSameBitsForAnyThreadCount) {
+  const std::vector<double> x = stillGyroRate(300'000, 11);
+  const std::vector<std::size_t> ms = octaveClusterSizes(x.size());
+  ASSERT_GT(ms.back(), 4096u);
+  std::vector<double> reference;
+  {
+    const FixedThreads one(1);
+    reference = overlappingAllanVariances(x, ms);
+  }
+  for (std::size_t threads : kThreadCounts) {
+    const FixedThreads fixed(threads);
+    const std::vector<double> v = overlappingAllanVariances(x, ms);
+    ASSERT_EQ(v.size(), reference.size());
+    for (std::size_t k = 0; k < v.size(); ++k)
+      EXPECT_EQ(bitsOf(v[k]), bitsOf(reference[k])) << threads << " threads, m = " << ms[k];
+  }
+}
+
+TEST(ParallelShares, TheWholeAxisAnalysisIsTheSameBitsForAnyThreadCount) {
+  const std::vector<double> x = stillGyroRate(120'000, 12);
+  AnalysisOptions options;
+  options.rate_hz = 50.0;
+  AxisAnalysis reference;
+  {
+    const FixedThreads one(1);
+    reference = analyzeAxis(x, options);
+  }
+  for (std::size_t threads : kThreadCounts) {
+    const FixedThreads fixed(threads);
+    const AxisAnalysis a = analyzeAxis(x, options);
+    ASSERT_EQ(a.allan.size(), reference.allan.size());
+    for (std::size_t k = 0; k < a.allan.size(); ++k) {
+      EXPECT_EQ(bitsOf(a.allan[k].oadev), bitsOf(reference.allan[k].oadev)) << threads << " threads, k = " << k;
+      EXPECT_EQ(bitsOf(a.allan[k].adev), bitsOf(reference.allan[k].adev)) << threads << " threads, k = " << k;
+      EXPECT_EQ(a.allan[k].noise_alpha, reference.allan[k].noise_alpha) << threads << " threads, k = " << k;
+    }
+    ASSERT_EQ(a.allan_after_kalman.size(), reference.allan_after_kalman.size());
+    for (std::size_t k = 0; k < a.allan_after_kalman.size(); ++k)
+      EXPECT_EQ(bitsOf(a.allan_after_kalman[k].oadev), bitsOf(reference.allan_after_kalman[k].oadev))
+          << threads << " threads, k = " << k;
+    EXPECT_EQ(bitsOf(a.noise.value.arw_deg_per_sqrt_h), bitsOf(reference.noise.value.arw_deg_per_sqrt_h));
+    EXPECT_EQ(bitsOf(a.noise_after_kalman.value.arw_deg_per_sqrt_h),
+              bitsOf(reference.noise_after_kalman.value.arw_deg_per_sqrt_h));
+    EXPECT_EQ(bitsOf(a.variance.kalman), bitsOf(reference.variance.kalman)) << threads << " threads";
+  }
+}
