@@ -191,7 +191,7 @@ AxisModelCheck checkAxisModel(const AxisModelCheckInput& input, const ModelCheck
   deterministic_found = checkSinusoids(xc, c, spectral_null, o.replicas, removal, out) || deterministic_found;
   deterministic_found = checkTemperatureAndSteps(input, xc, c, temp, base_reps, o, removal, out) || deterministic_found;
   removeLinearTrend(xc, c.tau0);
-  GaussMarkovFound gm = checkGaussMarkov(xc, c, deterministic_found, curve, o, out);
+  GaussMarkovFound gm = checkGaussMarkov(xc, c, deterministic_found, curve, base_reps, o, out);
   refitThroughChain(xc, c, deterministic_found, gm, out);
   const bool outliers_alone =
       outliers.found && removal.sinusoids.empty() && !removal.temperature && removal.step_samples.empty() && !gm.found;

@@ -16,8 +16,8 @@ constexpr std::uint64_t kGaussMarkovRound = 2;
 }  // namespace
 
 GaussMarkovFound checkGaussMarkov(std::span<const double> xc, const Context& c, bool deterministic_found,
-                                  const std::vector<AllanPoint>& curve, const ModelCheckOptions& o,
-                                  AxisModelCheck& out) {
+                                  const std::vector<AllanPoint>& curve, const std::vector<SeriesStats>& base_reps,
+                                  const ModelCheckOptions& o, AxisModelCheck& out) {
   GaussMarkovFound gm;
   const std::vector<AllanPoint> clean_curve = deterministic_found ? allanDeviationTable(xc, c.tau0, c.ms) : curve;
   gm.clean_fit = deterministic_found ? fitNoiseTerms(clean_curve) : out.base_fit;
@@ -29,11 +29,18 @@ GaussMarkovFound checkGaussMarkov(std::span<const double> xc, const Context& c, 
   // the five-term fit. Without a Gauss–Markov process the two agree (its σ fits to ~0); with
   // one, the five-term fit absorbs it into a larger flicker and random walk, whose replicas
   // (their flicker a bank of Gauss–Markov processes, docs/simulator.md) then show larger χ²
-  // gains: the threshold grew with the effect and the long-T curve levelled off at 60 %.
-  const std::vector<SeriesStats> reps =
-      runReplicas(pureModel(c.rate, gm.fit.terms_with_gm), statisticalUncertainty(gm.clean_fit), c, {}, o,
-                  kGaussMarkovRound, kStatGaussMarkov);
-  out.replicas_simulated += o.replicas;
+  // gains: the threshold grew with the effect. Through a DLPF the joint fit's terms are not
+  // in the chain's units (its columns are plain power laws, and the Gauss–Markov column
+  // takes up the roll-off: clean DLPF_CFG 6 data then named a process), so there the null
+  // stays the five-term fit's (the base replicas, or round 2's of the cleaned series).
+  const bool joint = !c.chain.dlpf_cfg.has_value();
+  std::vector<SeriesStats> own_reps;
+  if (joint || deterministic_found) {
+    const SimulationModel model = pureModel(c.rate, joint ? gm.fit.terms_with_gm : gm.clean_fit.value);
+    own_reps = runReplicas(model, statisticalUncertainty(gm.clean_fit), c, {}, o, kGaussMarkovRound, kStatGaussMarkov);
+    out.replicas_simulated += o.replicas;
+  }
+  const std::vector<SeriesStats>& reps = own_reps.empty() ? base_reps : own_reps;
   const NullSummary null =
       summarizeNull(column(reps, &SeriesStats::gm_statistic), o.false_alarm * kGaussMarkovAlphaFactor, false);
   const double stat = gaussMarkovStatistic(gm.fit);

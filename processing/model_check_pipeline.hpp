@@ -201,11 +201,10 @@ struct GaussMarkovFound {
   NoiseTerms extended_terms;  // the model's terms: with the Gauss–Markov term's when found
 };
 // A bump in the Allan curve of the cleaned series xc; `curve` is the measured series' table,
-// used when nothing deterministic was removed. Its null: replicas (round 2) of the five terms
-// fitted jointly with the Gauss–Markov column.
+// used when nothing deterministic was removed.
 GaussMarkovFound checkGaussMarkov(std::span<const double> xc, const Context& c, bool deterministic_found,
-                                  const std::vector<AllanPoint>& curve, const ModelCheckOptions& o,
-                                  AxisModelCheck& out);
+                                  const std::vector<AllanPoint>& curve, const std::vector<SeriesStats>& base_reps,
+                                  const ModelCheckOptions& o, AxisModelCheck& out);
 
 // ---- the extended model --------------------------------------------------------------------
 
