@@ -7,6 +7,7 @@
 #include <iomanip>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -83,25 +84,44 @@ class IntegratedPhase {
       : IntegratedPhase(rate, compensatedMean(rate, where)) {}
   // With the mean already formed (by compensatedMean, which has checked every sample).
   IntegratedPhase(std::span<const double> rate, double mean)
-      : rate_count_(rate.size()),
-        mean_(mean),
-        hi_(allan_kernels::allocatePhaseStorage<double>(rate.size() + 1)),
-        lo_(allan_kernels::allocatePhaseStorage<float>(rate.size() + 1)) {
-    const float max_abs_lo = allan_kernels::integratePhase(rate.data(), rate.size(), mean_, hi_.get(), lo_.get());
-    // Each lo combination (lc − lb) − (lb − la) of four floats is at most 4·max|lo| (its
-    // two roundings in double add at most 2⁻⁵² of that; the margin covers them).
-    lo_term_bound_ = 4.0 * static_cast<double>(max_abs_lo) * (1.0 + 1e-12);
+      : IntegratedPhase(rate, mean, allan_kernels::allocatePhaseStorage<double>(rate.size() + 1),
+                        allan_kernels::allocatePhaseStorage<float>(rate.size() + 1)) {}
+  // In storage the caller keeps (at least rate.size() + 1 points each). The rate may lie at
+  // hi + 1 itself: each sample is read before the phase point written over it.
+  IntegratedPhase(std::span<const double> rate, double mean, double* hi, float* lo)
+      : rate_count_(rate.size()), mean_(mean), hi_(hi), lo_(lo) {
+    integrate(rate);
   }
 
   std::size_t rateCount() const { return rate_count_; }
   double mean() const { return mean_; }
 
+ private:
+  IntegratedPhase(std::span<const double> rate, double mean, allan_kernels::PhaseStorage<double> hi,
+                  allan_kernels::PhaseStorage<float> lo)
+      : rate_count_(rate.size()),
+        mean_(mean),
+        owned_hi_(std::move(hi)),
+        owned_lo_(std::move(lo)),
+        hi_(owned_hi_.get()),
+        lo_(owned_lo_.get()) {
+    integrate(rate);
+  }
+
+  void integrate(std::span<const double> rate) {
+    const float max_abs_lo = allan_kernels::integratePhase(rate.data(), rate.size(), mean_, hi_, lo_);
+    // Each lo combination (lc − lb) − (lb − la) of four floats is at most 4·max|lo| (its
+    // two roundings in double add at most 2⁻⁵² of that; the margin covers them).
+    lo_term_bound_ = 4.0 * static_cast<double>(max_abs_lo) * (1.0 + 1e-12);
+  }
+
+ public:
   // x_{i+2m} − 2·x_{i+m} + x_i = m·(ȳ over [i+m, i+2m) − ȳ over [i, i+m)). The hi
   // parts are differenced first (each difference is a window sum, small), then the lo
   // corrections are added.
   double secondDifference(std::size_t i, std::size_t m) const {
-    const double* h = hi_.get();
-    const float* l = lo_.get();
+    const double* h = hi_;
+    const float* l = lo_;
     const double la = l[i], lb = l[i + m], lc = l[i + 2 * m];
     return ((h[i + 2 * m] - h[i + m]) - (h[i + m] - h[i])) + ((lc - lb) - (lb - la));
   }
@@ -121,7 +141,7 @@ class IntegratedPhase {
   // One block of the overlapping sum, terms [k, block_end) (allan_kernels: the same bits
   // on every ISA).
   double overlappingBlockTotal(std::size_t m, std::size_t k, std::size_t block_end) const {
-    return allan_kernels::overlappingBlockTotal(hi_.get(), lo_.get(), m, k, block_end);
+    return allan_kernels::overlappingBlockTotal(hi_, lo_, m, k, block_end);
   }
 
   double stridedBlockTotal(std::size_t m, std::size_t stride, std::size_t k, std::size_t block_end) const {
@@ -164,12 +184,12 @@ class IntegratedPhase {
   double sweepBlockTotal(std::size_t m, std::size_t k, std::size_t block_end, bool& try_high_first) const {
     const std::size_t terms = block_end - k;
     if (try_high_first) {
-      const double high = allan_kernels::overlappingHighTotal(hi_.get(), m, k, block_end);
+      const double high = allan_kernels::overlappingHighTotal(hi_, m, k, block_end);
       if (highOnlySuffices(high, terms)) return high;
       try_high_first = false;
       return overlappingBlockTotal(m, k, block_end);
     }
-    const allan_kernels::BlockTotals t = allan_kernels::overlappingBlockTotals(hi_.get(), lo_.get(), m, k, block_end);
+    const allan_kernels::BlockTotals t = allan_kernels::overlappingBlockTotals(hi_, lo_, m, k, block_end);
     if (highOnlySuffices(t.high, terms)) {
       try_high_first = true;
       return t.high;
@@ -239,8 +259,10 @@ class IntegratedPhase {
   double mean_;
   // Written once in full by the constructor: not zero-filled first (one pass less over
   // 12 bytes a point).
-  allan_kernels::PhaseStorage<double> hi_;
-  allan_kernels::PhaseStorage<float> lo_;
+  allan_kernels::PhaseStorage<double> owned_hi_;  // empty when the caller keeps the storage
+  allan_kernels::PhaseStorage<float> owned_lo_;
+  double* hi_;
+  float* lo_;
   double lo_term_bound_ = 0.0;  // bound on |(lc − lb) − (lb − la)| over the phase
 };
 
@@ -251,16 +273,34 @@ struct Lag1 {
   double sum_sq = 0.0;
 };
 
-Lag1 lag1Autocorrelation(std::span<const double> z) {
+// The d-th difference (d ≤ 2) of the series z at i, formed as differencing it d times in
+// place would: z′_i = z_{i+1} − z_i, z″_i = z′_{i+1} − z′_i (the same operations, the same bits).
+template <typename Series>
+double differenceOf(const Series& z, int d, std::size_t i) {
+  if (d == 0) return z(i);
+  if (d == 1) return z(i + 1) - z(i);
+  const double z0 = z(i), z1 = z(i + 1), z2 = z(i + 2);
+  return (z2 - z1) - (z1 - z0);
+}
+
+// lag1Autocorrelation of the d-th difference of z (`len` points before differencing), each
+// value formed when it is needed: no copy of the series, the same sums in the same order.
+template <typename Series>
+Lag1 lag1AutocorrelationOfDifference(const Series& z, std::size_t len, int d) {
+  const std::size_t n = len - static_cast<std::size_t>(d);
   double mean = 0.0;
-  for (double v : z) mean += v;
-  mean /= static_cast<double>(z.size());
+  for (std::size_t i = 0; i < n; ++i) mean += differenceOf(z, d, i);
+  mean /= static_cast<double>(n);
   double num = 0.0;
   double den = 0.0;
-  for (std::size_t i = 0; i < z.size(); ++i) {
-    const double a = z[i] - mean;
+  double a = differenceOf(z, d, 0) - mean;
+  for (std::size_t i = 0; i < n; ++i) {
     den += a * a;
-    if (i + 1 < z.size()) num += a * (z[i + 1] - mean);
+    if (i + 1 < n) {
+      const double next = differenceOf(z, d, i + 1) - mean;
+      num += a * next;
+      a = next;
+    }
   }
   return {den > 0.0 ? num / den : 0.0, den};
 }
@@ -274,7 +314,8 @@ int clampAlpha(double alpha) { return static_cast<int>(std::clamp(std::round(alp
 // A level that is numerically constant (spread ≤ 1e-10 of the undifferenced spread:
 // rounding only, e.g. the first difference of a pure ramp) has no correlation to measure;
 // it is taken as ρ = 0, i.e. the series is a polynomial of degree d − 1, α = −2d (clamped).
-int lag1NoiseIdOfAverages(std::vector<double> z);
+template <typename Series>
+int lag1NoiseIdOf(const Series& z, std::size_t n);
 
 int lag1NoiseId(std::span<const double> rate, std::size_t m, double mean) {
   const std::size_t n = rate.size() / m;
@@ -302,24 +343,23 @@ int lag1NoiseId(std::span<const double> rate, std::size_t m, double mean) {
     for (std::size_t i = k * m; i < (k + 1) * m; ++i) s += rate[i] - mean;
     z[k] = s / md;
   }
-  return lag1NoiseIdOfAverages(std::move(z));
+  return lag1NoiseIdOf([&z](std::size_t i) { return z[i]; }, n);
 }
 
-// The lag-1 decision on the averaged series z (consumed: it is differenced in place).
-int lag1NoiseIdOfAverages(std::vector<double> z) {
-  const std::size_t n = z.size();
+// The lag-1 decision on the averaged series z(0 … n−1), read as often as needed (each
+// difference level is formed on the fly, never stored).
+template <typename Series>
+int lag1NoiseIdOf(const Series& z, std::size_t n) {
   constexpr int kMaxDifferences = 2;
-  std::size_t len = n;
   double level0_spread = -1.0;
   for (int d = 0;; ++d) {
-    const Lag1 acf = lag1Autocorrelation(std::span<const double>(z.data(), len));
+    const std::size_t len = n - static_cast<std::size_t>(d);
+    const Lag1 acf = lag1AutocorrelationOfDifference(z, n, d);
     const double spread = std::sqrt(acf.sum_sq / static_cast<double>(len));
     if (level0_spread < 0.0) level0_spread = spread;
     if (spread <= 1e-10 * level0_spread) return clampAlpha(-2.0 * d);
     const double rho = acf.r1 / (1.0 + acf.r1);
     if (rho < 0.25 || d >= kMaxDifferences) return clampAlpha(-2.0 * (rho + d));
-    for (std::size_t i = 0; i + 1 < len; ++i) z[i] = z[i + 1] - z[i];
-    --len;
   }
 }
 
@@ -368,21 +408,36 @@ std::vector<int> noiseTypesForTable(std::span<const double> rate, std::span<cons
   // Powers of two: cluster sums by pairwise addition, level by level (2·count samples read
   // in all instead of count per averaging); the others averaged directly, on another core.
   const auto isPowerOfTwo = [](std::size_t m) { return (m & (m - 1)) == 0; };
-  const auto octaveChain = [&] {
-    const std::size_t top = distinct.empty() ? 0 : distinct.back();
-    // The next level is formed before this one is handed to the decision, so that at most
-    // one and a half series' worth of sums is held.
-    std::vector<double> sums(count);
-    for (std::size_t i = 0; i < count; ++i) sums[i] = rate[i] - mean;
-    for (std::size_t m = 1; m <= top; m *= 2) {
-      std::vector<double> next(count / (2 * m));
+  const std::size_t top = distinct.empty() ? 0 : distinct.back();
+  const auto alphaAt = [&](std::size_t m) -> int* {
+    const auto at = std::lower_bound(distinct.begin(), distinct.end(), m);
+    return at != distinct.end() && *at == m ? &distinct_alpha[static_cast<std::size_t>(at - distinct.begin())]
+                                            : nullptr;
+  };
+  // The cluster sums of m = 1 and 2 are read from the rate when needed (the additions of the
+  // pairwise cascade, the same bits) rather than held: a copy of the series would cost 8
+  // bytes a sample while the phase is also held (allanDeviationTable forms the two at once).
+  const auto sum1 = [&](std::size_t i) { return rate[i] - mean; };
+  const auto sum2 = [&](std::size_t k) { return sum1(2 * k) + sum1(2 * k + 1); };
+  // m = 1, on its own core: as much work as all the longer averagings together.
+  const auto firstLevel = [&] {
+    if (int* alpha = top >= 1 ? alphaAt(1) : nullptr) *alpha = lag1NoiseIdOf(sum1, count);  // v / 1.0 is v
+  };
+  const auto longerLevels = [&] {
+    if (int* alpha = top >= 2 ? alphaAt(2) : nullptr)
+      *alpha = lag1NoiseIdOf([&](std::size_t k) { return sum2(k) / 2.0; }, count / 2);
+    if (top < 4) return;
+    // From m = 4 on, level by level; the next level is formed before this one is scaled to
+    // averages, so that at most 3 bytes a sample of sums are held.
+    std::vector<double> sums(count / 4);
+    for (std::size_t k = 0; k < sums.size(); ++k) sums[k] = sum2(2 * k) + sum2(2 * k + 1);
+    for (std::size_t m = 4; m <= top; m *= 2) {
+      std::vector<double> next(sums.size() / 2);
       for (std::size_t k = 0; k < next.size(); ++k) next[k] = sums[2 * k] + sums[2 * k + 1];
-      const auto at = std::lower_bound(distinct.begin(), distinct.end(), m);
-      if (at != distinct.end() && *at == m) {
+      if (int* alpha = alphaAt(m)) {
         const double md = static_cast<double>(m);
-        if (m > 1)  // v / 1.0 is v: no pass needed
-          for (double& v : sums) v /= md;
-        distinct_alpha[static_cast<std::size_t>(at - distinct.begin())] = lag1NoiseIdOfAverages(std::move(sums));
+        for (double& v : sums) v /= md;
+        *alpha = lag1NoiseIdOf([&sums](std::size_t k) { return sums[k]; }, sums.size());
       }
       sums = std::move(next);
     }
@@ -390,14 +445,17 @@ std::vector<int> noiseTypesForTable(std::span<const double> rate, std::span<cons
   std::vector<std::size_t> others;  // indices into distinct
   for (std::size_t i = 0; i < distinct.size(); ++i)
     if (!isPowerOfTwo(distinct[i])) others.push_back(i);
+  // Each task writes only its own averagings' types: the same bits for any thread count.
   forEachShare(
-      others.size() + 1,
+      others.size() + 2,
       [&](std::size_t first, std::size_t end) {
         for (std::size_t task = first; task < end; ++task) {
           if (task == 0) {
-            octaveChain();
+            firstLevel();
+          } else if (task == 1) {
+            longerLevels();
           } else {
-            const std::size_t i = others[task - 1];
+            const std::size_t i = others[task - 2];
             distinct_alpha[i] = lag1NoiseId(rate, distinct[i], mean);
           }
         }
@@ -573,8 +631,17 @@ DeviationInterval allanDeviationConfidenceInterval(double deviation, double edf,
           deviation * std::sqrt(edf / chiSquareQuantile(0.5 * (1.0 - confidence), edf))};
 }
 
-std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double tau0_s,
-                                            std::span<const std::size_t> ms, const AllanOptions& options) {
+namespace {
+
+// Where a table's phase goes: storage of its own, or a workspace's (the rate maybe in it).
+struct PhasePlace {
+  double* hi = nullptr;  // null: the table allocates its own
+  float* lo = nullptr;
+  bool rate_in_place = false;  // the rate lies at hi + 1 and becomes the phase
+};
+
+std::vector<AllanPoint> tableWithPhaseAt(std::span<const double> rate, double tau0_s, std::span<const std::size_t> ms,
+                                         const AllanOptions& options, PhasePlace place) {
   if (!(std::isfinite(tau0_s) && tau0_s > 0.0)) {
     throw std::invalid_argument(
         "the Allan deviation table needs a sample interval tau0 that is a finite positive time in s (got " +
@@ -591,13 +658,28 @@ std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double
   for (std::size_t m : ms) requireClusterSize(m, "the Allan deviation table");
 
   const std::size_t count = rate.size();
-  // The noise types first, while only the rate is held (the lag-1 method averages the rate
-  // itself); the phase, twice the rate's size, comes after.
   const double mean = compensatedMean(rate, "the Allan deviation table");  // one pass for both
-  const std::vector<int> alphas = noiseTypesForTable(rate, ms, mean);
-  const IntegratedPhase phase(rate, mean);
-  const std::vector<double> overlapping = phase.overlappingAllanVariances(ms);
-  const std::vector<double> non_overlapping = nonOverlappingVariances(phase, ms);
+  std::vector<int> alphas;
+  std::optional<IntegratedPhase> integrated;
+  std::vector<double> overlapping, non_overlapping;
+  const auto phaseAndSweeps = [&] {
+    if (place.hi != nullptr)
+      integrated.emplace(rate, mean, place.hi, place.lo);
+    else
+      integrated.emplace(rate, mean);
+    overlapping = integrated->overlappingAllanVariances(ms);
+    non_overlapping = nonOverlappingVariances(*integrated, ms);
+  };
+  if (place.rate_in_place) {
+    // The noise types read the rate, which the phase then overwrites.
+    alphas = noiseTypesForTable(rate, ms, mean);
+    phaseAndSweeps();
+  } else {
+    // The noise types (the lag-1 method averages the rate itself) beside the phase and its
+    // sweeps, which share the cores among themselves.
+    runBoth([&] { alphas = noiseTypesForTable(rate, ms, mean); }, phaseAndSweeps);
+  }
+  const IntegratedPhase& phase = *integrated;
 
   std::vector<AllanPoint> table;
   table.reserve(ms.size());
@@ -610,6 +692,8 @@ std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double
     p.adev_terms = count / m >= 1 ? count / m - 1 : 0;
     p.oadev = std::sqrt(overlapping[j]);
     p.oadev_terms = phase.overlappingTerms(m);
+    // Empty alphas: a series too short for the lag-1 method, identified from the phase
+    // alone (identifyWithMean reads only the rate's length then).
     p.noise_alpha = alphas.empty() ? identifyWithMean(rate, m, phase.mean(), &phase) : alphas[j];
     if (p.oadev_terms >= 1) {
       p.edf = overlappingAllanEdf(p.noise_alpha, count + 1, m);
@@ -624,6 +708,38 @@ std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double
     table.push_back(p);
   }
   return table;
+}
+
+void requireCapacity(const AllanWorkspace& workspace, std::size_t count) {
+  if (count > workspace.capacity())
+    throw std::invalid_argument("the Allan deviation table needs a workspace for " + std::to_string(count) +
+                                " samples, this one holds " + std::to_string(workspace.capacity()));
+}
+
+}  // namespace
+
+AllanWorkspace::AllanWorkspace(std::size_t capacity)
+    : capacity_(capacity),
+      hi_(allan_kernels::allocatePhaseStorage<double>(capacity + 1)),
+      lo_(allan_kernels::allocatePhaseStorage<float>(capacity + 1)) {}
+
+std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double tau0_s,
+                                            std::span<const std::size_t> ms, const AllanOptions& options) {
+  return tableWithPhaseAt(rate, tau0_s, ms, options, {});
+}
+
+std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double tau0_s,
+                                            std::span<const std::size_t> ms, const AllanOptions& options,
+                                            AllanWorkspace& workspace) {
+  requireCapacity(workspace, rate.size());
+  return tableWithPhaseAt(rate, tau0_s, ms, options, {workspace.phaseHi(), workspace.phaseLo(), false});
+}
+
+std::vector<AllanPoint> allanDeviationTableInPlace(AllanWorkspace& workspace, std::size_t count, double tau0_s,
+                                                   std::span<const std::size_t> ms, const AllanOptions& options) {
+  requireCapacity(workspace, count);
+  return tableWithPhaseAt(workspace.rateSlots().first(count), tau0_s, ms, options,
+                          {workspace.phaseHi(), workspace.phaseLo(), true});
 }
 
 }  // namespace gyrod::processing

@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "processing/allan_kernels.hpp"
+
 namespace gyrod::processing {
 
 // ---- cluster sizes (averaging factors m, τ = m·τ0) --------------------------------
@@ -83,5 +85,34 @@ struct AllanOptions {
 // confidence outside (0, 1), m = 0, fewer than 3 samples or a non-finite sample.
 std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double tau0_s,
                                             std::span<const std::size_t> ms, const AllanOptions& options = {});
+
+// Storage for the phase of a series of up to `capacity` samples (12 bytes a sample), for
+// several tables in turn: a long analysis then allocates it, and the kernel clears its
+// pages, once instead of for every table. Between tables, rateSlots() (the phase's storage
+// from its second point on, `capacity` doubles) may hold the next series to analyse, which
+// allanDeviationTableInPlace integrates where it lies.
+class AllanWorkspace {
+ public:
+  explicit AllanWorkspace(std::size_t capacity);
+  std::size_t capacity() const { return capacity_; }
+  std::span<double> rateSlots() { return {hi_.get() + 1, capacity_}; }
+  double* phaseHi() { return hi_.get(); }
+  float* phaseLo() { return lo_.get(); }
+
+ private:
+  std::size_t capacity_;
+  allan_kernels::PhaseStorage<double> hi_;
+  allan_kernels::PhaseStorage<float> lo_;
+};
+
+// allanDeviationTable with the phase in `workspace` (rate.size() ≤ its capacity; the rate
+// must not lie in it): the same table, the same bits.
+std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double tau0_s,
+                                            std::span<const std::size_t> ms, const AllanOptions& options,
+                                            AllanWorkspace& workspace);
+// The table of the first `count` samples of workspace.rateSlots(), the same bits as
+// allanDeviationTable of a copy of them; the samples become the phase (they are lost).
+std::vector<AllanPoint> allanDeviationTableInPlace(AllanWorkspace& workspace, std::size_t count, double tau0_s,
+                                                   std::span<const std::size_t> ms, const AllanOptions& options = {});
 
 }  // namespace gyrod::processing

@@ -124,6 +124,14 @@ void meanFilterFullWindows(const double* x, std::size_t window, double threshold
 // filter itself, the rest from full windows read in place.
 std::vector<double> grossErrorMeanFiltered(std::span<const double> x, std::size_t window, double threshold) {
   std::vector<double> out(x.size());
+  grossErrorMeanFilterInto(x, window, threshold, out);
+  return out;
+}
+
+void grossErrorMeanFilterInto(std::span<const double> x, std::size_t window, double threshold, std::span<double> out) {
+  if (out.size() != x.size())
+    throw std::invalid_argument("the mean filter needs an output as long as its input (" + std::to_string(x.size()) +
+                                " samples), got " + std::to_string(out.size()));
   GrossErrorMeanFilter filling(window, threshold);  // throws for bad parameters or samples here, not in a thread
   const std::size_t filled_from = std::min(x.size(), window - 1);
   for (std::size_t i = 0; i < filled_from; ++i) out[i] = filling.update(x[i]);
@@ -136,16 +144,15 @@ std::vector<double> grossErrorMeanFiltered(std::span<const double> x, std::size_
         meanFilterFullWindows(x.data(), window, threshold, out.data(), filled_from + first, filled_from + end);
       },
       std::size_t{1} << 16);
-  return out;
 }
 
 AxisAnalysis analyzeAxis(std::span<const double> rate_dps, const AnalysisOptions& options) {
   return analyzeAxis(std::vector<double>(rate_dps.begin(), rate_dps.end()), options);
 }
 
-// The steps hold at most three series' worth of doubles at once (the series and the
-// Allan phase, twice its size; later the mean-filter output in place of the series):
-// 24 bytes a sample.
+// The steps hold at most 20 bytes a sample: the series (8) and the Allan workspace (12),
+// which holds the phase of each table and, between them, the mean-filter output (8 of its
+// 12) that the Kalman filter then overwrites.
 AxisAnalysis analyzeAxis(std::vector<double>&& rate_dps, const AnalysisOptions& options) {
   if (!(options.rate_hz > 0.0) || !std::isfinite(options.rate_hz))
     throw std::invalid_argument("the axis analysis needs a sample rate that is a positive number of Hz, got " +
@@ -172,9 +179,12 @@ AxisAnalysis analyzeAxis(std::vector<double>&& rate_dps, const AnalysisOptions& 
   if (options.detrend) a.trend_removed = removeLinearTrend(x, tau0);
   step("detrend");
 
-  // 3. Allan deviation and noise terms (§3.2.3, Table 2).
+  // 3. Allan deviation and noise terms (§3.2.3, Table 2). One workspace holds the phase of
+  // both tables and, between them, the mean-filter and Kalman output: its pages are
+  // allocated and cleared once.
   std::vector<std::size_t> ms = options.cluster_sizes.empty() ? octaveClusterSizes(x.size()) : options.cluster_sizes;
-  a.allan = allanDeviationTable(x, tau0, ms);
+  AllanWorkspace workspace(x.size());
+  a.allan = allanDeviationTable(x, tau0, ms, {}, workspace);
   a.noise = fitNoiseTerms(a.allan);
   a.noise_from_slopes = readNoiseTermsFromSlopes(a.allan);
   step("allan and fit");
@@ -182,7 +192,8 @@ AxisAnalysis analyzeAxis(std::vector<double>&& rate_dps, const AnalysisOptions& 
   // 4–6. Mean filter, AR models of its output, Kalman on AR(1) (§4–5). The mean filter runs
   // once: its output identifies the Kalman and then feeds it, exactly as AxisFilterChain
   // (mean filter, then Kalman) would on the same series.
-  std::vector<double> filtered = grossErrorMeanFiltered(x, options.mean_window, options.mean_threshold_dps);
+  const std::span<double> filtered = workspace.rateSlots().first(x.size());
+  grossErrorMeanFilterInto(x, options.mean_window, options.mean_threshold_dps, filtered);
   step("mean filter");
   // The identification and the AR models beside the spreads: all only read x and filtered.
   double peak_raw = 0.0;
@@ -202,20 +213,19 @@ AxisAnalysis analyzeAxis(std::vector<double>&& rate_dps, const AnalysisOptions& 
         a.variance.mean = varianceAboutMean(filtered);
       });
   step("identification, AR, spreads");
-  x = std::vector<double>();  // the Kalman output takes the mean-filter output's place
+  x = std::vector<double>();  // the series is not read again
 
   ScalarKalmanFilter kalman(a.filter.kalman);
-  for (double& v : filtered) v = kalman.update(v);
-  const std::vector<double>& kalman_filtered = filtered;
+  kalman.filterInPlace(filtered);
+  const std::span<const double> kalman_filtered = filtered;
   step("kalman");
 
-  // Table 4: the same Allan analysis on the Kalman output, beside its spread.
-  runBoth([&] { a.allan_after_kalman = allanDeviationTable(kalman_filtered, tau0, ms); },
-          [&] {
-            const Spread after = spreadAboutMean(kalman_filtered);
-            a.variance.kalman = after.variance;
-            a.peak_ratio = peak_raw > 0.0 ? after.peak / peak_raw : 0.0;
-          });
+  // Table 4: the same Allan analysis on the Kalman output, its spread first (the table turns
+  // the output into its phase where it lies).
+  const Spread after = spreadAboutMean(kalman_filtered);
+  a.variance.kalman = after.variance;
+  a.peak_ratio = peak_raw > 0.0 ? after.peak / peak_raw : 0.0;
+  a.allan_after_kalman = allanDeviationTableInPlace(workspace, kalman_filtered.size(), tau0, ms);
   a.noise_after_kalman = fitNoiseTerms(a.allan_after_kalman);
   step("allan after kalman");
   return a;

@@ -57,12 +57,14 @@ struct AxisAnalysis {
 
 AxisAnalysis analyzeAxis(std::span<const double> rate_dps, const AnalysisOptions& options);
 // The same, consuming the series (it becomes the detrended working copy): peak memory of
-// three series' worth of doubles, 24 bytes a sample, instead of four.
+// 20 bytes a sample (the series and the Allan workspace, which also holds the filter outputs).
 AxisAnalysis analyzeAxis(std::vector<double>&& rate_dps, const AnalysisOptions& options);
 
 // GrossErrorMeanFilter(window, threshold) run over x from its start: its outputs, the same
 // bits, computed on the cores and several windows at a time. Throws as the filter does.
 std::vector<double> grossErrorMeanFiltered(std::span<const double> x, std::size_t window, double threshold);
+// The same into `out` (as long as x; not overlapping it).
+void grossErrorMeanFilterInto(std::span<const double> x, std::size_t window, double threshold, std::span<double> out);
 
 // Population variance about the mean, and max |x − mean|.
 double varianceAboutMean(std::span<const double> x);

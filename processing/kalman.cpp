@@ -67,6 +67,35 @@ double ScalarKalmanFilter::update(double z) {
   return x_;
 }
 
+void ScalarKalmanFilter::filterInPlace(std::span<double> z) {
+  std::size_t i = 0;
+  for (; i < z.size(); ++i) {
+    const bool had_covariance = initialised_;
+    const double p_before = p_;
+    z[i] = update(z[i]);
+    if (had_covariance && p_ == p_before) {
+      ++i;
+      break;
+    }
+  }
+  // P is at its fixed point: P⁻, K and P stay as they are; x̂ and the innovation as update().
+  const double a = params_.a, k = k_;
+  double x = x_, innovation = innovation_;
+  for (; i < z.size(); ++i) {
+    if (!std::isfinite(z[i])) {
+      x_ = x;
+      innovation_ = innovation;
+      update(z[i]);  // throws, naming the value
+    }
+    const double x_prior = a * x;
+    innovation = z[i] - x_prior;
+    x = x_prior + k * innovation;
+    z[i] = x;
+  }
+  x_ = x;
+  innovation_ = innovation;
+}
+
 double steadyStatePriorCovariance(double a, double q, double r) {
   requireFinite(a, "the steady-state Kalman covariance", "a");
   validateNoise("the steady-state Kalman covariance", q, r, 0.0);

@@ -31,6 +31,13 @@ class ScalarKalmanFilter {
   // the first included, predicts from the previous estimate and updates.
   // Throws std::invalid_argument for a non-finite z (state unchanged).
   double update(double z);
+  // update() on every element of z in turn, each replaced by its estimate: the same bits and
+  // the same state after, faster on long series. The covariance recursion does not depend
+  // on the data, so once P repeats exactly (P after an update equal to P before it) every
+  // later update has the same P⁻ and gain: from there only the estimate is stepped, with
+  // update()'s own operations. Throws as update() at the first non-finite element, the
+  // elements before it filtered and the state that of update() after them.
+  void filterInPlace(std::span<double> z);
   // Back to the state after construction.
   void reset();
   double gain() const { return k_; }

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <random>
+#include <span>
 #include <stdexcept>
 #include <type_traits>
 #include <vector>
@@ -158,6 +159,61 @@ TEST(ScalarKalmanFilter, RejectsInvalidParameters) {
   EXPECT_THROW(steadyStatePriorCovariance(0.5, -1.0, 1.0), std::invalid_argument);
   EXPECT_THROW(steadyStateGain(0.5, 1.0, 0.0), std::invalid_argument);
   EXPECT_THROW(steadyStatePosteriorCovariance(NAN, 1.0, 1.0), std::invalid_argument);
+}
+
+// filterInPlace against update() sample by sample: the same bits for every output and the
+// same state after, for parameters whose P reaches its fixed point (most), one that starts
+// at it (q = 0, P0 = 0), a given x0, a series shorter than the convergence, and a series
+// split in two calls (the second starts at the fixed point already).
+TEST(ScalarKalmanFilter, FilterInPlaceIsUpdateSampleBySample) {
+  const Simulated data = simulateArPlusNoise({kPaperA}, kPaperQ, kPaperR, 20000, 11);
+  const std::vector<ScalarKalmanParameters> cases = {
+      {.a = kPaperA, .q = kPaperQ, .r = kPaperR, .p0 = 0.0, .x0 = std::nullopt},
+      {.a = 0.999, .q = 1e-6, .r = 0.01, .p0 = 0.0, .x0 = std::nullopt},
+      {.a = 0.5, .q = 0.0, .r = 1.0, .p0 = 0.0, .x0 = std::nullopt},
+      {.a = 0.9, .q = 0.02, .r = 0.05, .p0 = 3.0, .x0 = 0.25},
+  };
+  for (const auto& params : cases) {
+    for (std::size_t n : {std::size_t{1}, std::size_t{5}, data.measured.size()}) {
+      SCOPED_TRACE("a = " + std::to_string(params.a) + ", n = " + std::to_string(n));
+      ScalarKalmanFilter stepped(params), batch(params), split(params);
+      std::vector<double> expected(data.measured.begin(), data.measured.begin() + static_cast<std::ptrdiff_t>(n));
+      for (double& v : expected) v = stepped.update(v);
+      std::vector<double> got(data.measured.begin(), data.measured.begin() + static_cast<std::ptrdiff_t>(n));
+      std::vector<double> halves = got;
+      batch.filterInPlace(got);
+      split.filterInPlace(std::span<double>(halves).first(n / 2));
+      split.filterInPlace(std::span<double>(halves).subspan(n / 2));
+      for (std::size_t i = 0; i < n; ++i) {
+        ASSERT_EQ(got[i], expected[i]) << "sample " << i;
+        ASSERT_EQ(halves[i], expected[i]) << "sample " << i << " (two calls)";
+      }
+      for (const ScalarKalmanFilter* f : {&batch, &split}) {
+        EXPECT_EQ(f->gain(), stepped.gain());
+        EXPECT_EQ(f->covariance(), stepped.covariance());
+        EXPECT_EQ(f->innovation(), stepped.innovation());
+        EXPECT_EQ(ScalarKalmanFilter(*f).update(0.125), ScalarKalmanFilter(stepped).update(0.125));
+      }
+    }
+  }
+}
+
+// A non-finite sample stops filterInPlace as it stops update(): the samples before it
+// filtered, the error thrown, the state that of the samples before it.
+TEST(ScalarKalmanFilter, FilterInPlaceStopsAtANonFiniteSample) {
+  const Simulated data = simulateArPlusNoise({kPaperA}, kPaperQ, kPaperR, 3000, 12);
+  const ScalarKalmanParameters params{.a = kPaperA, .q = kPaperQ, .r = kPaperR, .p0 = 0.0, .x0 = std::nullopt};
+  for (std::size_t bad : {std::size_t{2}, std::size_t{2500}}) {
+    std::vector<double> z = data.measured;
+    z[bad] = NAN;
+    ScalarKalmanFilter stepped(params), batch(params);
+    std::vector<double> expected(z.begin(), z.begin() + static_cast<std::ptrdiff_t>(bad));
+    for (double& v : expected) v = stepped.update(v);
+    EXPECT_THROW(batch.filterInPlace(z), std::invalid_argument);
+    for (std::size_t i = 0; i < bad; ++i) ASSERT_EQ(z[i], expected[i]) << "sample " << i;
+    EXPECT_TRUE(std::isnan(z[bad]));
+    EXPECT_EQ(batch.update(0.5), stepped.update(0.5));
+  }
 }
 
 TEST(ArKalmanFilter, OrderOneEqualsScalarFilter) {

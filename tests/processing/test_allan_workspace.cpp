@@ -1,0 +1,119 @@
+// AllanWorkspace: a table whose phase lies in a workspace, or whose rate lies in it and
+// becomes the phase, is the same table, bit for bit, as allanDeviationTable's own; a
+// workspace serves tables in turn (gyroctl analyze's two tables of one axis share one).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "processing/allan.hpp"
+#include "processing/parallel_share.hpp"
+
+using namespace gyrod::processing;
+
+namespace {
+
+std::uint64_t bitsOf(double v) {
+  std::uint64_t b = 0;
+  std::memcpy(&b, &v, sizeof b);
+  return b;
+}
+
+// White noise on a bias plus `walk_sd` of random walk, from a seed: walk_sd 0 gives white
+// noise (no difference taken by the noise identification), a large one a strongly
+// correlated series like a Kalman output (differenced twice).
+std::vector<double> rateSeries(std::size_t n, double walk_sd, std::uint32_t seed) {
+  std::mt19937_64 gen(seed);
+  std::normal_distribution<double> white(0.0, 0.05);
+  std::normal_distribution<double> walk(0.0, 1.0);
+  std::vector<double> x(n);
+  double drift = 0.0;
+  for (double& v : x) {
+    drift += walk_sd * walk(gen);
+    v = 0.8 + drift + white(gen);
+  }
+  return x;
+}
+
+void expectSameTable(const std::vector<AllanPoint>& got, const std::vector<AllanPoint>& want, const std::string& what) {
+  ASSERT_EQ(got.size(), want.size()) << what;
+  for (std::size_t j = 0; j < got.size(); ++j) {
+    SCOPED_TRACE(what + ", m = " + std::to_string(want[j].m));
+    EXPECT_EQ(got[j].m, want[j].m);
+    EXPECT_EQ(bitsOf(got[j].tau_s), bitsOf(want[j].tau_s));
+    EXPECT_EQ(bitsOf(got[j].adev), bitsOf(want[j].adev));
+    EXPECT_EQ(bitsOf(got[j].oadev), bitsOf(want[j].oadev));
+    EXPECT_EQ(got[j].adev_terms, want[j].adev_terms);
+    EXPECT_EQ(got[j].oadev_terms, want[j].oadev_terms);
+    EXPECT_EQ(got[j].noise_alpha, want[j].noise_alpha);
+    EXPECT_EQ(bitsOf(got[j].edf), bitsOf(want[j].edf));
+    EXPECT_EQ(bitsOf(got[j].oadev_lo), bitsOf(want[j].oadev_lo));
+    EXPECT_EQ(bitsOf(got[j].oadev_hi), bitsOf(want[j].oadev_hi));
+  }
+}
+
+}  // namespace
+
+TEST(AllanWorkspace, TablesInAWorkspaceAreTheSameBitsAsTheirOwn) {
+  struct Case {
+    const char* name;
+    std::vector<double> rate;
+  };
+  // 300 000 samples: many sweep blocks and integration runs, octave m past 4096 (hi-only
+  // blocks); the short ones take the noise identification's fallbacks (< 30 averages at
+  // long m; < 30 samples: the slope of the phase's variances).
+  const std::vector<Case> cases = {{"white, 300000", rateSeries(300'000, 0.0, 21)},
+                                   {"random walk, 300000", rateSeries(300'000, 0.02, 22)},
+                                   {"white, 1000", rateSeries(1000, 0.0, 23)},
+                                   {"random walk, 20", rateSeries(20, 0.02, 24)}};
+  AllanWorkspace workspace(300'000);  // one workspace for every table below, in turn
+  for (const Case& c : cases) {
+    for (const std::vector<std::size_t>& ms :
+         {octaveClusterSizes(c.rate.size()), denseClusterSizes(c.rate.size(), 8)}) {
+      const std::vector<AllanPoint> own = allanDeviationTable(c.rate, 0.02, ms);
+      expectSameTable(allanDeviationTable(c.rate, 0.02, ms, {}, workspace), own, std::string(c.name) + ", workspace");
+      std::copy(c.rate.begin(), c.rate.end(), workspace.rateSlots().begin());
+      expectSameTable(allanDeviationTableInPlace(workspace, c.rate.size(), 0.02, ms), own,
+                      std::string(c.name) + ", in place");
+    }
+  }
+}
+
+TEST(AllanWorkspace, InPlaceTablesAreTheSameBitsForAnyThreadCount) {
+  const std::vector<double> rate = rateSeries(200'000, 0.02, 25);
+  const std::vector<std::size_t> ms = octaveClusterSizes(rate.size());
+  AllanWorkspace workspace(rate.size());
+  std::vector<AllanPoint> reference;
+  for (std::size_t threads : {1u, 2u, 3u, 5u}) {
+    shareThreadOverride().store(threads);
+    std::copy(rate.begin(), rate.end(), workspace.rateSlots().begin());
+    const std::vector<AllanPoint> table = allanDeviationTableInPlace(workspace, rate.size(), 0.02, ms);
+    shareThreadOverride().store(0);
+    if (reference.empty())
+      reference = table;
+    else
+      expectSameTable(table, reference, std::to_string(threads) + " threads");
+  }
+}
+
+TEST(AllanWorkspace, ASeriesLongerThanTheWorkspaceIsRefusedByName) {
+  const std::vector<double> rate = rateSeries(101, 0.0, 26);
+  AllanWorkspace workspace(100);
+  const std::vector<std::size_t> ms = {1, 2, 4};
+  try {
+    allanDeviationTable(rate, 0.02, ms, {}, workspace);
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("101 samples"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("holds 100"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(allanDeviationTableInPlace(workspace, 101, 0.02, ms), std::invalid_argument);
+  std::copy(rate.begin(), rate.begin() + 100, workspace.rateSlots().begin());
+  EXPECT_NO_THROW(allanDeviationTableInPlace(workspace, 100, 0.02, ms));
+}
