@@ -273,31 +273,55 @@ struct Lag1 {
   double sum_sq = 0.0;
 };
 
-// The d-th difference (d ≤ 2) of the series z at i, formed as differencing it d times in
-// place would: z′_i = z_{i+1} − z_i, z″_i = z′_{i+1} − z′_i (the same operations, the same bits).
+// The d-th differences (d ≤ 2) of the series z in order, formed as differencing it d times
+// in place would (z′_i = z_{i+1} − z_i, z″_i = z′_{i+1} − z′_i: the same operations, the
+// same bits), each z read once.
 template <typename Series>
-double differenceOf(const Series& z, int d, std::size_t i) {
-  if (d == 0) return z(i);
-  if (d == 1) return z(i + 1) - z(i);
-  const double z0 = z(i), z1 = z(i + 1), z2 = z(i + 2);
-  return (z2 - z1) - (z1 - z0);
-}
+class DifferenceStream {
+ public:
+  DifferenceStream(const Series& z, int d) : z_(z), d_(d) {
+    if (d_ >= 1) z0_ = z_(next_++);
+    if (d_ >= 2) z1_ = z_(next_++);
+  }
+  double next() {
+    const double v = z_(next_++);
+    if (d_ == 0) return v;
+    if (d_ == 1) {
+      const double diff = v - z0_;
+      z0_ = v;
+      return diff;
+    }
+    const double diff = (v - z1_) - (z1_ - z0_);
+    z0_ = z1_;
+    z1_ = v;
+    return diff;
+  }
+
+ private:
+  const Series& z_;
+  int d_;
+  std::size_t next_ = 0;
+  double z0_ = 0.0, z1_ = 0.0;
+};
 
 // lag1Autocorrelation of the d-th difference of z (`len` points before differencing), each
-// value formed when it is needed: no copy of the series, the same sums in the same order.
+// value formed when it is needed: no copy of the series, the same sums in the same order
+// (Σ (z_i − z̄)² and Σ (z_i − z̄)(z_{i+1} − z̄), z̄ the plain running mean).
 template <typename Series>
 Lag1 lag1AutocorrelationOfDifference(const Series& z, std::size_t len, int d) {
   const std::size_t n = len - static_cast<std::size_t>(d);
   double mean = 0.0;
-  for (std::size_t i = 0; i < n; ++i) mean += differenceOf(z, d, i);
+  DifferenceStream<Series> first_pass(z, d);
+  for (std::size_t i = 0; i < n; ++i) mean += first_pass.next();
   mean /= static_cast<double>(n);
   double num = 0.0;
   double den = 0.0;
-  double a = differenceOf(z, d, 0) - mean;
+  DifferenceStream<Series> second_pass(z, d);
+  double a = second_pass.next() - mean;
   for (std::size_t i = 0; i < n; ++i) {
     den += a * a;
     if (i + 1 < n) {
-      const double next = differenceOf(z, d, i + 1) - mean;
+      const double next = second_pass.next() - mean;
       num += a * next;
       a = next;
     }
