@@ -154,6 +154,14 @@ AxisAnalysis analyzeAxis(std::span<const double> rate_dps, const AnalysisOptions
 // which holds the phase of each table and, between them, the mean-filter output (8 of its
 // 12) that the Kalman filter then overwrites.
 AxisAnalysis analyzeAxis(std::vector<double>&& rate_dps, const AnalysisOptions& options) {
+  AllanWorkspace workspace(rate_dps.size());
+  return analyzeAxis(std::move(rate_dps), options, workspace);
+}
+
+AxisAnalysis analyzeAxis(std::vector<double>&& rate_dps, const AnalysisOptions& options, AllanWorkspace& workspace) {
+  if (rate_dps.size() > workspace.capacity())
+    throw std::invalid_argument("the axis analysis needs a workspace for " + std::to_string(rate_dps.size()) +
+                                " samples, this one holds " + std::to_string(workspace.capacity()));
   if (!(options.rate_hz > 0.0) || !std::isfinite(options.rate_hz))
     throw std::invalid_argument("the axis analysis needs a sample rate that is a positive number of Hz, got " +
                                 std::to_string(options.rate_hz));
@@ -181,9 +189,8 @@ AxisAnalysis analyzeAxis(std::vector<double>&& rate_dps, const AnalysisOptions& 
 
   // 3. Allan deviation and noise terms (§3.2.3, Table 2). One workspace holds the phase of
   // both tables and, between them, the mean-filter and Kalman output: its pages are
-  // allocated and cleared once.
+  // allocated and cleared once (once for every axis, when the caller passes one).
   std::vector<std::size_t> ms = options.cluster_sizes.empty() ? octaveClusterSizes(x.size()) : options.cluster_sizes;
-  AllanWorkspace workspace(x.size());
   a.allan = allanDeviationTable(x, tau0, ms, {}, workspace);
   a.noise = fitNoiseTerms(a.allan);
   a.noise_from_slopes = readNoiseTermsFromSlopes(a.allan);

@@ -59,6 +59,10 @@ AxisAnalysis analyzeAxis(std::span<const double> rate_dps, const AnalysisOptions
 // The same, consuming the series (it becomes the detrended working copy): peak memory of
 // 20 bytes a sample (the series and the Allan workspace, which also holds the filter outputs).
 AxisAnalysis analyzeAxis(std::vector<double>&& rate_dps, const AnalysisOptions& options);
+// The same in a workspace the caller keeps (capacity ≥ the series; its contents are
+// overwritten): several axes analysed in turn then share one, whose pages the kernel
+// clears once. The same results, bit for bit.
+AxisAnalysis analyzeAxis(std::vector<double>&& rate_dps, const AnalysisOptions& options, AllanWorkspace& workspace);
 
 // GrossErrorMeanFilter(window, threshold) run over x from its start: its outputs, the same
 // bits, computed on the cores and several windows at a time. Throws as the filter does.

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "processing/allan.hpp"
+#include "processing/axis_analysis.hpp"
 #include "processing/parallel_share.hpp"
 
 using namespace gyrod::processing;
@@ -116,4 +117,33 @@ TEST(AllanWorkspace, ASeriesLongerThanTheWorkspaceIsRefusedByName) {
   EXPECT_THROW(allanDeviationTableInPlace(workspace, 101, 0.02, ms), std::invalid_argument);
   std::copy(rate.begin(), rate.begin() + 100, workspace.rateSlots().begin());
   EXPECT_NO_THROW(allanDeviationTableInPlace(workspace, 100, 0.02, ms));
+}
+
+// Axes analysed in turn in one workspace (gyroctl analyze's three axes) come out as each
+// analysed in its own: the first longer than the second, so the second finds the first's
+// phase and filter output in the workspace.
+TEST(AllanWorkspace, AxesAnalysedInTurnInOneWorkspaceAreTheSameBitsAsAlone) {
+  const std::vector<std::vector<double>> axes = {rateSeries(150'000, 0.001, 27), rateSeries(90'000, 0.0, 28)};
+  AnalysisOptions options;
+  options.rate_hz = 100.0;
+  AllanWorkspace workspace(150'000);
+  for (std::size_t k = 0; k < axes.size(); ++k) {
+    SCOPED_TRACE("axis " + std::to_string(k));
+    const AxisAnalysis alone = analyzeAxis(axes[k], options);
+    const AxisAnalysis shared = analyzeAxis(std::vector<double>(axes[k]), options, workspace);
+    expectSameTable(shared.allan, alone.allan, "table 2");
+    expectSameTable(shared.allan_after_kalman, alone.allan_after_kalman, "table 4");
+    EXPECT_EQ(bitsOf(shared.variance.raw), bitsOf(alone.variance.raw));
+    EXPECT_EQ(bitsOf(shared.variance.mean), bitsOf(alone.variance.mean));
+    EXPECT_EQ(bitsOf(shared.variance.kalman), bitsOf(alone.variance.kalman));
+    EXPECT_EQ(bitsOf(shared.peak_ratio), bitsOf(alone.peak_ratio));
+    EXPECT_EQ(bitsOf(shared.filter.kalman.a), bitsOf(alone.filter.kalman.a));
+    EXPECT_EQ(bitsOf(shared.filter.kalman.r), bitsOf(alone.filter.kalman.r));
+    ASSERT_EQ(shared.ar.size(), alone.ar.size());
+    EXPECT_EQ(shared.ar_order_aic, alone.ar_order_aic);
+    EXPECT_EQ(bitsOf(shared.noise_after_kalman.value.arw_deg_per_sqrt_h),
+              bitsOf(alone.noise_after_kalman.value.arw_deg_per_sqrt_h));
+  }
+  AllanWorkspace small(1000);
+  EXPECT_THROW(analyzeAxis(std::vector<double>(axes[1]), options, small), std::invalid_argument);
 }
