@@ -766,4 +766,13 @@ std::vector<AllanPoint> allanDeviationTableInPlace(AllanWorkspace& workspace, st
                           {workspace.phaseHi(), workspace.phaseLo(), true});
 }
 
+std::vector<double> overlappingAllanVariances(std::span<const double> rate, std::span<const std::size_t> ms,
+                                              AllanWorkspace& workspace) {
+  for (std::size_t m : ms) requireClusterSize(m, "the overlapping Allan variances");
+  requireCapacity(workspace, rate.size());
+  const IntegratedPhase phase(rate, compensatedMean(rate, "the overlapping Allan variances"), workspace.phaseHi(),
+                              workspace.phaseLo());
+  return phase.overlappingAllanVariances(ms);
+}
+
 }  // namespace gyrod::processing

@@ -110,6 +110,9 @@ class AllanWorkspace {
 std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double tau0_s,
                                             std::span<const std::size_t> ms, const AllanOptions& options,
                                             AllanWorkspace& workspace);
+// overlappingAllanVariances with the phase in `workspace` (the rate not in it): the same bits.
+std::vector<double> overlappingAllanVariances(std::span<const double> rate, std::span<const std::size_t> ms,
+                                              AllanWorkspace& workspace);
 // The table of the first `count` samples of workspace.rateSlots(), the same bits as
 // allanDeviationTable of a copy of them; the samples become the phase (they are lost).
 std::vector<AllanPoint> allanDeviationTableInPlace(AllanWorkspace& workspace, std::size_t count, double tau0_s,

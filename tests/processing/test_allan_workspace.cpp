@@ -147,3 +147,17 @@ TEST(AllanWorkspace, AxesAnalysedInTurnInOneWorkspaceAreTheSameBitsAsAlone) {
   AllanWorkspace small(1000);
   EXPECT_THROW(analyzeAxis(std::vector<double>(axes[1]), options, small), std::invalid_argument);
 }
+
+TEST(AllanWorkspace, OverlappingVariancesInAWorkspaceAreTheSameBits) {
+  const std::vector<double> rate = rateSeries(300'000, 0.001, 29);
+  const std::vector<std::size_t> ms = octaveClusterSizes(rate.size());
+  AllanWorkspace workspace(rate.size());
+  const std::vector<double> own = overlappingAllanVariances(rate, ms);
+  for (int call = 0; call < 2; ++call) {  // the second finds the first's phase there
+    const std::vector<double> kept = overlappingAllanVariances(rate, ms, workspace);
+    ASSERT_EQ(kept.size(), own.size());
+    for (std::size_t j = 0; j < own.size(); ++j) EXPECT_EQ(bitsOf(kept[j]), bitsOf(own[j])) << "m = " << ms[j];
+  }
+  AllanWorkspace small(10);
+  EXPECT_THROW(overlappingAllanVariances(rate, ms, small), std::invalid_argument);
+}
