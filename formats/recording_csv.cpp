@@ -555,28 +555,4 @@ Recording parseRecordingCsv(std::istream& in, const std::string& path) {
   return parseRecordingFile(file.get(), path, ReadOptions{});
 }
 
-double sampleRateFromTimes(const Recording& r) {
-  if (r.t.size() < 2) throw RecordingError(r.path + ": need at least two samples in column 't' to infer the rate");
-  std::vector<double> dt(r.t.size() - 1);
-  for (std::size_t i = 1; i < r.t.size(); ++i) {
-    dt[i - 1] = r.t[i] - r.t[i - 1];
-    if (!(dt[i - 1] > 0.0)) {
-      std::ostringstream s;
-      s.precision(17);
-      s << r.path << ':' << r.lineOfSample(i) << ": column 't' is not strictly increasing (t = " << r.t[i] << " after "
-        << r.t[i - 1] << ")";
-      throw RecordingError(s.str());
-    }
-  }
-  auto mid = dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2);
-  std::nth_element(dt.begin(), mid, dt.end());
-  if (!std::isfinite(1.0 / *mid)) {  // steps of 1e-320 s are positive, but no rate
-    std::ostringstream s;
-    s.precision(17);
-    s << r.path << ": column 't' steps by " << *mid << " s, too small for a sample rate";
-    throw RecordingError(s.str());
-  }
-  return 1.0 / *mid;
-}
-
 }  // namespace gyrod::recording
