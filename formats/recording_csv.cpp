@@ -204,7 +204,8 @@ std::vector<ColumnRole> headerRoles(const std::string& path, std::size_t line_no
 // What a slice of the sample lines yields, numbered from the slice: its first line is 1 and
 // its first sample 0. Slices are parsed apart (on both cores) and appended in file order.
 struct SliceResult {
-  std::vector<std::vector<double>> columns;   // one per field of the header
+  std::vector<std::vector<double>> columns;   // one per field of the header, when stored here
+  std::vector<std::vector<double>*> store;    // where the values go: `columns`, or the recording's
   std::vector<Recording::LineRun> line_runs;  // runs within the slice
   std::vector<std::size_t> sample_lines;      // each sample's line (only with ReadOptions::line_numbers)
   std::vector<LostSamples> lost;              // GAP and DROPPED lines
@@ -212,9 +213,19 @@ struct SliceResult {
   std::size_t samples = 0;
   std::string error;  // the cause of the first bad line (the slice's last), empty when none
 
-  // Empty again, keeping the columns' memory for the next slice.
-  void clear() {
-    for (auto& column : columns) column.clear();
+  // Empty again, keeping the columns' memory for the next slice; the values go to `targets`
+  // (the recording's columns) when given, else to this slice's own columns.
+  void clear(std::size_t column_count, const std::vector<std::vector<double>*>* targets = nullptr) {
+    columns.resize(targets ? 0 : column_count);
+    store.clear();
+    for (std::size_t c = 0; c < column_count; ++c) {
+      if (targets) {
+        store.push_back((*targets)[c]);
+      } else {
+        columns[c].clear();
+        store.push_back(&columns[c]);
+      }
+    }
     line_runs.clear();
     sample_lines.clear();
     lost.clear();
@@ -235,7 +246,6 @@ struct SliceParser {
   // Parses the lines of `text` (each ending in '\n' but maybe the last) into `out`,
   // stopping at the first bad line.
   void parse(std::string_view text, SliceResult& out) const {
-    out.columns.resize(column_names.size());
     std::array<std::string_view, kKnownColumns.size() + kStreamColumns.size()> fields;
     std::size_t start = 0;
     while (start < text.size()) {
@@ -276,7 +286,9 @@ struct SliceParser {
   // sample is stored and the start of the next line returned; 0 (nothing stored) for any
   // other line, left to the general path with its messages.
   std::size_t parsePlainLine(std::string_view text, std::size_t start, SliceResult& out) const {
-    std::array<double, kKnownColumns.size() + kStreamColumns.size()> values{};
+    // Not zeroed: a line sets every value it stores, and zeroing 19 doubles a line cost as much
+    // as the rest of this function.
+    std::array<double, kKnownColumns.size() + kStreamColumns.size()> values;
     const char* p = text.data() + start;
     const char* const end = text.data() + text.size();
     const std::size_t columns = column_names.size();
@@ -296,7 +308,7 @@ struct SliceParser {
     const auto line_end = static_cast<std::size_t>(p - text.data());
     if (line_end - start > max_bytes) return 0;
     ++out.lines;
-    for (std::size_t c = 0; c < columns; ++c) out.columns[c].push_back(values[c]);
+    for (std::size_t c = 0; c < columns; ++c) out.store[c]->push_back(values[c]);
     recordSample(out);
     return line_end + 1;  // past the '\n' (or the end of the text)
   }
@@ -321,7 +333,7 @@ struct SliceParser {
     }
     for (std::size_t c = 0; c < count; ++c) {
       if (fields[c].empty() && may_be_empty[c]) {  // a value the sample did not have
-        out.columns[c].push_back(std::numeric_limits<double>::quiet_NaN());
+        out.store[c]->push_back(std::numeric_limits<double>::quiet_NaN());
         continue;
       }
       const auto value = parseNumber(fields[c]);
@@ -333,7 +345,7 @@ struct SliceParser {
         out.error = "column '" + column_names[c] + "': non-finite value " + formats::quotedValue(fields[c]);
         return false;
       }
-      out.columns[c].push_back(*value);
+      out.store[c]->push_back(*value);
     }
     recordSample(out);
     return true;
@@ -351,10 +363,10 @@ std::pair<std::string_view, std::string_view> splitAtLineNearMiddle(std::string_
   return {text.substr(0, nl + 1), text.substr(nl + 1)};
 }
 
-// A slice's samples, records and line runs appended to `rec`, its lines numbered after line_no.
-void appendSlice(const SliceResult& slice, std::size_t line_no, Recording& rec,
+// A slice's records and line runs appended to `rec`, its lines numbered after line_no and its
+// samples after first_sample; its values too when the slice kept them in its own columns.
+void appendSlice(const SliceResult& slice, std::size_t line_no, std::size_t first_sample, Recording& rec,
                  const std::vector<std::vector<double>*>& targets) {
-  const std::size_t first_sample = rec.size();
   for (LostSamples lost : slice.lost) {
     lost.line += line_no;
     lost.before_sample += first_sample;
@@ -366,7 +378,7 @@ void appendSlice(const SliceResult& slice, std::size_t line_no, Recording& rec,
       rec.line_runs.push_back({sample, line});
   }
   for (std::size_t line : slice.sample_lines) rec.line_numbers.push_back(line_no + line);
-  for (std::size_t c = 0; c < targets.size(); ++c)
+  for (std::size_t c = 0; c < slice.columns.size(); ++c)
     targets[c]->insert(targets[c]->end(), slice.columns[c].begin(), slice.columns[c].end());
 }
 
@@ -492,46 +504,54 @@ Recording parseRecordingFile(std::FILE* file, const std::string& path, const Rea
     parser.column_names.push_back(columnName(c));
     parser.may_be_empty.push_back(roles[c].first == Role::Stream);
   }
-  bool reserved = false;
-  // Appends a parsed slice whose text starts at byte `text_start` of the file after line line_no.
-  const auto append = [&](std::string_view text, std::uint64_t text_start, const SliceResult& slice) {
+  // Appends a parsed slice whose text starts at byte `text_start` of the file after line
+  // line_no, its samples after first_sample.
+  const auto append = [&](std::string_view text, std::uint64_t text_start, std::size_t first_sample,
+                          const SliceResult& slice) {
     if (!slice.error.empty()) fail(path, line_no + slice.lines, slice.error);
-    if (!reserved && slice.samples > 0) {
-      reserved = true;
-      const std::size_t lines = expectedLines(file, text.size() / slice.lines);
-      for (auto* target : targets) target->reserve(lines);
-      if (options.line_numbers) rec.line_numbers.reserve(lines);
-    }
-    appendSlice(slice, line_no, rec, targets);
+    appendSlice(slice, line_no, first_sample, rec, targets);
     reportProgress(options, text, text_start, line_no, slice.lines);
     line_no += slice.lines;
   };
 
   if (bare_numbers) {
     SliceResult slice;
+    slice.clear(roles.size());
     parser.parse(first, slice);
     --line_no;  // `first` is line line_no: the slice's line 1
-    append(first, reader.bytesConsumed(), slice);
+    append(first, reader.bytesConsumed(), 0, slice);
   }
   // The rest in batches of whole lines (about a chunk each), each cut in two slices that are
   // parsed on both cores and appended in file order: the first bad line is still the one named.
-  SliceResult front_slice, back_slice;  // reused: their columns are allocated once
+  // The front slice stores its values straight into the recording's columns (allocated once,
+  // from the file's size and the first batch's line length); the back slice into its own,
+  // copied after them.
+  SliceResult front_slice, back_slice;  // reused: the back slice's columns are allocated once
+  bool reserved = false;
   while (true) {
     const auto result = reader.nextLines();
     if (result == ChunkedLineReader::Result::End) break;
     if (result == ChunkedLineReader::Result::TooLong) fail(path, line_no + 1, lineTooLongCause(reader.maxBytes()));
     const std::string_view text = reader.line();
     const std::uint64_t text_start = reader.bytesConsumed() - text.size();
+    if (!reserved) {
+      reserved = true;
+      const auto lines = static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1;
+      const std::size_t expected = expectedLines(file, text.size() / lines);
+      for (auto* target : targets) target->reserve(expected);
+      if (options.line_numbers) rec.line_numbers.reserve(expected);
+    }
     const auto [front, back] = splitAtLineNearMiddle(text);
-    front_slice.clear();
-    back_slice.clear();
+    const std::size_t first_sample = rec.size();
+    front_slice.clear(roles.size(), &targets);
+    back_slice.clear(roles.size());
     if (back.empty())
       parser.parse(front, front_slice);
     else
       processing::runBoth([&, front = front] { parser.parse(front, front_slice); },
                           [&, back = back] { parser.parse(back, back_slice); });
-    append(front, text_start, front_slice);
-    if (!back.empty()) append(back, text_start + front.size(), back_slice);
+    append(front, text_start, first_sample, front_slice);
+    if (!back.empty()) append(back, text_start + front.size(), first_sample + front_slice.samples, back_slice);
   }
   if (std::ferror(file)) fail(path, line_no, std::string("read error: ") + std::strerror(errno));
   if (rec.size() == 0) fail(path, header_line, "no samples after the header");
