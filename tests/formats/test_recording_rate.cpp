@@ -40,7 +40,7 @@ struct Lcg {
 TEST(RecordingRate, MedianStepIsTheSortedMiddleToTheBit) {
   Lcg rng{20261125};
   std::vector<std::vector<double>> columns;
-  for (std::size_t n : {2u, 3u, 4u, 5u, 100u, 1025u, 20'001u, 20'002u}) {
+  for (std::size_t n : {2u, 3u, 4u, 5u, 100u, 1025u, 20'001u, 20'002u, 300'001u}) {  // the last on both cores
     std::vector<double> printed(n), jittered(n), two_steps(n);
     double now = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -68,16 +68,27 @@ TEST(RecordingRate, MedianStepIsTheSortedMiddleToTheBit) {
   }
 }
 
+// On one core or two (a long column is counted in halves), the first such step in the file.
 TEST(RecordingRate, TheFirstStepThatIsNotPositiveIsNamed) {
-  std::vector<double> t(5000);
-  for (std::size_t i = 0; i < t.size(); ++i) t[i] = 0.5 * static_cast<double>(i);
-  t[3000] = t[2999];
-  t[4000] = 0.0;
-  try {
-    (void)sampleRateFromTimes(withTimes(t));
-    FAIL() << "accepted t standing still";
-  } catch (const RecordingError& e) {
-    EXPECT_EQ(std::string(e.what()), "rec.csv:3001: column 't' is not strictly increasing (t = 1499.5 after 1499.5)");
+  for (const std::size_t n : {std::size_t{5000}, std::size_t{400'000}}) {
+    std::vector<double> t(n);
+    for (std::size_t i = 0; i < t.size(); ++i) t[i] = 0.5 * static_cast<double>(i);
+    t[3000] = t[2999];
+    t[n - 1000] = 0.0;
+    for (const bool both_halves : {true, false}) {
+      if (!both_halves) t[3000] = 1500.0;  // only the later one left
+      try {
+        (void)sampleRateFromTimes(withTimes(t));
+        FAIL() << "accepted t standing still";
+      } catch (const RecordingError& e) {
+        const std::string expected =
+            both_halves
+                ? "rec.csv:3001: column 't' is not strictly increasing (t = 1499.5 after 1499.5)"
+                : "rec.csv:" + std::to_string(n - 999) + ": column 't' is not strictly increasing (t = 0 after " +
+                      std::to_string(static_cast<int>(n - 1001) / 2) + (n % 2 == 0 ? ".5" : "") + ")";
+        EXPECT_EQ(std::string(e.what()), expected);
+      }
+    }
   }
   EXPECT_THROW((void)sampleRateFromTimes(withTimes({1.0})), RecordingError);
 }
