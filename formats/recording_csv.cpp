@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <barrier>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -19,6 +20,7 @@
 
 #include <sys/stat.h>
 
+#include "formats/chunked_line_reader.hpp"
 #include "formats/csv_fields.hpp"
 #include "formats/quoted_value.hpp"
 #include "processing/parallel_share.hpp"
@@ -48,88 +50,6 @@ std::vector<double>* streamColumn(Recording& rec, std::size_t index) {
 }
 
 bool isSkippable(std::string_view line) { return line.empty() || line.front() == '#'; }
-
-// Lines of at most `max_bytes` bytes (the '\n' not counted) from a std::FILE, read in large
-// chunks: one copy of the text, no allocation per line, the same results as
-// BoundedLineReader (a line past the limit stops the reading).
-class ChunkedLineReader {
- public:
-  enum class Result { Line, End, TooLong };
-  static constexpr std::size_t kChunkBytes = std::size_t{1} << 20;
-
-  ChunkedLineReader(std::FILE* file, std::size_t max_bytes)
-      : file_(file), max_bytes_(max_bytes), buffer_(kChunkBytes + max_bytes + 2) {}
-
-  Result next() {
-    while (true) {
-      const char* begin = buffer_.data() + pos_;
-      const std::size_t available = end_ - pos_;
-      if (const void* nl = std::memchr(begin, '\n', available)) {
-        const auto length = static_cast<std::size_t>(static_cast<const char*>(nl) - begin);
-        line_ = {begin, length};
-        pos_ += length + 1;
-        consumed_ += length + 1;
-        return length > max_bytes_ ? Result::TooLong : Result::Line;
-      }
-      if (available > max_bytes_) return Result::TooLong;
-      if (eof_) {
-        if (available == 0) return Result::End;
-        line_ = {begin, available};
-        pos_ = end_;
-        consumed_ += available;
-        return Result::Line;
-      }
-      refill(begin, available);
-    }
-  }
-  // Every complete line now in the buffer, with their '\n' (refilling first when there is
-  // none), or the last line of the file without one. Lines longer than the limit are left
-  // to the caller to find; TooLong when no line ends within the limit.
-  Result nextLines() {
-    while (true) {
-      const char* begin = buffer_.data() + pos_;
-      const std::size_t available = end_ - pos_;
-      if (const void* nl = available > 0 ? ::memrchr(begin, '\n', available) : nullptr) {
-        const auto length = static_cast<std::size_t>(static_cast<const char*>(nl) - begin) + 1;
-        line_ = {begin, length};
-        pos_ += length;
-        consumed_ += length;
-        return Result::Line;
-      }
-      if (available > max_bytes_) return Result::TooLong;
-      if (eof_) {
-        if (available == 0) return Result::End;
-        line_ = {begin, available};
-        pos_ = end_;
-        consumed_ += available;
-        return Result::Line;
-      }
-      refill(begin, available);
-    }
-  }
-  std::string_view line() const { return line_; }
-  std::size_t maxBytes() const { return max_bytes_; }
-  std::uint64_t bytesConsumed() const { return consumed_; }
-
- private:
-  // Keeps the partial line (at most max_bytes_) and fills the rest of the buffer.
-  void refill(const char* begin, std::size_t available) {
-    std::memmove(buffer_.data(), begin, available);
-    pos_ = 0;
-    end_ = available;
-    const std::size_t got = std::fread(buffer_.data() + end_, 1, buffer_.size() - end_, file_);
-    end_ += got;
-    if (got == 0) eof_ = true;
-  }
-
-  std::FILE* file_;
-  std::size_t max_bytes_;
-  std::vector<char> buffer_;
-  std::size_t pos_ = 0, end_ = 0;
-  std::uint64_t consumed_ = 0;
-  bool eof_ = false;
-  std::string_view line_;
-};
 
 struct FileCloser {
   void operator()(std::FILE* f) const { std::fclose(f); }
@@ -204,7 +124,8 @@ std::vector<ColumnRole> headerRoles(const std::string& path, std::size_t line_no
 // What a slice of the sample lines yields, numbered from the slice: its first line is 1 and
 // its first sample 0. Slices are parsed apart (on both cores) and appended in file order.
 struct SliceResult {
-  std::vector<std::vector<double>> columns;   // one per field of the header
+  std::vector<std::vector<double>> columns;   // one per field of the header, when stored here
+  std::vector<std::vector<double>*> store;    // where the values go: `columns`, or the recording's
   std::vector<Recording::LineRun> line_runs;  // runs within the slice
   std::vector<std::size_t> sample_lines;      // each sample's line (only with ReadOptions::line_numbers)
   std::vector<LostSamples> lost;              // GAP and DROPPED lines
@@ -212,9 +133,19 @@ struct SliceResult {
   std::size_t samples = 0;
   std::string error;  // the cause of the first bad line (the slice's last), empty when none
 
-  // Empty again, keeping the columns' memory for the next slice.
-  void clear() {
-    for (auto& column : columns) column.clear();
+  // Empty again, keeping the columns' memory for the next slice; the values go to `targets`
+  // (the recording's columns) when given, else to this slice's own columns.
+  void clear(std::size_t column_count, const std::vector<std::vector<double>*>* targets = nullptr) {
+    columns.resize(targets ? 0 : column_count);
+    store.clear();
+    for (std::size_t c = 0; c < column_count; ++c) {
+      if (targets) {
+        store.push_back((*targets)[c]);
+      } else {
+        columns[c].clear();
+        store.push_back(&columns[c]);
+      }
+    }
     line_runs.clear();
     sample_lines.clear();
     lost.clear();
@@ -235,7 +166,6 @@ struct SliceParser {
   // Parses the lines of `text` (each ending in '\n' but maybe the last) into `out`,
   // stopping at the first bad line.
   void parse(std::string_view text, SliceResult& out) const {
-    out.columns.resize(column_names.size());
     std::array<std::string_view, kKnownColumns.size() + kStreamColumns.size()> fields;
     std::size_t start = 0;
     while (start < text.size()) {
@@ -276,7 +206,9 @@ struct SliceParser {
   // sample is stored and the start of the next line returned; 0 (nothing stored) for any
   // other line, left to the general path with its messages.
   std::size_t parsePlainLine(std::string_view text, std::size_t start, SliceResult& out) const {
-    std::array<double, kKnownColumns.size() + kStreamColumns.size()> values{};
+    // Not zeroed: a line sets every value it stores, and zeroing 19 doubles a line cost as much
+    // as the rest of this function.
+    std::array<double, kKnownColumns.size() + kStreamColumns.size()> values;
     const char* p = text.data() + start;
     const char* const end = text.data() + text.size();
     const std::size_t columns = column_names.size();
@@ -296,7 +228,7 @@ struct SliceParser {
     const auto line_end = static_cast<std::size_t>(p - text.data());
     if (line_end - start > max_bytes) return 0;
     ++out.lines;
-    for (std::size_t c = 0; c < columns; ++c) out.columns[c].push_back(values[c]);
+    for (std::size_t c = 0; c < columns; ++c) out.store[c]->push_back(values[c]);
     recordSample(out);
     return line_end + 1;  // past the '\n' (or the end of the text)
   }
@@ -321,7 +253,7 @@ struct SliceParser {
     }
     for (std::size_t c = 0; c < count; ++c) {
       if (fields[c].empty() && may_be_empty[c]) {  // a value the sample did not have
-        out.columns[c].push_back(std::numeric_limits<double>::quiet_NaN());
+        out.store[c]->push_back(std::numeric_limits<double>::quiet_NaN());
         continue;
       }
       const auto value = parseNumber(fields[c]);
@@ -333,7 +265,7 @@ struct SliceParser {
         out.error = "column '" + column_names[c] + "': non-finite value " + formats::quotedValue(fields[c]);
         return false;
       }
-      out.columns[c].push_back(*value);
+      out.store[c]->push_back(*value);
     }
     recordSample(out);
     return true;
@@ -351,10 +283,10 @@ std::pair<std::string_view, std::string_view> splitAtLineNearMiddle(std::string_
   return {text.substr(0, nl + 1), text.substr(nl + 1)};
 }
 
-// A slice's samples, records and line runs appended to `rec`, its lines numbered after line_no.
-void appendSlice(const SliceResult& slice, std::size_t line_no, Recording& rec,
-                 const std::vector<std::vector<double>*>& targets) {
-  const std::size_t first_sample = rec.size();
+// A slice's records and line runs appended to `rec`, its lines numbered after line_no and its
+// samples after first_sample; its values too, to `targets`, unless null (already there).
+void appendSlice(const SliceResult& slice, std::size_t line_no, std::size_t first_sample, Recording& rec,
+                 const std::vector<std::vector<double>*>* targets) {
   for (LostSamples lost : slice.lost) {
     lost.line += line_no;
     lost.before_sample += first_sample;
@@ -366,8 +298,9 @@ void appendSlice(const SliceResult& slice, std::size_t line_no, Recording& rec,
       rec.line_runs.push_back({sample, line});
   }
   for (std::size_t line : slice.sample_lines) rec.line_numbers.push_back(line_no + line);
-  for (std::size_t c = 0; c < targets.size(); ++c)
-    targets[c]->insert(targets[c]->end(), slice.columns[c].begin(), slice.columns[c].end());
+  if (targets)
+    for (std::size_t c = 0; c < slice.columns.size(); ++c)
+      (*targets)[c]->insert((*targets)[c]->end(), slice.columns[c].begin(), slice.columns[c].end());
 }
 
 // ReadOptions::progress at every multiple of kProgressLines among the `lines` lines of
@@ -385,6 +318,87 @@ void reportProgress(const ReadOptions& options, std::string_view text, std::uint
       pos = nl == std::string_view::npos ? text.size() : nl + 1;
     }
     options.progress(mark, text_start + pos);
+  }
+}
+
+// The sample lines after the header, in batches of whole lines (about a chunk each), each cut
+// in two slices parsed on both cores and appended in file order: the first bad line is still
+// the one named. The front slice stores its values straight into the recording's columns
+// (allocated once, from the file's size and the first batch's line length), the back slice
+// into its own. Once both are parsed, the front's thread copies the back slice's values after
+// the front's while the calling thread reports progress and reads the next batch.
+void readSampleLines(ChunkedLineReader& reader, const SliceParser& parser,
+                     const std::vector<std::vector<double>*>& targets, const ReadOptions& options, std::FILE* file,
+                     std::size_t& line_no, Recording& rec) {
+  const std::string& path = rec.path;
+  const std::size_t columns = targets.size();
+  // Checks a parsed slice and appends its records and line runs (and its values, unless
+  // already copied), its samples after first_sample.
+  const auto append = [&](const SliceResult& slice, std::size_t first_sample, bool values_copied) {
+    if (!slice.error.empty()) fail(path, line_no + slice.lines, slice.error);
+    appendSlice(slice, line_no, first_sample, rec, values_copied ? nullptr : &targets);
+    line_no += slice.lines;
+  };
+  SliceResult front_slice, back_slice;  // reused: the back slice's columns are allocated once
+  bool reserved = false;
+  const bool two_cores = processing::shareThreadCount() > 1;
+  std::barrier both_parsed(2);
+  while (true) {
+    const auto result = reader.nextLines();
+    if (result == ChunkedLineReader::Result::End) break;
+    if (result == ChunkedLineReader::Result::TooLong) fail(path, line_no + 1, lineTooLongCause(reader.maxBytes()));
+    const std::string_view text = reader.line();
+    const std::uint64_t text_start = reader.bytesConsumed() - text.size();
+    if (!reserved) {
+      reserved = true;
+      const auto lines = static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1;
+      const std::size_t expected = expectedLines(file, text.size() / lines);
+      for (auto* target : targets) target->reserve(expected);
+      if (options.line_numbers) rec.line_numbers.reserve(expected);
+    }
+    const auto [front, back] = splitAtLineNearMiddle(text);
+    const std::size_t first_sample = rec.size();
+    front_slice.clear(columns, &targets);
+    back_slice.clear(columns);
+    if (back.empty() || !two_cores) {
+      for (const auto& [slice_text, slice] : {std::pair{front, &front_slice}, std::pair{back, &back_slice}}) {
+        if (slice_text.empty()) continue;
+        const std::size_t slice_line = line_no;
+        parser.parse(slice_text, *slice);
+        append(*slice, rec.size() - (slice == &front_slice ? slice->samples : 0), false);
+        reportProgress(options, slice_text, text_start + static_cast<std::size_t>(slice_text.data() - text.data()),
+                       slice_line, slice->lines);
+      }
+      continue;
+    }
+    // Both threads meet once their slice is parsed, even when a parse throws (memory).
+    const auto parse = [&](std::string_view slice_text, SliceResult& slice) {
+      try {
+        parser.parse(slice_text, slice);
+      } catch (...) {
+        both_parsed.arrive_and_wait();
+        throw;
+      }
+      both_parsed.arrive_and_wait();
+    };
+    const auto fine = [](const SliceResult& slice) { return slice.error.empty(); };
+    processing::runBoth(
+        [&, front = front] {
+          parse(front, front_slice);
+          if (fine(front_slice) && fine(back_slice))
+            for (std::size_t c = 0; c < columns; ++c)
+              targets[c]->insert(targets[c]->end(), back_slice.columns[c].begin(), back_slice.columns[c].end());
+        },
+        [&, front = front, back = back] {
+          parse(back, back_slice);
+          if (!fine(front_slice)) return;
+          reportProgress(options, front, text_start, line_no, front_slice.lines);
+          if (!fine(back_slice)) return;
+          reportProgress(options, back, text_start + front.size(), line_no + front_slice.lines, back_slice.lines);
+          reader.prefetch();  // the text of both slices is no longer needed
+        });
+    append(front_slice, first_sample, true);
+    append(back_slice, first_sample + front_slice.samples, true);
   }
 }
 
@@ -492,47 +506,17 @@ Recording parseRecordingFile(std::FILE* file, const std::string& path, const Rea
     parser.column_names.push_back(columnName(c));
     parser.may_be_empty.push_back(roles[c].first == Role::Stream);
   }
-  bool reserved = false;
-  // Appends a parsed slice whose text starts at byte `text_start` of the file after line line_no.
-  const auto append = [&](std::string_view text, std::uint64_t text_start, const SliceResult& slice) {
-    if (!slice.error.empty()) fail(path, line_no + slice.lines, slice.error);
-    if (!reserved && slice.samples > 0) {
-      reserved = true;
-      const std::size_t lines = expectedLines(file, text.size() / slice.lines);
-      for (auto* target : targets) target->reserve(lines);
-      if (options.line_numbers) rec.line_numbers.reserve(lines);
-    }
-    appendSlice(slice, line_no, rec, targets);
-    reportProgress(options, text, text_start, line_no, slice.lines);
-    line_no += slice.lines;
-  };
-
   if (bare_numbers) {
     SliceResult slice;
+    slice.clear(roles.size());
     parser.parse(first, slice);
     --line_no;  // `first` is line line_no: the slice's line 1
-    append(first, reader.bytesConsumed(), slice);
+    if (!slice.error.empty()) fail(path, line_no + slice.lines, slice.error);
+    appendSlice(slice, line_no, 0, rec, &targets);
+    reportProgress(options, first, reader.bytesConsumed(), line_no, slice.lines);
+    line_no += slice.lines;
   }
-  // The rest in batches of whole lines (about a chunk each), each cut in two slices that are
-  // parsed on both cores and appended in file order: the first bad line is still the one named.
-  SliceResult front_slice, back_slice;  // reused: their columns are allocated once
-  while (true) {
-    const auto result = reader.nextLines();
-    if (result == ChunkedLineReader::Result::End) break;
-    if (result == ChunkedLineReader::Result::TooLong) fail(path, line_no + 1, lineTooLongCause(reader.maxBytes()));
-    const std::string_view text = reader.line();
-    const std::uint64_t text_start = reader.bytesConsumed() - text.size();
-    const auto [front, back] = splitAtLineNearMiddle(text);
-    front_slice.clear();
-    back_slice.clear();
-    if (back.empty())
-      parser.parse(front, front_slice);
-    else
-      processing::runBoth([&, front = front] { parser.parse(front, front_slice); },
-                          [&, back = back] { parser.parse(back, back_slice); });
-    append(front, text_start, front_slice);
-    if (!back.empty()) append(back, text_start + front.size(), back_slice);
-  }
+  readSampleLines(reader, parser, targets, options, file, line_no, rec);
   if (std::ferror(file)) fail(path, line_no, std::string("read error: ") + std::strerror(errno));
   if (rec.size() == 0) fail(path, header_line, "no samples after the header");
   return rec;
@@ -553,30 +537,6 @@ Recording parseRecordingCsv(std::istream& in, const std::string& path) {
   const std::unique_ptr<std::FILE, FileCloser> file(::fmemopen(text.data(), text.size(), "rb"));
   if (!file) fail(path, 0, std::string("cannot read: ") + std::strerror(errno));
   return parseRecordingFile(file.get(), path, ReadOptions{});
-}
-
-double sampleRateFromTimes(const Recording& r) {
-  if (r.t.size() < 2) throw RecordingError(r.path + ": need at least two samples in column 't' to infer the rate");
-  std::vector<double> dt(r.t.size() - 1);
-  for (std::size_t i = 1; i < r.t.size(); ++i) {
-    dt[i - 1] = r.t[i] - r.t[i - 1];
-    if (!(dt[i - 1] > 0.0)) {
-      std::ostringstream s;
-      s.precision(17);
-      s << r.path << ':' << r.lineOfSample(i) << ": column 't' is not strictly increasing (t = " << r.t[i] << " after "
-        << r.t[i - 1] << ")";
-      throw RecordingError(s.str());
-    }
-  }
-  auto mid = dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2);
-  std::nth_element(dt.begin(), mid, dt.end());
-  if (!std::isfinite(1.0 / *mid)) {  // steps of 1e-320 s are positive, but no rate
-    std::ostringstream s;
-    s.precision(17);
-    s << r.path << ": column 't' steps by " << *mid << " s, too small for a sample rate";
-    throw RecordingError(s.str());
-  }
-  return 1.0 / *mid;
 }
 
 }  // namespace gyrod::recording

@@ -33,6 +33,44 @@ void SampleTimingCheck::add(double t_s, std::size_t line) {
   last_t_s_ = t_s;
 }
 
+void SampleTimingCheck::addTimes(std::span<const double> t, const std::function<std::size_t(std::size_t)>& line_of) {
+  std::size_t i = 0;
+  for (; i < t.size() && (!settled_ || report_.samples == 0); ++i) add(t[i], line_of(i));
+  if (i == t.size()) return;
+  // An interval that is neither a gap nor irregular only adds to the jitter: done here, in
+  // the same order and with the same expressions as classify(), which takes every other one.
+  const double nominal = report_.nominal_dt_s;
+  const double gap_limit = report_.limits.gap_factor * nominal;
+  const double jitter_limit = report_.limits.jitter_tolerance * nominal;
+  double last = last_t_s_, max_jitter = report_.max_jitter_s, sum_squared = sum_squared_jitter_;
+  std::size_t regular = 0;
+  for (; i < t.size(); ++i) {
+    const double dt = t[i] - last;
+    const double jitter = std::abs(dt - nominal);
+    if (!(nominal > 0.0 && dt > gap_limit) && dt > 0.0 && jitter <= jitter_limit) {
+      max_jitter = std::max(max_jitter, jitter);
+      sum_squared += jitter * jitter;
+      ++regular;
+    } else {
+      report_.samples += regular;
+      jitter_intervals_ += regular;
+      regular = 0;
+      report_.max_jitter_s = max_jitter;
+      sum_squared_jitter_ = sum_squared;
+      ++report_.samples;
+      classify(last, t[i], line_of(i));
+      max_jitter = report_.max_jitter_s;
+      sum_squared = sum_squared_jitter_;
+    }
+    last = t[i];
+  }
+  report_.samples += regular;
+  jitter_intervals_ += regular;
+  report_.max_jitter_s = max_jitter;
+  sum_squared_jitter_ = sum_squared;
+  last_t_s_ = last;
+}
+
 void SampleTimingCheck::settleNominal() {
   settled_ = true;
   std::array<double, kNominalIntervals> positive{};

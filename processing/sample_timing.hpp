@@ -18,7 +18,9 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
+#include <span>
 
 namespace gyrod::processing {
 
@@ -63,6 +65,9 @@ class SampleTimingCheck {
 
   // The next sample's time (s) and, for the report, its line in the file (0: none).
   void add(double t_s, std::size_t line = 0);
+  // The same as add(t[i], line_of(i)) for each i in order (the same report, bit for bit), in
+  // one tight loop: line_of is asked only for the intervals the report keeps or that settle τ0.
+  void addTimes(std::span<const double> t, const std::function<std::size_t(std::size_t)>& line_of);
 
   // What the times fed so far show; may be called at any point (fewer than kNominalIntervals
   // intervals and no τ0 given: the median of those there are).

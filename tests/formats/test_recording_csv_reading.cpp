@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -17,6 +18,7 @@
 #include "formats/csv_fields.hpp"
 #include "formats/recording_csv.hpp"
 #include "formats/recording_format.hpp"
+#include "processing/parallel_share.hpp"
 
 using namespace gyrod::recording;
 namespace fs = std::filesystem;
@@ -129,6 +131,74 @@ TEST(RecordingReading, TheFirstBadLineIsNamedWhereverItFalls) {
   }
 }
 
+// Runs a block with the reader's thread count fixed (processing/parallel_share.hpp).
+class FixedThreads {
+ public:
+  explicit FixedThreads(std::size_t n) { gyrod::processing::shareThreadOverride().store(n); }
+  ~FixedThreads() { gyrod::processing::shareThreadOverride().store(0); }
+  FixedThreads(const FixedThreads&) = delete;
+  FixedThreads& operator=(const FixedThreads&) = delete;
+};
+
+// A bad line as the last line of a front slice, the first of a back slice, the last of a
+// batch and the first of the next, on one core and on two: always the one named. The edges
+// are found as the reader cuts them today (a buffer of 1 MiB + the line limit + 2 bytes, each
+// batch up to its last line end, split at the first line end past its middle); were that to
+// change, the lines tried would still be bad lines of a long file.
+TEST(RecordingReading, ABadLineAtASliceOrBatchEdgeIsNamed) {
+  const Written w = longFile();
+  const std::size_t buffer = (std::size_t{1} << 20) + kMaxLineBytes + 2;
+  std::vector<std::size_t> starts;  // byte offsets of the lines to spoil
+  std::size_t batch_start = w.text.find('\n', w.text.find("t,gx,gy")) + 1;
+  for (int batch = 0; batch < 2; ++batch) {
+    const std::size_t batch_end = w.text.rfind('\n', batch_start + buffer - 1) + 1;
+    const std::size_t middle = w.text.find('\n', batch_start + (batch_end - batch_start) / 2) + 1;
+    for (const std::size_t edge : {middle, batch_end}) {
+      starts.push_back(w.text.rfind('\n', edge - 2) + 1);  // the line before the edge
+      starts.push_back(edge);                              // the line after it
+    }
+    batch_start = batch_end;
+  }
+  for (const std::size_t threads : {std::size_t{1}, std::size_t{2}}) {
+    const FixedThreads fixed(threads);
+    for (const std::size_t at : starts) {
+      std::string text = w.text;
+      text.replace(at, text.find('\n', at) - at, "0,1,x");
+      const auto line =
+          static_cast<std::size_t>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n')) + 1;
+      TempFile f(text);
+      try {
+        (void)readRecordingCsv(f.path());
+        FAIL() << "accepted a bad value at line " << line;
+      } catch (const RecordingError& e) {
+        EXPECT_EQ(std::string(e.what()), f.path() + ":" + std::to_string(line) + ": column 'gy': 'x' is not a number")
+            << threads << " thread(s)";
+      }
+    }
+  }
+}
+
+// One core or two: the same values, lines and records.
+TEST(RecordingReading, OneCoreAndTwoCoresReadTheSame) {
+  Written w = longFile();
+  RecordingLine gap;
+  w.text += formatGapLine(gap, 60'000, 1200.0, 3, "fifo_overflow");
+  w.text += "1200.06,0.5,0.25\n";
+  TempFile f(w.text);
+  std::vector<Recording> read;
+  for (const std::size_t threads : {std::size_t{1}, std::size_t{2}}) {
+    const FixedThreads fixed(threads);
+    read.push_back(readRecordingCsv(f.path()));
+  }
+  ASSERT_EQ(read[0].size(), w.gy.size() + 1);
+  EXPECT_EQ(read[0].t, read[1].t);
+  EXPECT_EQ(read[0].axes, read[1].axes);
+  EXPECT_EQ(read[0].line_numbers, read[1].line_numbers);
+  EXPECT_EQ(read[0].lost, read[1].lost);
+  ASSERT_EQ(read[1].lost.size(), 1u);
+  EXPECT_EQ(read[1].lost[0].before_sample, w.gy.size());
+}
+
 // GAP lines anywhere in a long file: each record keeps its line and the sample after it.
 TEST(RecordingReading, GapRecordsKeepTheirPlaceInLongFiles) {
   std::string text = "t,gx\n";
@@ -168,10 +238,15 @@ TEST(RecordingReading, ProgressIsReportedEveryMillionLines) {
     reported_lines.push_back(lines);
     reported_bytes.push_back(bytes);
   };
-  const Recording rec = readRecordingCsv(f.path(), options);
-  EXPECT_EQ(rec.size(), count);
-  EXPECT_EQ(reported_lines, (std::vector<std::size_t>{kProgressLines, 2 * kProgressLines}));
-  EXPECT_EQ(reported_bytes, (std::vector<std::uint64_t>{2 * kProgressLines, 4 * kProgressLines}));
+  for (const std::size_t threads : {std::size_t{1}, std::size_t{2}}) {
+    const FixedThreads fixed(threads);
+    reported_lines.clear();
+    reported_bytes.clear();
+    const Recording rec = readRecordingCsv(f.path(), options);
+    EXPECT_EQ(rec.size(), count);
+    EXPECT_EQ(reported_lines, (std::vector<std::size_t>{kProgressLines, 2 * kProgressLines}));
+    EXPECT_EQ(reported_bytes, (std::vector<std::uint64_t>{2 * kProgressLines, 4 * kProgressLines}));
+  }
 }
 
 // Plain lines ("number,number\n") are read in one pass by from_chars; any other form (spaces,

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <span>
 #include <stdexcept>
 #include <vector>
 
@@ -132,6 +133,62 @@ TEST(SampleTiming, TimeGoingBackIsIrregular) {
   EXPECT_EQ(r.gaps, 1u);       // then 20 ms
   ASSERT_TRUE(r.first_offending);
   EXPECT_EQ(r.first_offending->index, 150u);
+}
+
+void expectSameInterval(const std::optional<TimingInterval>& a, const std::optional<TimingInterval>& b) {
+  ASSERT_EQ(a.has_value(), b.has_value());
+  if (!a) return;
+  EXPECT_EQ(a->start_t_s, b->start_t_s);
+  EXPECT_EQ(a->dt_s, b->dt_s);
+  EXPECT_EQ(a->index, b->index);
+  EXPECT_EQ(a->line, b->line);
+}
+
+// addTimes gives add()'s report to the bit, asking for few lines, on jittered series with gaps,
+// repeated and backward times, whether τ0 is given or the median, fed in one piece or several.
+TEST(SampleTiming, AddTimesIsAddSampleBySample) {
+  SplitMix64 rng(20261125);
+  for (int round = 0; round < 24; ++round) {
+    const std::size_t n = round < 4 ? static_cast<std::size_t>(round) * 30 : 5000;
+    std::vector<double> t(n);
+    double now = 10.0 * uniform(rng);
+    for (std::size_t i = 0; i < n; ++i) {
+      const double u = uniform(rng);
+      now += u < 0.002   ? 0.02 * (2.0 + 50.0 * uniform(rng))          // a gap
+             : u < 0.004 ? -0.01 * uniform(rng)                        // back in time
+             : u < 0.006 ? 0.0                                         // standing still
+                         : 0.02 * (1.0 + 0.3 * (uniform(rng) - 0.5));  // jitter, some over 10 %
+      t[i] = now;
+    }
+    const std::optional<double> nominal = round % 2 == 0 ? std::nullopt : std::optional<double>(0.02);
+    SampleTimingCheck one(nominal), batch(nominal);
+    for (std::size_t i = 0; i < n; ++i) one.add(t[i], 3 * i + 7);
+    std::size_t asked = 0;
+    const std::size_t cut = round % 3 == 0 ? n : n / 3;  // in two pieces, the second numbered from its start
+    batch.addTimes(std::span<const double>(t).first(cut), [&](std::size_t i) {
+      ++asked;
+      return 3 * i + 7;
+    });
+    batch.addTimes(std::span<const double>(t).subspan(cut), [&](std::size_t i) {
+      ++asked;
+      return 3 * (i + cut) + 7;
+    });
+    const auto a = one.report(), b = batch.report();
+    EXPECT_EQ(a.samples, b.samples);
+    EXPECT_EQ(a.nominal_dt_s, b.nominal_dt_s);
+    EXPECT_EQ(a.gaps, b.gaps);
+    EXPECT_EQ(a.missing_samples, b.missing_samples);
+    EXPECT_EQ(a.irregular, b.irregular);
+    EXPECT_EQ(a.max_jitter_s, b.max_jitter_s);
+    EXPECT_EQ(a.rms_jitter_s, b.rms_jitter_s);
+    expectSameInterval(a.largest_gap, b.largest_gap);
+    expectSameInterval(a.first_offending, b.first_offending);
+    if (n == 5000) {
+      EXPECT_GT(a.irregular, 10u);
+      EXPECT_LT(a.irregular + a.gaps, n / 2);
+      EXPECT_LE(asked, a.irregular + a.gaps + kNominalIntervals + 1);  // the offending intervals, and τ0's
+    }
+  }
 }
 
 TEST(SampleTiming, RefusesBadNominalAndLimits) {

@@ -21,6 +21,7 @@
 #include "processing/noise_fit.hpp"
 #include "processing/noise_terms.hpp"
 #include "processing/noise_units.hpp"
+#include "processing/parallel_share.hpp"
 #include "processing/warm_up_fit.hpp"
 #include "protocol/allan_table.hpp"
 #include "tools/gyroctl/analyze_imu.hpp"
@@ -393,8 +394,13 @@ int runAnalyze(const AnalyzeOptions& opt) {
   options.mean_window = opt.mean_window;
   options.mean_threshold_dps = opt.mean_threshold_dps;
   options.max_ar_order = opt.max_ar_order;
-  for (std::size_t idx : in.axis_indices) requireAnalysableValues(rec, idx);
-  const TimingSummary timing = checkTiming(rec, opt.rate_hz);
+  // The values and the timing checked on both cores; a bad value is still reported first.
+  TimingSummary timing;
+  runBoth(
+      [&] {
+        for (std::size_t idx : in.axis_indices) requireAnalysableValues(rec, idx);
+      },
+      [&] { timing = checkTiming(rec, opt.rate_hz); });
   reportTiming(opt.file, timing, opt.strict_timing);
   const bool writes_model = !opt.write_model.empty();
   if (!writes_model) releaseColumnsNotAnalysed(rec);

@@ -60,7 +60,7 @@ void requireAnalysableValues(const recording::Recording& rec, std::size_t axis_i
 TimingSummary checkTiming(const recording::Recording& rec, std::optional<double> rate_hz) {
   if (rec.t.empty()) return summarizeTiming(std::nullopt, rec.lost);
   processing::SampleTimingCheck check(rate_hz ? std::optional<double>(1.0 / *rate_hz) : std::nullopt);
-  for (std::size_t i = 0; i < rec.t.size(); ++i) check.add(rec.t[i], rec.lineOfSample(i));
+  check.addTimes(rec.t, [&rec](std::size_t i) { return rec.lineOfSample(i); });
   return summarizeTiming(check.report(), rec.lost);
 }
 
