@@ -60,6 +60,10 @@ void score(const HiddenEffect& h, const AxisModelCheck& r, double duration, std:
       // Only a line found at the hidden frequency speaks about its amplitude.
       if (d && std::fabs(d->freq_hz - h.freq_hz) < 2.0 / duration && d->amp_interval.stated)
         x.add(d->amp_interval, h.amp_dps);
+      if (d && std::getenv("COVERAGE_VERBOSE"))
+        std::printf("sinusoid: amp %g in [%g, %g] est %g; freq %g est %g; further components %zu\n", h.amp_dps,
+                    d->amp_interval.lo, d->amp_interval.hi, d->amp_dps, h.freq_hz, d->freq_hz,
+                    d->evidence.further_components.size());
       break;
     }
     case ModelEffect::GaussMarkov: {

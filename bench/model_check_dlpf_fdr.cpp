@@ -1,11 +1,13 @@
 // False discoveries of the model check on clean gyrod-like recordings made through every DLPF
 // setting (processing/hidden_effect_generator.hpp with its dlpf_cfg set; the check told the
-// chain, as gyrod's '# device' header tells it). Any effect reported on an axis is a false
-// discovery. Not a unit test and not run by ctest: scripts/model-check-dlpf-fdr.sh builds and
+// chain, as gyrod's '# device' header tells it), and without a DLPF (`--cfg none`: 50 Hz,
+// FS_SEL 0 told, no DLPF — where the Gauss–Markov null is the joint fit's). Any effect
+// reported on an axis is a false discovery. Not a unit test and not run by ctest: scripts/model-check-dlpf-fdr.sh builds and
 // runs it; the table is in docs/model-check.md.
 //
-//   model_check_dlpf_fdr [--seeds N] [--first S] [--duration SEC] [--replicas R] [--cfg C]
+//   model_check_dlpf_fdr [--seeds N] [--first S] [--duration SEC] [--replicas R] [--cfg C|none]
 //                        [--threads T] [--rows-only 1] [--verbose 1|2]
+// Without --cfg: the settings 0..6 (not `none`).
 // The upper bound is Clopper–Pearson's, one-sided 95 % (0 of 300 axes: 1.0 %). --verbose
 // prints the base fit against the truth and the measured/replica-median Allan ratio per τ
 // of each flagged axis (2: of every axis).
@@ -15,6 +17,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -30,7 +33,9 @@ using gyrod::bench::clopperPearsonUpper95;
 int main(int argc, char** argv) {
   std::size_t seeds = 20, first = 1000, replicas = 40;
   double duration = 600.0;
-  int only_cfg = -1;
+  // The settings to run: 0..6 by default; kNone is "no DLPF".
+  constexpr int kNone = -1, kAll = -2;
+  int only_cfg = kAll;
   int verbose = 0;
   std::size_t threads = 0;
   bool rows_only = false;
@@ -52,15 +57,15 @@ int main(int argc, char** argv) {
     else if (key == "--verbose")
       verbose = std::atoi(v);
     else if (key == "--cfg")
-      only_cfg = std::atoi(v);
+      only_cfg = std::string(v) == "none" ? kNone : std::atoi(v);
     else {
       std::fprintf(stderr, "model_check_dlpf_fdr: unknown option %s\n", key.c_str());
       return 2;
     }
   }
   // Each setting at a rate it allows (the narrow ones at gyrod's default 50 Hz).
-  const std::vector<std::pair<int, double>> settings{{0, 100.0}, {1, 200.0}, {2, 200.0}, {3, 100.0},
-                                                     {4, 50.0},  {5, 50.0},  {6, 50.0}};
+  const std::vector<std::pair<int, double>> settings{{kNone, 50.0}, {0, 100.0}, {1, 200.0}, {2, 200.0},
+                                                     {3, 100.0},    {4, 50.0},  {5, 50.0},  {6, 50.0}};
   if (!rows_only) {
     std::printf("clean %g s records through each DLPF setting, %zu seeds from %zu, %zu replicas, 3 axes each\n\n",
                 duration, seeds, first, replicas);
@@ -70,12 +75,13 @@ int main(int argc, char** argv) {
   std::size_t all_axes = 0, all_false = 0;
   const auto start = std::chrono::steady_clock::now();
   for (const auto& [cfg, rate] : settings) {
-    if (only_cfg >= 0 && cfg != only_cfg) continue;
+    if (only_cfg == kAll ? cfg == kNone : cfg != only_cfg) continue;
+    const std::optional<int> dlpf = cfg == kNone ? std::nullopt : std::optional<int>(cfg);
     std::size_t axes = 0, false_axes = 0;
     std::map<std::string, std::size_t> named;
     for (std::size_t s = first; s < first + seeds; ++s) {
       HiddenEffectGenerator gen(s);
-      gen.dlpf_cfg = cfg;
+      gen.dlpf_cfg = dlpf;
       // The same number of samples at every rate: the check's cost and power depend on it.
       const GeneratedRecording g = gen.generate(duration * 50.0 / rate, rate, {});
       for (std::size_t a = 0; a < 3; ++a) {
@@ -83,7 +89,7 @@ int main(int argc, char** argv) {
         o.seed = s;
         o.replicas = replicas;
         o.threads = threads;
-        const AxisModelCheck r = checkAxisModel({g.axes[a], g.rate_hz, g.temp, g.t, {cfg, 0}}, o);
+        const AxisModelCheck r = checkAxisModel({g.axes[a], g.rate_hz, g.temp, g.t, {dlpf, 0}}, o);
         ++axes;
         if (!r.effects.empty()) ++false_axes;
         if (verbose > 1 || (verbose && !r.effects.empty())) {
@@ -108,7 +114,8 @@ int main(int argc, char** argv) {
     }
     std::string list;
     for (const auto& [name, count] : named) list += (list.empty() ? "" : ", ") + name + " " + std::to_string(count);
-    std::printf("| %d | %g | %zu | %zu | %.2f %% | %.2f %% | %s |\n", cfg, rate, axes, false_axes,
+    std::printf("| %s | %g | %zu | %zu | %.2f %% | %.2f %% | %s |\n",
+                cfg == kNone ? "none" : std::to_string(cfg).c_str(), rate, axes, false_axes,
                 100.0 * static_cast<double>(false_axes) / static_cast<double>(axes),
                 100.0 * clopperPearsonUpper95(false_axes, axes), list.empty() ? "none" : list.c_str());
     std::fflush(stdout);

@@ -7,7 +7,8 @@
 // sizes, the sinusoid's sine and cosine parts, the temperature coefficient) are refitted
 // jointly by least squares on each replica; the Gauss–Markov term by the Allan fit. The
 // interval is the estimate ± 1.96 × the replicas' robust spread (log scale for T and σ; T's
-// widened by one step of its fitting grid, which the replicas cannot show).
+// widened by one step of its fitting grid, which the replicas cannot show); the sinusoid's
+// amplitude from the Rice distribution of √(a² + b²) with the parts' pooled replica spread.
 // Outliers: an exact Poisson interval of the count, and the median excursion's normal one.
 #include <cstddef>
 #include <span>
@@ -25,6 +26,17 @@ ParameterInterval bootstrapInterval(double estimate, std::span<const double> rep
 ParameterInterval logBootstrapInterval(double estimate, std::span<const double> replica_estimates);
 // Exact (Garwood) 95 % interval of a Poisson mean from one count.
 ParameterInterval poissonInterval(std::size_t count);
+// P(R ≤ r) for R Rice-distributed with noncentrality ν and unit scale: the length of a 2-D
+// normal vector of unit variance per coordinate whose mean is ν from the origin.
+double riceCdf(double r, double nu);
+// A sinusoid's amplitude A = √(a² + b²) from its fitted amplitude and the replicas' fitted
+// sine and cosine parts (a, b): (â, b̂) ~ N((a, b), s²·I), s² pooled from both parts' replica
+// variances (2R − 2 degrees of freedom, s widened by t₀.₉₇₅/z₀.₉₇₅ for being estimated), so
+// Â/s is Rice(A/s); the interval is every A whose Rice distribution puts Â/s inside its
+// central 95 % (Neyman's construction: exact at any SNR, lower limit 0 when Â is
+// compatible with no line). Not stated with fewer than 8 finite replica pairs.
+ParameterInterval sinusoidAmplitudeInterval(double amplitude, std::span<const double> replica_a,
+                                            std::span<const double> replica_b);
 
 }  // namespace gyrod::processing
 
