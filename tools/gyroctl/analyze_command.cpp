@@ -10,6 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "formats/calibration.hpp"
 #include "formats/kalibr_yaml.hpp"
@@ -39,12 +40,14 @@ using nlohmann::json;
 // need ≥ 10 samples each to mean anything) nor a useful Allan curve.
 constexpr std::size_t kMinimumSamples = 100;
 // Consumes the column unless `keep` (the model's calibration reads it again): the analysis
-// then works in the column's own memory.
-AxisAnalysis analyzeColumn(recording::Recording& rec, std::size_t axis_index, const AnalysisOptions& options,
-                           bool keep) {
+// then works in the column's own memory. Every column shares `workspace` (the Allan tables'
+// phase and the filter outputs), whose pages are then allocated and cleared once.
+AxisAnalysis analyzeColumn(recording::Recording& rec, std::size_t axis_index, const AnalysisOptions& options, bool keep,
+                           processing::AllanWorkspace& workspace) {
   try {
-    if (keep) return analyzeAxis(std::span<const double>(rec.axes[axis_index]), options);
-    return analyzeAxis(std::move(rec.axes[axis_index]), options);
+    std::vector<double> column =
+        keep ? rec.axes[axis_index] : std::exchange(rec.axes[axis_index], std::vector<double>());
+    return analyzeAxis(std::move(column), options, workspace);
   } catch (const std::invalid_argument& e) {
     throw recording::RecordingError(rec.path + ": column '" + rec.axis_names[axis_index] + "': " + e.what());
   }
@@ -407,6 +410,7 @@ int runAnalyze(const AnalyzeOptions& opt) {
   step_timer("checks");
   std::vector<AxisAnalysis> analyses;
   analyses.reserve(in.axis_indices.size());
+  processing::AllanWorkspace workspace(samples);
   const bool show_progress = samples >= kProgressSamples && stderrIsTerminal();
   for (std::size_t k = 0; k < in.axis_indices.size(); ++k) {
     const std::size_t idx = in.axis_indices[k];
@@ -420,7 +424,7 @@ int runAnalyze(const AnalyzeOptions& opt) {
       column_options.step_done = [&step_timer, &name = rec.axis_names[idx]](const char* step) {
         step_timer(name + " " + step);
       };
-    analyses.push_back(analyzeColumn(rec, idx, column_options, writes_model));
+    analyses.push_back(analyzeColumn(rec, idx, column_options, writes_model, workspace));
   }
   if (show_progress) std::fprintf(stderr, "\r\033[K");
 
