@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <optional>
 #include <string_view>
 #include <vector>
 
@@ -32,15 +33,7 @@ class ChunkedLineReader {
         consumed_ += length + 1;
         return length > max_bytes_ ? Result::TooLong : Result::Line;
       }
-      if (available > max_bytes_) return Result::TooLong;
-      if (eof_) {
-        if (available == 0) return Result::End;
-        line_ = {begin, available};
-        pos_ = end_;
-        consumed_ += available;
-        return Result::Line;
-      }
-      refill(begin, available);
+      if (const auto result = withoutNewline(begin, available)) return *result;
     }
   }
   // Every complete line now in the buffer, with their '\n' (refilling first when there is
@@ -57,15 +50,7 @@ class ChunkedLineReader {
         consumed_ += length;
         return Result::Line;
       }
-      if (available > max_bytes_) return Result::TooLong;
-      if (eof_) {
-        if (available == 0) return Result::End;
-        line_ = {begin, available};
-        pos_ = end_;
-        consumed_ += available;
-        return Result::Line;
-      }
-      refill(begin, available);
+      if (const auto result = withoutNewline(begin, available)) return *result;
     }
   }
   // Reads on now, when nextLines() has taken every complete line: the partial line left moves
@@ -80,6 +65,21 @@ class ChunkedLineReader {
   std::uint64_t bytesConsumed() const { return consumed_; }
 
  private:
+  // No '\n' in the `available` bytes at `begin`: TooLong past the limit; at the end of the
+  // file the last line (End when nothing is left); else nothing, after a refill.
+  std::optional<Result> withoutNewline(const char* begin, std::size_t available) {
+    if (available > max_bytes_) return Result::TooLong;
+    if (eof_) {
+      if (available == 0) return Result::End;
+      line_ = {begin, available};
+      pos_ = end_;
+      consumed_ += available;
+      return Result::Line;
+    }
+    refill(begin, available);
+    return std::nullopt;
+  }
+
   // Keeps the partial line (at most max_bytes_) and fills the rest of the buffer.
   void refill(const char* begin, std::size_t available) {
     std::memmove(buffer_.data(), begin, available);
