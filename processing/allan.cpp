@@ -451,19 +451,20 @@ std::vector<int> noiseTypesForTable(std::span<const double> rate, std::span<cons
     if (int* alpha = top >= 2 ? alphaAt(2) : nullptr)
       *alpha = lag1NoiseIdOf([&](std::size_t k) { return sum2(k) / 2.0; }, count / 2);
     if (top < 4) return;
-    // From m = 4 on, level by level; the next level is formed before this one is scaled to
-    // averages, so that at most 3 bytes a sample of sums are held.
-    std::vector<double> sums(count / 4);
-    for (std::size_t k = 0; k < sums.size(); ++k) sums[k] = sum2(2 * k) + sum2(2 * k + 1);
+    // From m = 4 on, level by level in one buffer of 2 bytes a sample (not zeroed first: every
+    // value is written before it is read): each level's averages are read as sum / m, and the
+    // next level's sums then overwrite the front half of this one's (sums[k] is written after
+    // sums[2k] and sums[2k + 1] are read).
+    std::size_t level_size = count / 4;
+    const auto sums = std::make_unique_for_overwrite<double[]>(std::max<std::size_t>(level_size, 1));
+    for (std::size_t k = 0; k < level_size; ++k) sums[k] = sum2(2 * k) + sum2(2 * k + 1);
     for (std::size_t m = 4; m <= top; m *= 2) {
-      std::vector<double> next(sums.size() / 2);
-      for (std::size_t k = 0; k < next.size(); ++k) next[k] = sums[2 * k] + sums[2 * k + 1];
       if (int* alpha = alphaAt(m)) {
         const double md = static_cast<double>(m);
-        for (double& v : sums) v /= md;
-        *alpha = lag1NoiseIdOf([&sums](std::size_t k) { return sums[k]; }, sums.size());
+        *alpha = lag1NoiseIdOf([&sums, md](std::size_t k) { return sums[k] / md; }, level_size);
       }
-      sums = std::move(next);
+      level_size /= 2;
+      for (std::size_t k = 0; k < level_size; ++k) sums[k] = sums[2 * k] + sums[2 * k + 1];
     }
   };
   std::vector<std::size_t> others;  // indices into distinct

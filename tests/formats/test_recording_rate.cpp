@@ -55,13 +55,20 @@ TEST(RecordingRate, MedianStepIsTheSortedMiddleToTheBit) {
   }
   // Short steps just where the reader samples 1024 steps evenly, long ones elsewhere: a guess
   // from the sample misses the median.
-  const std::size_t steps = 40'000;
-  std::vector<bool> sampled(steps + 1, false);
-  for (std::size_t j = 0; j < 1024; ++j) sampled[j * steps / 1024 + 1] = true;
-  std::vector<double> misleading(steps + 1);
-  for (std::size_t i = 1; i <= steps; ++i)
-    misleading[i] = misleading[i - 1] + (sampled[i] ? 0.001 : 0.02 + 1e-9 * static_cast<double>(i % 97));
-  columns.push_back(misleading);
+  // On one core and on both (the search by bits counts each half apart).
+  for (const std::size_t steps : {std::size_t{40'000}, std::size_t{300'000}}) {
+    std::vector<bool> sampled(steps + 1, false);
+    for (std::size_t j = 0; j < 1024; ++j) sampled[j * steps / 1024 + 1] = true;
+    std::vector<double> misleading(steps + 1);
+    for (std::size_t i = 1; i <= steps; ++i)
+      misleading[i] = misleading[i - 1] + (sampled[i] ? 0.001 : 0.02 + 1e-9 * static_cast<double>(i % 97));
+    columns.push_back(misleading);
+  }
+  // A 50 Hz clock from t = 60000 s on: a few distinct steps, in a pattern the even sample
+  // aliases (its median lies outside the bracket it guesses).
+  std::vector<double> aliased(300'001);
+  for (std::size_t i = 0; i < aliased.size(); ++i) aliased[i] = 60000.0 + 0.02 * static_cast<double>(i);
+  columns.push_back(aliased);
   for (const auto& t : columns) {
     const double expected = rateBySorting(t);
     EXPECT_EQ(sampleRateFromTimes(withTimes(t)), expected) << t.size() << " samples";
