@@ -743,10 +743,20 @@ void requireCapacity(const AllanWorkspace& workspace, std::size_t count) {
 
 }  // namespace
 
-AllanWorkspace::AllanWorkspace(std::size_t capacity)
-    : capacity_(capacity),
-      hi_(allan_kernels::allocatePhaseStorage<double>(capacity + 1)),
-      lo_(allan_kernels::allocatePhaseStorage<float>(capacity + 1)) {}
+AllanWorkspace::AllanWorkspace(std::size_t capacity) : AllanWorkspace(capacity, std::vector<double>()) {}
+
+AllanWorkspace::AllanWorkspace(std::size_t capacity, std::vector<double>&& reused)
+    : capacity_(capacity), lo_(allan_kernels::allocatePhaseStorage<float>(capacity + 1)) {
+  if (reused.capacity() >= capacity + 1) {
+    reused_hi_ = std::move(reused);
+    reused_hi_.resize(capacity + 1);  // within its capacity: the column's memory, no new
+    hi_ = reused_hi_.data();
+  } else {
+    reused = std::vector<double>();  // lost either way, as the caller was told
+    owned_hi_ = allan_kernels::allocatePhaseStorage<double>(capacity + 1);
+    hi_ = owned_hi_.get();
+  }
+}
 
 std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double tau0_s,
                                             std::span<const std::size_t> ms, const AllanOptions& options) {

@@ -94,14 +94,20 @@ std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double
 class AllanWorkspace {
  public:
   explicit AllanWorkspace(std::size_t capacity);
+  // The phase's high parts (8 of the 12 bytes a sample) in `reused`'s memory when it can hold
+  // capacity + 1 doubles (its values are lost), else in storage of their own: a column the
+  // caller no longer needs (a recording's time) then serves, its pages already present.
+  AllanWorkspace(std::size_t capacity, std::vector<double>&& reused);
   std::size_t capacity() const { return capacity_; }
-  std::span<double> rateSlots() { return {hi_.get() + 1, capacity_}; }
-  double* phaseHi() { return hi_.get(); }
+  std::span<double> rateSlots() { return {hi_ + 1, capacity_}; }
+  double* phaseHi() { return hi_; }
   float* phaseLo() { return lo_.get(); }
 
  private:
   std::size_t capacity_;
-  allan_kernels::PhaseStorage<double> hi_;
+  std::vector<double> reused_hi_;                 // the high parts, when in a reused column
+  allan_kernels::PhaseStorage<double> owned_hi_;  // else here
+  double* hi_;
   allan_kernels::PhaseStorage<float> lo_;
 };
 

@@ -86,6 +86,29 @@ TEST(AllanWorkspace, TablesInAWorkspaceAreTheSameBitsAsTheirOwn) {
   }
 }
 
+// A workspace on a column the caller is done with (gyroctl analyze's time column) puts the
+// phase in that column's memory when it is long enough, else in its own; same tables.
+TEST(AllanWorkspace, AReusedColumnHoldsThePhaseWhenLongEnough) {
+  const std::vector<double> rate = rateSeries(100'000, 0.02, 27);
+  const std::vector<std::size_t> ms = octaveClusterSizes(rate.size());
+  const std::vector<AllanPoint> own = allanDeviationTable(rate, 0.02, ms);
+  std::vector<double> time_column(rate.size(), 1.5);  // as long as the rate: one more slot fits
+  time_column.reserve(rate.size() + 1);
+  const double* column_memory = time_column.data();
+  AllanWorkspace on_column(rate.size(), std::move(time_column));
+  EXPECT_EQ(on_column.phaseHi(), column_memory);
+  expectSameTable(allanDeviationTable(rate, 0.02, ms, {}, on_column), own, "on a reused column");
+  std::copy(rate.begin(), rate.end(), on_column.rateSlots().begin());
+  expectSameTable(allanDeviationTableInPlace(on_column, rate.size(), 0.02, ms), own, "on a reused column, in place");
+
+  std::vector<double> short_column(rate.size() / 2, 1.5);
+  short_column.shrink_to_fit();
+  const double* short_memory = short_column.data();
+  AllanWorkspace own_storage(rate.size(), std::move(short_column));
+  EXPECT_NE(own_storage.phaseHi(), short_memory);
+  expectSameTable(allanDeviationTable(rate, 0.02, ms, {}, own_storage), own, "a column too short");
+}
+
 TEST(AllanWorkspace, InPlaceTablesAreTheSameBitsForAnyThreadCount) {
   const std::vector<double> rate = rateSeries(200'000, 0.02, 25);
   const std::vector<std::size_t> ms = octaveClusterSizes(rate.size());

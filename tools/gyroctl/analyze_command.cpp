@@ -406,11 +406,14 @@ int runAnalyze(const AnalyzeOptions& opt) {
       [&] { timing = checkTiming(rec, opt.rate_hz); });
   reportTiming(opt.file, timing, opt.strict_timing);
   const bool writes_model = !opt.write_model.empty();
+  // Without --write-model the time column is done with: its memory holds the Allan phase,
+  // whose pages are then not cleared a second time.
+  processing::AllanWorkspace workspace =
+      writes_model ? processing::AllanWorkspace(samples) : processing::AllanWorkspace(samples, std::move(rec.t));
   if (!writes_model) releaseColumnsNotAnalysed(rec);
   step_timer("checks");
   std::vector<AxisAnalysis> analyses;
   analyses.reserve(in.axis_indices.size());
-  processing::AllanWorkspace workspace(samples);
   const bool show_progress = samples >= kProgressSamples && stderrIsTerminal();
   for (std::size_t k = 0; k < in.axis_indices.size(); ++k) {
     const std::size_t idx = in.axis_indices[k];
