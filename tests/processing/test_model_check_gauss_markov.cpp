@@ -74,7 +74,8 @@ bool namesGaussMarkov(const std::vector<double>& x, std::uint64_t seed, std::str
 
 TEST(ModelCheckGaussMarkov, FindsAProcessBetweenTheOldAndNewHalfDetectionSizes) {
   // Six seeds: the five-term null named 2 of them (measured before the change), the joint
-  // null 5. The same six records without the process must stay clean.
+  // null 5 (session 9, on the tree then: 4, and 4 with the joint null guarded by the
+  // five-term null at 100 α). The same six records without the process must stay clean.
   const double sigma = sigmaForPeak(kDuration / 300.0, 1.6);
   std::size_t found = 0, false_found = 0;
   std::string log;
