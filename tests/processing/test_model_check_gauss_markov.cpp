@@ -9,9 +9,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "processing/hidden_effect_generator.hpp"
 #include "processing/model_check.hpp"
 #include "processing/noise_simulator.hpp"
 #include "processing/noise_terms.hpp"
@@ -70,7 +74,8 @@ bool namesGaussMarkov(const std::vector<double>& x, std::uint64_t seed, std::str
 
 TEST(ModelCheckGaussMarkov, FindsAProcessBetweenTheOldAndNewHalfDetectionSizes) {
   // Six seeds: the five-term null named 2 of them (measured before the change), the joint
-  // null 5. The same six records without the process must stay clean.
+  // null 5 (session 9, on the tree then: 4, and 4 with the joint null guarded by the
+  // five-term null at 100 α). The same six records without the process must stay clean.
   const double sigma = sigmaForPeak(kDuration / 300.0, 1.6);
   std::size_t found = 0, false_found = 0;
   std::string log;
@@ -80,4 +85,33 @@ TEST(ModelCheckGaussMarkov, FindsAProcessBetweenTheOldAndNewHalfDetectionSizes) 
   }
   EXPECT_GE(found, 4u) << log;
   EXPECT_EQ(false_found, 0u) << log;
+}
+
+TEST(ModelCheckGaussMarkov, CleanRecordsWithoutDlpfTheJointNullNamedStayMostlyClean) {
+  // The four clean axes (generator seeds 1212, 1224, 1259, 1262, 10 minutes at 50 Hz, no
+  // DLPF, as `model_check_dlpf_fdr --cfg none`) on which the joint-fit null alone named a
+  // process (T 0.06–3.8 s), each with a rate random walk the five-term fit put at 0. With the
+  // five-term null as a guard at 100 α, three are clean; the fourth (seed 1259 axis 1, statistic
+  // 5.7 above both thresholds) is still named (measured, docs/model-check.md, session 9).
+  // The power side: FindsAProcessBetweenTheOldAndNewHalfDetectionSizes above.
+  const std::vector<std::pair<std::uint64_t, std::size_t>> axes{{1212, 1}, {1224, 2}, {1259, 1}, {1262, 0}};
+  std::size_t named = 0;
+  std::string log;
+  for (const auto& [seed, axis] : axes) {
+    HiddenEffectGenerator gen(seed);
+    gen.dlpf_cfg = std::nullopt;
+    const GeneratedRecording g = gen.generate(kDuration, kRate, {});
+    ModelCheckOptions o;
+    o.seed = seed;
+    o.replicas = 40;
+    o.threads = 2;
+    const AxisModelCheck r = checkAxisModel({g.axes[axis], g.rate_hz, g.temp, g.t, {std::nullopt, 0}}, o);
+    for (const CheckStatistic& st : r.statistics)
+      if (st.name == "gauss_markov_sqrt_chi2_gain")
+        log += "seed " + std::to_string(seed) + " axis " + std::to_string(axis) + ": statistic " +
+               std::to_string(st.value) + ", threshold " + std::to_string(st.threshold) + "\n";
+    named += std::any_of(r.effects.begin(), r.effects.end(),
+                         [](const DetectedEffect& e) { return e.effect == ModelEffect::GaussMarkov; });
+  }
+  EXPECT_LE(named, 1u) << log;
 }
