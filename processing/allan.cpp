@@ -438,8 +438,8 @@ std::vector<int> noiseTypesForTable(std::span<const double> rate, std::span<cons
     return at != distinct.end() && *at == m ? &distinct_alpha[static_cast<std::size_t>(at - distinct.begin())]
                                             : nullptr;
   };
-  // The cluster sums of m = 1 and 2 are read from the rate when needed (the additions of the
-  // pairwise cascade, the same bits) rather than held: a copy of the series would cost 8
+  // The cluster sums of m = 1, 2 and 4 are read from the rate when needed (the additions of
+  // the pairwise cascade, the same bits) rather than held: a copy of the series would cost 8
   // bytes a sample while the phase is also held (allanDeviationTable forms the two at once).
   const auto sum1 = [&](std::size_t i) { return rate[i] - mean; };
   const auto sum2 = [&](std::size_t k) { return sum1(2 * k) + sum1(2 * k + 1); };
@@ -450,15 +450,18 @@ std::vector<int> noiseTypesForTable(std::span<const double> rate, std::span<cons
   const auto longerLevels = [&] {
     if (int* alpha = top >= 2 ? alphaAt(2) : nullptr)
       *alpha = lag1NoiseIdOf([&](std::size_t k) { return sum2(k) / 2.0; }, count / 2);
-    if (top < 4) return;
-    // From m = 4 on, level by level in one buffer of 2 bytes a sample (not zeroed first: every
+    const auto sum4 = [&](std::size_t k) { return sum2(2 * k) + sum2(2 * k + 1); };
+    if (int* alpha = top >= 4 ? alphaAt(4) : nullptr)
+      *alpha = lag1NoiseIdOf([&](std::size_t k) { return sum4(k) / 4.0; }, count / 4);
+    if (top < 8) return;
+    // From m = 8 on, level by level in one buffer of 1 byte a sample (not zeroed first: every
     // value is written before it is read): each level's averages are read as sum / m, and the
     // next level's sums then overwrite the front half of this one's (sums[k] is written after
     // sums[2k] and sums[2k + 1] are read).
-    std::size_t level_size = count / 4;
+    std::size_t level_size = count / 8;
     const auto sums = std::make_unique_for_overwrite<double[]>(std::max<std::size_t>(level_size, 1));
-    for (std::size_t k = 0; k < level_size; ++k) sums[k] = sum2(2 * k) + sum2(2 * k + 1);
-    for (std::size_t m = 4; m <= top; m *= 2) {
+    for (std::size_t k = 0; k < level_size; ++k) sums[k] = sum4(2 * k) + sum4(2 * k + 1);
+    for (std::size_t m = 8; m <= top; m *= 2) {
       if (int* alpha = alphaAt(m)) {
         const double md = static_cast<double>(m);
         *alpha = lag1NoiseIdOf([&sums, md](std::size_t k) { return sums[k] / md; }, level_size);
