@@ -101,11 +101,13 @@ TEST(AllanWorkspace, AReusedColumnHoldsThePhaseWhenLongEnough) {
   std::copy(rate.begin(), rate.end(), on_column.rateSlots().begin());
   expectSameTable(allanDeviationTableInPlace(on_column, rate.size(), 0.02, ms), own, "on a reused column, in place");
 
+  // A column too short is dropped for storage of the workspace's own. Its address proves
+  // nothing here: the allocator may hand the freed block's memory straight back (it did, in a
+  // full run of this suite); a phase written into the short column would overrun it (ASan)
+  // or give other tables.
   std::vector<double> short_column(rate.size() / 2, 1.5);
   short_column.shrink_to_fit();
-  const double* short_memory = short_column.data();
   AllanWorkspace own_storage(rate.size(), std::move(short_column));
-  EXPECT_NE(own_storage.phaseHi(), short_memory);
   expectSameTable(allanDeviationTable(rate, 0.02, ms, {}, own_storage), own, "a column too short");
 }
 
