@@ -79,6 +79,45 @@ TEST(GyroctlAnalyze, WhiteNoiseJsonHasEveryTableAndTheRightArw) {
   EXPECT_LT(gx["noise_after_kalman"]["arw_deg_per_sqrt_h"].get<double>(), n_true);
 }
 
+// With two cores the axes are analysed two at a time, each in a workspace of its own (one in
+// the time column's memory, one in the temperature's): every axis must come out as it does
+// analysed alone, with and without --write-model (which keeps the columns).
+TEST(GyroctlAnalyze, AxesAnalysedTogetherAreTheSameAsEachAlone) {
+  ScratchDir d;
+  const double rate = 50.0;
+  const std::size_t n = 20000;
+  std::mt19937_64 rng(23);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  std::string csv = "t,gx,gy,gz,temp\n";
+  char buf[160];
+  double walk = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    walk += 0.002 * noise(rng);
+    std::snprintf(buf, sizeof buf, "%.17g,%.17g,%.17g,%.17g,%.6f\n", static_cast<double>(i) / rate,
+                  0.5 + 0.1 * noise(rng), -0.2 + 0.3 * noise(rng) + walk, 0.05 * noise(rng),
+                  30.0 + 1e-4 * static_cast<double>(i));
+    csv += buf;
+  }
+  const auto f = d.write("three.csv", csv);
+  const auto all = runGyroctl("analyze " + f.string() + " --json", d.path());
+  ASSERT_EQ(all.exit_status, 0) << all.err;
+  const auto kept =
+      runGyroctl("analyze " + f.string() + " --json --write-model " + (d.path() / "m.toml").string(), d.path());
+  ASSERT_EQ(kept.exit_status, 0) << kept.err;
+  const json together = json::parse(all.out), together_kept = json::parse(kept.out);
+  ASSERT_EQ(together["axes"].size(), 3u);
+  for (const char* axis : {"gx", "gy", "gz"}) {
+    const auto alone = runGyroctl("analyze " + f.string() + " --json --axis " + axis, d.path());
+    ASSERT_EQ(alone.exit_status, 0) << alone.err;
+    const json one = json::parse(alone.out)["axes"][axis];
+    ASSERT_FALSE(one.is_null()) << axis;
+    EXPECT_EQ(together["axes"][axis], one) << axis;
+    EXPECT_EQ(together_kept["axes"][axis], one) << axis;
+  }
+  // The axes differ, so an axis's table put in another's place would show above.
+  EXPECT_NE(together["axes"]["gx"], together["axes"]["gy"]);
+}
+
 TEST(GyroctlAnalyze, BareNumbersUseTheGivenRateAndExplicitTaus) {
   ScratchDir d;
   std::mt19937_64 rng(12);

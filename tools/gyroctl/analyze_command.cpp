@@ -1,11 +1,14 @@
 // gyroctl analyze: every table of the paper for each axis of a static recording.
+#include <atomic>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <exception>
 #include <iostream>
 #include <memory>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -63,12 +66,15 @@ void releaseColumnsNotAnalysed(recording::Recording& rec) {
 
 // GYROD_ANALYZE_TIMING=1: each step's wall and process CPU seconds on stderr, as it ends
 // (bench/measure_analyze.sh --steps), to see where the time goes and where a core idles.
+// With two axes analysed at once, a line's times run from the line before it, whichever
+// axis printed that one.
 class StepTimer {
  public:
   StepTimer() : enabled_(std::getenv("GYROD_ANALYZE_TIMING") != nullptr) { last_ = now(); }
   bool enabled() const { return enabled_; }
   void operator()(const std::string& step) {
     if (!enabled_) return;
+    const std::lock_guard<std::mutex> lock(mutex_);
     const Times t = now();
     const double wall = t.wall - last_.wall, cpu = t.cpu - last_.cpu;
     std::fprintf(stderr, "step %-36s wall %7.3f s  cpu %7.3f s  cpu/wall %4.2f\n", step.c_str(), wall, cpu,
@@ -87,6 +93,7 @@ class StepTimer {
   }
   static Times now() { return {seconds(CLOCK_MONOTONIC), seconds(CLOCK_PROCESS_CPUTIME_ID)}; }
   bool enabled_;
+  std::mutex mutex_;
   Times last_;
 };
 
@@ -406,20 +413,30 @@ int runAnalyze(const AnalyzeOptions& opt) {
       [&] { timing = checkTiming(rec, opt.rate_hz); });
   reportTiming(opt.file, timing, opt.strict_timing);
   const bool writes_model = !opt.write_model.empty();
+  const std::size_t axis_count = in.axis_indices.size();
+  // Two axes at a time on two cores, each with a workspace of its own: an axis's serial steps
+  // (detrend, Kalman, the in-place table's noise types) then leave no core idle.
+  const bool two_at_once = axis_count >= 2 && processing::shareThreadCount() > 1;
   // Without --write-model the time column is done with: its memory holds the Allan phase,
-  // whose pages are then not cleared a second time.
-  processing::AllanWorkspace workspace =
-      writes_model ? processing::AllanWorkspace(samples) : processing::AllanWorkspace(samples, std::move(rec.t));
+  // whose pages are then not cleared a second time; the temperature column's, the second
+  // workspace's, when there is one.
+  std::vector<processing::AllanWorkspace> workspaces;
+  workspaces.reserve(2);
+  workspaces.push_back(writes_model ? processing::AllanWorkspace(samples)
+                                    : processing::AllanWorkspace(samples, std::move(rec.t)));
+  if (two_at_once)
+    workspaces.push_back(writes_model ? processing::AllanWorkspace(samples)
+                                      : processing::AllanWorkspace(samples, std::move(rec.temp)));
   if (!writes_model) releaseColumnsNotAnalysed(rec);
   step_timer("checks");
-  std::vector<AxisAnalysis> analyses;
-  analyses.reserve(in.axis_indices.size());
   const bool show_progress = samples >= kProgressSamples && stderrIsTerminal();
-  for (std::size_t k = 0; k < in.axis_indices.size(); ++k) {
+  std::mutex progress_mutex;
+  const auto analyseAxis = [&](std::size_t k, processing::AllanWorkspace& workspace) {
     const std::size_t idx = in.axis_indices[k];
-    if (show_progress)
-      std::fprintf(stderr, "\ranalysing %s (%zu of %zu)...\033[K", rec.axis_names[idx].c_str(), k + 1,
-                   in.axis_indices.size());
+    if (show_progress) {
+      const std::lock_guard<std::mutex> lock(progress_mutex);
+      std::fprintf(stderr, "\ranalysing %s (%zu of %zu)...\033[K", rec.axis_names[idx].c_str(), k + 1, axis_count);
+    }
     AnalysisOptions column_options = options;
     if (sensorOfColumn(rec.axis_names[idx]) == SensorKind::Accel)
       column_options.mean_threshold_dps = opt.accel_mean_threshold_g;
@@ -427,8 +444,31 @@ int runAnalyze(const AnalyzeOptions& opt) {
       column_options.step_done = [&step_timer, &name = rec.axis_names[idx]](const char* step) {
         step_timer(name + " " + step);
       };
-    analyses.push_back(analyzeColumn(rec, idx, column_options, writes_model, workspace));
+    return analyzeColumn(rec, idx, column_options, writes_model, workspace);
+  };
+  std::vector<AxisAnalysis> analyses(axis_count);
+  if (!two_at_once) {
+    for (std::size_t k = 0; k < axis_count; ++k) analyses[k] = analyseAxis(k, workspaces[0]);
+  } else {
+    // Each worker takes the next axis not yet taken; every axis is analysed (an axis's result
+    // never depends on another's), and the first failure in axis order is the one reported,
+    // as one after the other would report it.
+    std::atomic<std::size_t> next_axis{0};
+    std::vector<std::exception_ptr> failures(axis_count);
+    const auto worker = [&](processing::AllanWorkspace& workspace) {
+      for (std::size_t k; (k = next_axis.fetch_add(1)) < axis_count;) {
+        try {
+          analyses[k] = analyseAxis(k, workspace);
+        } catch (...) {
+          failures[k] = std::current_exception();
+        }
+      }
+    };
+    processing::runBoth([&] { worker(workspaces[1]); }, [&] { worker(workspaces[0]); });
+    for (const auto& failure : failures)
+      if (failure) std::rethrow_exception(failure);
   }
+  workspaces.clear();
   if (show_progress) std::fprintf(stderr, "\r\033[K");
 
   json doc;
