@@ -273,70 +273,79 @@ struct Lag1 {
   double sum_sq = 0.0;
 };
 
-// The d-th differences (d ≤ 2) of the series z in order, formed as differencing it d times
+// The D-th differences (D ≤ 2) of the series z in order, formed as differencing it D times
 // in place would (z′_i = z_{i+1} − z_i, z″_i = z′_{i+1} − z′_i: the same operations, the
-// same bits), each z read once.
-template <typename Series>
+// same bits), each z read once. D is a template parameter: no branch per value.
+template <int D, typename Series>
 class DifferenceStream {
  public:
-  DifferenceStream(const Series& z, int d) : z_(z), d_(d) {
-    if (d_ >= 1) z0_ = z_(next_++);
-    if (d_ >= 2) z1_ = z_(next_++);
+  explicit DifferenceStream(const Series& z) : z_(z) {
+    if constexpr (D >= 1) z0_ = z_(next_++);
+    if constexpr (D >= 2) z1_ = z_(next_++);
   }
   double next() {
     const double v = z_(next_++);
-    if (d_ == 0) return v;
-    if (d_ == 1) {
+    if constexpr (D == 0) {
+      return v;
+    } else if constexpr (D == 1) {
       const double diff = v - z0_;
       z0_ = v;
       return diff;
+    } else {
+      const double diff = (v - z1_) - (z1_ - z0_);
+      z0_ = z1_;
+      z1_ = v;
+      return diff;
     }
-    const double diff = (v - z1_) - (z1_ - z0_);
-    z0_ = z1_;
-    z1_ = v;
-    return diff;
   }
 
  private:
   const Series& z_;
-  int d_;
   std::size_t next_ = 0;
   double z0_ = 0.0, z1_ = 0.0;
 };
 
-// lag1Autocorrelation of the d-th difference of z (`len` points before differencing), each
+// lag1Autocorrelation of the D-th difference of z (`len` points before differencing), each
 // value formed when it is needed: no copy of the series. The sums Σ (z_i − z̄)² and
 // Σ (z_i − z̄)(z_{i+1} − z̄) (z̄ the plain mean) are each kept in four lanes, i mod 4, added
 // at the end: four independent addition chains where one would wait on each addition's
 // latency. The order differs from one running sum's by a few ε, which moves a decision only
 // for a ρ within ~10⁻¹⁵ of a rounding boundary of α.
-template <typename Series>
-Lag1 lag1AutocorrelationOfDifference(const Series& z, std::size_t len, int d) {
-  const std::size_t n = len - static_cast<std::size_t>(d);
+template <int D, typename Series>
+Lag1 lag1AutocorrelationOfDifference(const Series& z, std::size_t len) {
+  const std::size_t n = len - static_cast<std::size_t>(D);
   constexpr std::size_t kLanes = 4;
-  const auto total = [](const double(&lanes)[kLanes]) { return (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]); };
-  double mean_lanes[kLanes] = {};
-  DifferenceStream<Series> first_pass(z, d);
+  DifferenceStream<D, Series> first_pass(z);
+  double m0 = 0.0, m1 = 0.0, m2 = 0.0, m3 = 0.0;
   std::size_t i = 0;
-  for (; i + kLanes <= n; i += kLanes)
-    for (double& lane : mean_lanes) lane += first_pass.next();
-  double mean = total(mean_lanes);
+  for (; i + kLanes <= n; i += kLanes) {
+    m0 += first_pass.next();
+    m1 += first_pass.next();
+    m2 += first_pass.next();
+    m3 += first_pass.next();
+  }
+  double mean = (m0 + m1) + (m2 + m3);
   for (; i < n; ++i) mean += first_pass.next();
   mean /= static_cast<double>(n);
   // den over all n values, num over the n − 1 neighbouring pairs (a_i, a_{i+1}).
-  double num_lanes[kLanes] = {}, den_lanes[kLanes] = {};
-  DifferenceStream<Series> second_pass(z, d);
+  DifferenceStream<D, Series> second_pass(z);
+  double n0 = 0.0, n1 = 0.0, n2 = 0.0, n3 = 0.0, d0 = 0.0, d1 = 0.0, d2 = 0.0, d3 = 0.0;
   double a = second_pass.next() - mean;
   i = 0;
   for (; i + kLanes < n; i += kLanes) {
-    for (std::size_t lane = 0; lane < kLanes; ++lane) {
-      const double next = second_pass.next() - mean;
-      den_lanes[lane] += a * a;
-      num_lanes[lane] += a * next;
-      a = next;
-    }
+    const double b = second_pass.next() - mean, c = second_pass.next() - mean, e = second_pass.next() - mean,
+                 f = second_pass.next() - mean;
+    d0 += a * a;
+    n0 += a * b;
+    d1 += b * b;
+    n1 += b * c;
+    d2 += c * c;
+    n2 += c * e;
+    d3 += e * e;
+    n3 += e * f;
+    a = f;
   }
-  double num = total(num_lanes), den = total(den_lanes);
+  double num = (n0 + n1) + (n2 + n3), den = (d0 + d1) + (d2 + d3);
   for (; i < n; ++i) {
     den += a * a;
     if (i + 1 < n) {
@@ -346,6 +355,13 @@ Lag1 lag1AutocorrelationOfDifference(const Series& z, std::size_t len, int d) {
     }
   }
   return {den > 0.0 ? num / den : 0.0, den};
+}
+
+template <typename Series>
+Lag1 lag1AutocorrelationOfDifference(const Series& z, std::size_t len, int d) {
+  if (d == 0) return lag1AutocorrelationOfDifference<0>(z, len);
+  if (d == 1) return lag1AutocorrelationOfDifference<1>(z, len);
+  return lag1AutocorrelationOfDifference<2>(z, len);
 }
 
 int clampAlpha(double alpha) { return static_cast<int>(std::clamp(std::round(alpha), -2.0, 2.0)); }
