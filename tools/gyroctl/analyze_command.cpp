@@ -371,6 +371,71 @@ void writeKalibrImu(const AnalyzeOptions& opt, const LoadedInput& in, const std:
   if (!opt.json) std::printf("\nKalibr imu.yaml written to %s\n", opt.kalibr.output.c_str());
 }
 
+// Every selected axis analysed, in axis order. Two at a time on two cores, each with a
+// workspace of its own: an axis's serial steps (detrend, Kalman, the in-place table's noise
+// types) then leave no core idle.
+std::vector<AxisAnalysis> analyzeEveryAxis(const AnalyzeOptions& opt, LoadedInput& in, const AnalysisOptions& options,
+                                           StepTimer& step_timer) {
+  auto& rec = in.recording;
+  const std::size_t samples = rec.size();
+  const bool writes_model = !opt.write_model.empty();
+  const std::size_t axis_count = in.axis_indices.size();
+  const bool two_at_once = axis_count >= 2 && processing::shareThreadCount() > 1;
+  // Without --write-model the time column is done with: its memory holds the Allan phase,
+  // whose pages are then not cleared a second time; the temperature column's, the second
+  // workspace's, when there is one.
+  std::vector<processing::AllanWorkspace> workspaces;
+  workspaces.reserve(2);
+  workspaces.push_back(writes_model ? processing::AllanWorkspace(samples)
+                                    : processing::AllanWorkspace(samples, std::move(rec.t)));
+  if (two_at_once)
+    workspaces.push_back(writes_model ? processing::AllanWorkspace(samples)
+                                      : processing::AllanWorkspace(samples, std::move(rec.temp)));
+  if (!writes_model) releaseColumnsNotAnalysed(rec);
+  step_timer("checks");
+  const bool show_progress = samples >= kProgressSamples && stderrIsTerminal();
+  std::mutex progress_mutex;
+  const auto analyseAxis = [&](std::size_t k, processing::AllanWorkspace& workspace) {
+    const std::size_t idx = in.axis_indices[k];
+    if (show_progress) {
+      const std::lock_guard<std::mutex> lock(progress_mutex);
+      std::fprintf(stderr, "\ranalysing %s (%zu of %zu)...\033[K", rec.axis_names[idx].c_str(), k + 1, axis_count);
+    }
+    AnalysisOptions column_options = options;
+    if (sensorOfColumn(rec.axis_names[idx]) == SensorKind::Accel)
+      column_options.mean_threshold_dps = opt.accel_mean_threshold_g;
+    if (step_timer.enabled())
+      column_options.step_done = [&step_timer, &name = rec.axis_names[idx]](const char* step) {
+        step_timer(name + " " + step);
+      };
+    return analyzeColumn(rec, idx, column_options, writes_model, workspace);
+  };
+  std::vector<AxisAnalysis> analyses(axis_count);
+  if (!two_at_once) {
+    for (std::size_t k = 0; k < axis_count; ++k) analyses[k] = analyseAxis(k, workspaces[0]);
+  } else {
+    // Each worker takes the next axis not yet taken; every axis is analysed (an axis's result
+    // never depends on another's), and the first failure in axis order is the one reported,
+    // as one after the other would report it.
+    std::atomic<std::size_t> next_axis{0};
+    std::vector<std::exception_ptr> failures(axis_count);
+    const auto worker = [&](processing::AllanWorkspace& workspace) {
+      for (std::size_t k = next_axis.fetch_add(1); k < axis_count; k = next_axis.fetch_add(1)) {
+        try {
+          analyses[k] = analyseAxis(k, workspace);
+        } catch (...) {
+          failures[k] = std::current_exception();
+        }
+      }
+    };
+    processing::runBoth([&] { worker(workspaces[1]); }, [&] { worker(workspaces[0]); });
+    for (const auto& failure : failures)
+      if (failure) std::rethrow_exception(failure);
+  }
+  if (show_progress) std::fprintf(stderr, "\r\033[K");
+  return analyses;
+}
+
 int runAnalyze(const AnalyzeOptions& opt) {
   // A target that cannot be written fails now, not after the analysis.
   if (!opt.write_model.empty()) formats::checkOutputTarget(opt.write_model, {opt.file});
@@ -413,63 +478,7 @@ int runAnalyze(const AnalyzeOptions& opt) {
       [&] { timing = checkTiming(rec, opt.rate_hz); });
   reportTiming(opt.file, timing, opt.strict_timing);
   const bool writes_model = !opt.write_model.empty();
-  const std::size_t axis_count = in.axis_indices.size();
-  // Two axes at a time on two cores, each with a workspace of its own: an axis's serial steps
-  // (detrend, Kalman, the in-place table's noise types) then leave no core idle.
-  const bool two_at_once = axis_count >= 2 && processing::shareThreadCount() > 1;
-  // Without --write-model the time column is done with: its memory holds the Allan phase,
-  // whose pages are then not cleared a second time; the temperature column's, the second
-  // workspace's, when there is one.
-  std::vector<processing::AllanWorkspace> workspaces;
-  workspaces.reserve(2);
-  workspaces.push_back(writes_model ? processing::AllanWorkspace(samples)
-                                    : processing::AllanWorkspace(samples, std::move(rec.t)));
-  if (two_at_once)
-    workspaces.push_back(writes_model ? processing::AllanWorkspace(samples)
-                                      : processing::AllanWorkspace(samples, std::move(rec.temp)));
-  if (!writes_model) releaseColumnsNotAnalysed(rec);
-  step_timer("checks");
-  const bool show_progress = samples >= kProgressSamples && stderrIsTerminal();
-  std::mutex progress_mutex;
-  const auto analyseAxis = [&](std::size_t k, processing::AllanWorkspace& workspace) {
-    const std::size_t idx = in.axis_indices[k];
-    if (show_progress) {
-      const std::lock_guard<std::mutex> lock(progress_mutex);
-      std::fprintf(stderr, "\ranalysing %s (%zu of %zu)...\033[K", rec.axis_names[idx].c_str(), k + 1, axis_count);
-    }
-    AnalysisOptions column_options = options;
-    if (sensorOfColumn(rec.axis_names[idx]) == SensorKind::Accel)
-      column_options.mean_threshold_dps = opt.accel_mean_threshold_g;
-    if (step_timer.enabled())
-      column_options.step_done = [&step_timer, &name = rec.axis_names[idx]](const char* step) {
-        step_timer(name + " " + step);
-      };
-    return analyzeColumn(rec, idx, column_options, writes_model, workspace);
-  };
-  std::vector<AxisAnalysis> analyses(axis_count);
-  if (!two_at_once) {
-    for (std::size_t k = 0; k < axis_count; ++k) analyses[k] = analyseAxis(k, workspaces[0]);
-  } else {
-    // Each worker takes the next axis not yet taken; every axis is analysed (an axis's result
-    // never depends on another's), and the first failure in axis order is the one reported,
-    // as one after the other would report it.
-    std::atomic<std::size_t> next_axis{0};
-    std::vector<std::exception_ptr> failures(axis_count);
-    const auto worker = [&](processing::AllanWorkspace& workspace) {
-      for (std::size_t k; (k = next_axis.fetch_add(1)) < axis_count;) {
-        try {
-          analyses[k] = analyseAxis(k, workspace);
-        } catch (...) {
-          failures[k] = std::current_exception();
-        }
-      }
-    };
-    processing::runBoth([&] { worker(workspaces[1]); }, [&] { worker(workspaces[0]); });
-    for (const auto& failure : failures)
-      if (failure) std::rethrow_exception(failure);
-  }
-  workspaces.clear();
-  if (show_progress) std::fprintf(stderr, "\r\033[K");
+  const std::vector<AxisAnalysis> analyses = analyzeEveryAxis(opt, in, options, step_timer);
 
   json doc;
   doc["file"] = opt.file;
