@@ -4,6 +4,8 @@
 #include <cmath>
 #include <system_error>
 
+#include "formats/decimal_number.hpp"
+
 namespace gyrod::recording {
 
 std::string_view trimField(std::string_view s) {
@@ -30,7 +32,7 @@ std::optional<double> parseNumber(std::string_view field) {
   if (field.empty()) return std::nullopt;
   if (field.front() == '+') field.remove_prefix(1);
   double value = 0.0;
-  const auto [end, ec] = std::from_chars(field.data(), field.data() + field.size(), value);
+  const auto [end, ec] = decimalFromChars(field.data(), field.data() + field.size(), value);
   if (ec == std::errc::result_out_of_range) return HUGE_VAL;  // reported as non-finite
   if (ec != std::errc() || end != field.data() + field.size()) return std::nullopt;
   return value;

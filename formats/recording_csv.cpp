@@ -22,6 +22,7 @@
 
 #include "formats/chunked_line_reader.hpp"
 #include "formats/csv_fields.hpp"
+#include "formats/decimal_number.hpp"
 #include "formats/quoted_value.hpp"
 #include "processing/parallel_share.hpp"
 
@@ -202,7 +203,8 @@ struct SliceParser {
   // The common line, in one pass: exactly one plain number per column (no sign '+', no
   // spaces, nothing empty), separated by single commas, ending in '\n' or the text's end,
   // within the length limit. Each field is then exactly what from_chars read up to the
-  // comma, which is what the general path below would parse from it: the same values. The
+  // comma, which is what the general path below would parse from it: the same values (both
+  // read with decimalFromChars, std::from_chars' values, faster on plain decimals). The
   // sample is stored and the start of the next line returned; 0 (nothing stored) for any
   // other line, left to the general path with its messages.
   std::size_t parsePlainLine(std::string_view text, std::size_t start, SliceResult& out) const {
@@ -215,7 +217,7 @@ struct SliceParser {
     if (columns > values.size()) return 0;
     for (std::size_t c = 0; c < columns; ++c) {
       if (p == end || *p == '+') return 0;
-      const auto [after, ec] = std::from_chars(p, end, values[c]);
+      const auto [after, ec] = decimalFromChars(p, end, values[c]);
       if (ec != std::errc() || after == p || !std::isfinite(values[c])) return 0;
       p = after;
       if (c + 1 < columns) {
