@@ -149,13 +149,13 @@ TEST(DecimalNumber, RandomDigitStringsAreReadAsFromCharsReadsThem) {
   }
 }
 
-// The hard cases for the 80-bit quotient: 19-digit decimals next to the midpoint of two
-// doubles, where a quotient rounded to 64 bits can land exactly halfway and round again the
-// wrong way; and exact midpoints (integers + .5, .25, .125 above 2⁵⁰), which must round to even.
+// The hard cases for rounding: 19-digit decimals next to the midpoint of two doubles, where
+// the bits below the 53 decide; exact midpoints (integers + .5, .25, .125 above 2⁵⁰), which
+// must round to even and which the truncated product cannot tell: std::from_chars rounds
+// those; and decimals just below a power of two, which round up into the next binade.
 TEST(DecimalNumber, DecimalsNextToHalfwayBetweenDoublesRoundAsFromCharsRounds) {
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> exponent(-3.0, 4.0);
-  std::size_t near_halfway = 0;
   for (int i = 0; i < 200000; ++i) {
     const double d = std::pow(10.0, exponent(rng));
     const long double midpoint =
@@ -163,14 +163,10 @@ TEST(DecimalNumber, DecimalsNextToHalfwayBetweenDoublesRoundAsFromCharsRounds) {
     const int fraction_digits = 18 - static_cast<int>(std::floor(std::log10(static_cast<double>(midpoint))));
     const long double scaled = midpoint * std::pow(10.0L, static_cast<long double>(fraction_digits));
     const auto w = static_cast<std::uint64_t>(std::nearbyint(scaled));
-    for (std::uint64_t neighbour : {w - 1, w, w + 1}) {
-      const std::string text = withPoint(neighbour, fraction_digits);
-      ASSERT_EQ(disagreement(text), "");
-      if (!roundedHere(text)) ++near_halfway;
-    }
+    for (std::uint64_t neighbour : {w - 1, w, w + 1})
+      ASSERT_EQ(disagreement(withPoint(neighbour, fraction_digits)), "");
   }
-  // Some quotients did land halfway and went to std::from_chars (else this tests nothing).
-  EXPECT_GT(near_halfway, 0u);
+  std::size_t exact_midpoints_handed_back = 0;
   for (int shift = 1; shift <= 3; ++shift) {
     for (int i = 0; i < 20000; ++i) {
       const std::uint64_t integer = (std::uint64_t{1} << (53 - shift)) + rng() % (std::uint64_t{1} << (53 - shift));
@@ -179,7 +175,17 @@ TEST(DecimalNumber, DecimalsNextToHalfwayBetweenDoublesRoundAsFromCharsRounds) {
       for (int s = 0; s < shift; ++s) fraction *= 5;  // odd / 2^shift = odd * 5^shift / 10^shift
       std::string digits = std::to_string(fraction);
       digits.insert(0, static_cast<std::size_t>(shift) - digits.size(), '0');
-      ASSERT_EQ(disagreement(std::to_string(integer) + "." + digits), "");
+      const std::string text = std::to_string(integer) + "." + digits;
+      ASSERT_EQ(disagreement(text), "");
+      if (!roundedHere(text)) ++exact_midpoints_handed_back;
+    }
+  }
+  EXPECT_EQ(exact_midpoints_handed_back, 60000u);
+  for (int power = -40; power <= 62; ++power) {
+    const double below = std::nextafter(std::ldexp(1.0, power), 0.0);
+    for (const char* format : {"%.17g", "%.18g", "%.19g", "%.16g"}) {
+      ASSERT_EQ(disagreement(printed(format, below)), "") << power;
+      ASSERT_EQ(disagreement(printed(format, std::ldexp(1.0, power))), "") << power;
     }
   }
 }
