@@ -7,37 +7,15 @@
 #include <new>
 #include <vector>
 
+#include "processing/isa_clones.hpp"
 #include "processing/parallel_share.hpp"
 
 #if defined(__linux__)
 #include <sys/mman.h>
 #endif
 
-// One clone per ISA where the compiler can dispatch at load time (x86-64 ELF); elsewhere
-// (arm64, armhf, sanitizer builds that lack ifunc) the one portable build.
-#if defined(__x86_64__) && defined(__ELF__) && defined(__has_attribute) && !defined(GYROD_NO_TARGET_CLONES)
-#if __has_attribute(target_clones)
-#define GYROD_ISA_CLONES __attribute__((target_clones("avx2", "default")))
-#endif
-#endif
-#ifndef GYROD_ISA_CLONES
-#define GYROD_ISA_CLONES
-#endif
-
-// The four-lane helpers below take and give vectors by reference only, so no vector crosses
-// an ABI boundary and GCC's note that a 32-byte vector would change the ABI without AVX does
-// not apply.
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wpsabi"
-#endif
-
 namespace gyrod::processing::allan_kernels {
 namespace {
-
-// Four doubles (floats) operated on lane by lane: one AVX2 register, or two SSE2/NEON ones.
-// Each lane is IEEE arithmetic in the written order, the same as a scalar chain.
-using Doubles4 = double __attribute__((vector_size(4 * sizeof(double))));
-using Floats4 = float __attribute__((vector_size(4 * sizeof(float))));
 
 // Vectors leave the helpers by reference only: a 32-byte vector passed or returned by value
 // would have a different ABI in the AVX2 clone and the baseline (Clang refuses it).

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "processing/isa_clones.hpp"
 #include "processing/parallel_share.hpp"
 
 namespace gyrod::processing {
@@ -58,50 +59,40 @@ namespace {
 // the window of out[i] is x[i − L + 1 .. i], contiguous in x. The filter sums the window in
 // time order, then the kept samples in time order; here four outputs are formed at once,
 // each lane doing exactly those additions in that order (four independent chains instead of
-// one: the same bits, about four times the speed). A rejected sample adds +0.0 to its lane's
-// kept sum, which changes no bit: that sum starts at +0.0 and so is never −0.0.
+// one: the same bits, about four times the speed; one AVX2 register where the machine has it,
+// the same bits again). A rejected sample adds +0.0 to its lane's kept sum, which changes no
+// bit: that sum starts at +0.0 and so is never −0.0.
+GYROD_ISA_CLONES
 void meanFilterFullWindows(const double* x, std::size_t window, double threshold, double* out, std::size_t first,
                            std::size_t end) {
-  // Four lanes as two pairs in GCC/Clang vector types (one SSE2 or NEON register each;
-  // elementwise IEEE operations, no fused multiply-add: the bits of the scalar code).
-  using Pair = double __attribute__((vector_size(16)));
-  using PairBits = std::int64_t __attribute__((vector_size(16)));
+  // Elementwise IEEE operations on GCC/Clang vector types, no fused multiply-add: the bits of
+  // the scalar code in every lane.
   constexpr std::size_t kLanes = 4;
   const auto n = static_cast<double>(window);
-  const Pair n_pair = {n, n}, threshold_pair = {threshold, threshold}, ones = {1.0, 1.0};
-  const PairBits no_sign = {INT64_MAX, INT64_MAX};
+  const Doubles4 n4 = {n, n, n, n}, threshold4 = {threshold, threshold, threshold, threshold},
+                 ones = {1.0, 1.0, 1.0, 1.0};
+  const LaneMask4 no_sign = {INT64_MAX, INT64_MAX, INT64_MAX, INT64_MAX};
   std::size_t i = first;
   for (; i + kLanes <= end; i += kLanes) {
     const double* w = x + (i + 1 - window);  // lane k's window starts at w + k
-    Pair sum_lo = {}, sum_hi = {};
+    Doubles4 sum = {};
     for (std::size_t j = 0; j < window; ++j) {
-      Pair lo, hi;
-      std::memcpy(&lo, w + j, sizeof lo);
-      std::memcpy(&hi, w + j + 2, sizeof hi);
-      sum_lo += lo;
-      sum_hi += hi;
+      Doubles4 v;
+      std::memcpy(&v, w + j, sizeof v);
+      sum += v;
     }
-    const Pair m_lo = sum_lo / n_pair, m_hi = sum_hi / n_pair;
-    Pair kept_sum_lo = {}, kept_sum_hi = {}, kept_lo = {}, kept_hi = {};
+    const Doubles4 m = sum / n4;
+    Doubles4 kept_sum = {}, kept = {};
     for (std::size_t j = 0; j < window; ++j) {
-      Pair lo, hi;
-      std::memcpy(&lo, w + j, sizeof lo);
-      std::memcpy(&hi, w + j + 2, sizeof hi);
+      Doubles4 v;
+      std::memcpy(&v, w + j, sizeof v);
       // keep: |v − m| ≤ r, all ones or zero; a kept v adds itself, a rejected one +0.0.
-      const PairBits keep_lo =
-          reinterpret_cast<Pair>(reinterpret_cast<PairBits>(lo - m_lo) & no_sign) <= threshold_pair;
-      const PairBits keep_hi =
-          reinterpret_cast<Pair>(reinterpret_cast<PairBits>(hi - m_hi) & no_sign) <= threshold_pair;
-      kept_sum_lo += reinterpret_cast<Pair>(reinterpret_cast<PairBits>(lo) & keep_lo);
-      kept_sum_hi += reinterpret_cast<Pair>(reinterpret_cast<PairBits>(hi) & keep_hi);
-      kept_lo += reinterpret_cast<Pair>(reinterpret_cast<PairBits>(ones) & keep_lo);
-      kept_hi += reinterpret_cast<Pair>(reinterpret_cast<PairBits>(ones) & keep_hi);
+      const LaneMask4 keep = reinterpret_cast<Doubles4>(reinterpret_cast<LaneMask4>(v - m) & no_sign) <= threshold4;
+      kept_sum += reinterpret_cast<Doubles4>(reinterpret_cast<LaneMask4>(v) & keep);
+      kept += reinterpret_cast<Doubles4>(reinterpret_cast<LaneMask4>(ones) & keep);
     }
-    const Pair mean_lo = kept_sum_lo / kept_lo, mean_hi = kept_sum_hi / kept_hi;
-    out[i] = kept_lo[0] == 0.0 ? m_lo[0] : mean_lo[0];
-    out[i + 1] = kept_lo[1] == 0.0 ? m_lo[1] : mean_lo[1];
-    out[i + 2] = kept_hi[0] == 0.0 ? m_hi[0] : mean_hi[0];
-    out[i + 3] = kept_hi[1] == 0.0 ? m_hi[1] : mean_hi[1];
+    const Doubles4 mean = kept_sum / kept;
+    for (std::size_t k = 0; k < kLanes; ++k) out[i + k] = kept[k] == 0.0 ? m[k] : mean[k];
   }
   for (; i < end; ++i) {  // the last few, one at a time, the same operations
     const double* w = x + (i + 1 - window);
