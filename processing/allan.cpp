@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
+#include <functional>
 #include <iomanip>
 #include <limits>
 #include <memory>
@@ -453,9 +454,14 @@ int identifyWithMean(std::span<const double> rate, std::size_t m, double mean, c
 // one-by-one sum of lag1NoiseId (both within a few ε of the exact sum): the decision
 // differs only for a ρ within ~10⁻¹⁵ of a rounding boundary of α. Empty for a series shorter than kMinAveragedPointsForNoiseId, whose fallback
 // needs the phase. `mean` is compensatedMean's, which has rejected any non-finite sample.
-std::vector<int> noiseTypesForTable(std::span<const double> rate, std::span<const std::size_t> ms, double mean) {
+// `alongside`, when given, runs as one more task beside them (work that only reads the rate).
+std::vector<int> noiseTypesForTable(std::span<const double> rate, std::span<const std::size_t> ms, double mean,
+                                    const std::function<void()>& alongside = {}) {
   const std::size_t count = rate.size();
-  if (count < kMinAveragedPointsForNoiseId) return {};
+  if (count < kMinAveragedPointsForNoiseId) {
+    if (alongside) alongside();
+    return {};
+  }
   const auto averaging = [&](std::size_t m) {
     return count / m >= kMinAveragedPointsForNoiseId ? m : count / kMinAveragedPointsForNoiseId;
   };
@@ -465,7 +471,7 @@ std::vector<int> noiseTypesForTable(std::span<const double> rate, std::span<cons
   distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
   std::vector<int> distinct_alpha(distinct.size());
   // Powers of two: cluster sums by pairwise addition, level by level (2·count samples read
-  // in all instead of count per averaging); the others averaged directly, on another core.
+  // in all instead of count per averaging); the others averaged directly.
   const auto isPowerOfTwo = [](std::size_t m) { return (m & (m - 1)) == 0; };
   const std::size_t top = distinct.empty() ? 0 : distinct.back();
   const auto alphaAt = [&](std::size_t m) -> int* {
@@ -478,13 +484,14 @@ std::vector<int> noiseTypesForTable(std::span<const double> rate, std::span<cons
   // bytes a sample while the phase is also held (allanDeviationTable forms the two at once).
   const auto sum1 = [&](std::size_t i) { return rate[i] - mean; };
   const auto sum2 = [&](std::size_t k) { return sum1(2 * k) + sum1(2 * k + 1); };
-  // m = 1, on its own core: as much work as all the longer averagings together.
   const auto firstLevel = [&] {
     if (int* alpha = top >= 1 ? alphaAt(1) : nullptr) *alpha = lag1NoiseIdOf(sum1, count);  // v / 1.0 is v
   };
-  const auto longerLevels = [&] {
+  const auto secondLevel = [&] {
     if (int* alpha = top >= 2 ? alphaAt(2) : nullptr)
       *alpha = lag1NoiseIdOf([&](std::size_t k) { return sum2(k) / 2.0; }, count / 2);
+  };
+  const auto levelsFromFour = [&] {
     const auto sum4 = [&](std::size_t k) { return sum2(2 * k) + sum2(2 * k + 1); };
     if (int* alpha = top >= 4 ? alphaAt(4) : nullptr)
       *alpha = lag1NoiseIdOf([&](std::size_t k) { return sum4(k) / 4.0; }, count / 4);
@@ -505,25 +512,17 @@ std::vector<int> noiseTypesForTable(std::span<const double> rate, std::span<cons
       for (std::size_t k = 0; k < level_size; ++k) sums[k] = sums[2 * k] + sums[2 * k + 1];
     }
   };
-  std::vector<std::size_t> others;  // indices into distinct
+  // Tasks, about the longest first, taken in turn by both cores (each a few passes over the
+  // rate; a correlated level, one that must be differenced, takes two more a difference):
+  // m = 4 with the levels from 8 on, m = 1, the caller's work, m = 2, then the averagings that
+  // are not powers of two. Each writes only its own types: the same bits for any thread count.
+  std::vector<std::function<void()>> tasks = {levelsFromFour, firstLevel};
+  if (alongside) tasks.emplace_back(alongside);
+  tasks.emplace_back(secondLevel);
   for (std::size_t i = 0; i < distinct.size(); ++i)
-    if (!isPowerOfTwo(distinct[i])) others.push_back(i);
-  // Each task writes only its own averagings' types: the same bits for any thread count.
-  forEachShare(
-      others.size() + 2,
-      [&](std::size_t first, std::size_t end) {
-        for (std::size_t task = first; task < end; ++task) {
-          if (task == 0) {
-            firstLevel();
-          } else if (task == 1) {
-            longerLevels();
-          } else {
-            const std::size_t i = others[task - 2];
-            distinct_alpha[i] = lag1NoiseId(rate, distinct[i], mean);
-          }
-        }
-      },
-      1);
+    if (!isPowerOfTwo(distinct[i]))
+      tasks.emplace_back([&, i] { distinct_alpha[i] = lag1NoiseId(rate, distinct[i], mean); });
+  runTasksOnBothCores(std::span(tasks));
   std::vector<int> alphas;
   alphas.reserve(ms.size());
   for (std::size_t m : ms) {
@@ -700,7 +699,8 @@ namespace {
 struct PhasePlace {
   double* hi = nullptr;  // null: the table allocates its own
   float* lo = nullptr;
-  bool rate_in_place = false;  // the rate lies at hi + 1 and becomes the phase
+  bool rate_in_place = false;                        // the rate lies at hi + 1 and becomes the phase
+  const std::function<void()>* alongside = nullptr;  // run beside the noise types (in place only)
 };
 
 std::vector<AllanPoint> tableWithPhaseAt(std::span<const double> rate, double tau0_s, std::span<const std::size_t> ms,
@@ -735,7 +735,8 @@ std::vector<AllanPoint> tableWithPhaseAt(std::span<const double> rate, double ta
   };
   if (place.rate_in_place) {
     // The noise types read the rate, which the phase then overwrites.
-    alphas = noiseTypesForTable(rate, ms, mean);
+    alphas =
+        noiseTypesForTable(rate, ms, mean, place.alongside != nullptr ? *place.alongside : std::function<void()>());
     phaseAndSweeps();
   } else {
     // The noise types (the lag-1 method averages the rate itself) beside the phase and its
@@ -809,10 +810,11 @@ std::vector<AllanPoint> allanDeviationTable(std::span<const double> rate, double
 }
 
 std::vector<AllanPoint> allanDeviationTableInPlace(AllanWorkspace& workspace, std::size_t count, double tau0_s,
-                                                   std::span<const std::size_t> ms, const AllanOptions& options) {
+                                                   std::span<const std::size_t> ms, const AllanOptions& options,
+                                                   const std::function<void()>& alongside) {
   requireCapacity(workspace, count);
   return tableWithPhaseAt(workspace.rateSlots().first(count), tau0_s, ms, options,
-                          {workspace.phaseHi(), workspace.phaseLo(), true});
+                          {workspace.phaseHi(), workspace.phaseLo(), true, alongside ? &alongside : nullptr});
 }
 
 std::vector<double> overlappingAllanVariances(std::span<const double> rate, std::span<const std::size_t> ms,

@@ -8,6 +8,7 @@
 // blind to a constant), kept as a double-double running sum, in O(M) per m.
 // Non-finite rate samples are rejected with std::invalid_argument; m = 0 likewise.
 #include <cstddef>
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -121,7 +122,11 @@ std::vector<double> overlappingAllanVariances(std::span<const double> rate, std:
                                               AllanWorkspace& workspace);
 // The table of the first `count` samples of workspace.rateSlots(), the same bits as
 // allanDeviationTable of a copy of them; the samples become the phase (they are lost).
+// `alongside`, when given, runs once on one of the cores that identify the noise types, before
+// the samples become the phase: work of the caller's that only reads them (their spread, say)
+// fills the time those tasks leave a core idle.
 std::vector<AllanPoint> allanDeviationTableInPlace(AllanWorkspace& workspace, std::size_t count, double tau0_s,
-                                                   std::span<const std::size_t> ms, const AllanOptions& options = {});
+                                                   std::span<const std::size_t> ms, const AllanOptions& options = {},
+                                                   const std::function<void()>& alongside = {});
 
 }  // namespace gyrod::processing

@@ -218,12 +218,13 @@ AxisAnalysis analyzeAxis(std::vector<double>&& rate_dps, const AnalysisOptions& 
   const std::span<const double> kalman_filtered = filtered;
   step("kalman");
 
-  // Table 4: the same Allan analysis on the Kalman output, its spread first (the table turns
-  // the output into its phase where it lies).
-  const Spread after = spreadAboutMean(kalman_filtered);
+  // Table 4: the same Allan analysis on the Kalman output, its spread beside the table's noise
+  // types (before the table turns the output into its phase where it lies).
+  Spread after;
+  a.allan_after_kalman = allanDeviationTableInPlace(workspace, kalman_filtered.size(), tau0, ms, {},
+                                                    [&] { after = spreadAboutMean(kalman_filtered); });
   a.variance.kalman = after.variance;
   a.peak_ratio = peak_raw > 0.0 ? after.peak / peak_raw : 0.0;
-  a.allan_after_kalman = allanDeviationTableInPlace(workspace, kalman_filtered.size(), tau0, ms);
   a.noise_after_kalman = fitNoiseTerms(a.allan_after_kalman);
   step("allan after kalman");
   return a;

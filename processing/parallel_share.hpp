@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cstddef>
 #include <exception>
+#include <span>
 #include <thread>
 #include <vector>
 
@@ -72,6 +73,35 @@ void runBoth(First&& first, Second&& second) {
   worker.join();
   if (first_error) std::rethrow_exception(first_error);
   if (second_error) std::rethrow_exception(second_error);
+}
+
+// Runs every task once, on two threads where there are two cores (the calling thread and one
+// more), each taking the next task not yet taken: put the longest first and the two threads
+// end close together, however unequal the tasks. Each task writes only its own results, so
+// nothing depends on which thread ran it. The first exception in task order is rethrown once
+// all have ended.
+template <typename Task>
+void runTasksOnBothCores(std::span<Task> tasks) {
+  std::vector<std::exception_ptr> errors(tasks.size());
+  std::atomic<std::size_t> next{0};
+  const auto take = [&] {
+    for (std::size_t t = next.fetch_add(1); t < tasks.size(); t = next.fetch_add(1)) {
+      try {
+        tasks[t]();
+      } catch (...) {
+        errors[t] = std::current_exception();
+      }
+    }
+  };
+  if (shareThreadCount() <= 1 || tasks.size() <= 1) {
+    take();
+  } else {
+    std::thread worker(take);
+    take();
+    worker.join();
+  }
+  for (const auto& error : errors)
+    if (error) std::rethrow_exception(error);
 }
 
 }  // namespace gyrod::processing

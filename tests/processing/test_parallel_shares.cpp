@@ -4,10 +4,16 @@
 // shareThreadOverride, so the test means the same on a 2-core CI machine and a 64-core one.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <random>
+#include <span>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "processing/allan.hpp"
@@ -96,5 +102,49 @@ TEST(ParallelShares, TheWholeAxisAnalysisIsTheSameBitsForAnyThreadCount) {
     EXPECT_EQ(bitsOf(a.noise_after_kalman.value.arw_deg_per_sqrt_h),
               bitsOf(reference.noise_after_kalman.value.arw_deg_per_sqrt_h));
     EXPECT_EQ(bitsOf(a.variance.kalman), bitsOf(reference.variance.kalman)) << threads << " threads";
+  }
+}
+
+TEST(ParallelShares, EveryTaskRunsOnceAndTheFirstFailureInTaskOrderIsRethrown) {
+  for (std::size_t threads : kThreadCounts) {
+    const FixedThreads fixed(threads);
+    std::vector<std::atomic<int>> runs(9);
+    std::vector<std::function<void()>> tasks;
+    for (std::size_t t = 0; t < runs.size(); ++t)
+      tasks.emplace_back([&runs, t] {
+        runs[t].fetch_add(1);
+        if (t == 4 || t == 7) throw std::runtime_error("task " + std::to_string(t));
+      });
+    try {
+      runTasksOnBothCores(std::span(tasks));
+      ADD_FAILURE() << "no exception with " << threads << " threads";
+    } catch (const std::runtime_error& e) {
+      EXPECT_STREQ(e.what(), "task 4") << threads << " threads";
+    }
+    for (std::size_t t = 0; t < runs.size(); ++t) EXPECT_EQ(runs[t].load(), 1) << "task " << t << ", " << threads;
+  }
+}
+
+// The in-place table's `alongside` work sees the samples before they become the phase, once.
+TEST(ParallelShares, TheInPlaceTablesAlongsideWorkReadsTheSamplesBeforeTheyBecomeThePhase) {
+  const std::vector<double> x = stillGyroRate(50'000, 5);
+  const std::vector<std::size_t> ms = octaveClusterSizes(x.size());
+  const std::vector<AllanPoint> reference = allanDeviationTable(x, 0.02, ms);
+  for (std::size_t threads : kThreadCounts) {
+    const FixedThreads fixed(threads);
+    AllanWorkspace workspace(x.size());
+    std::copy(x.begin(), x.end(), workspace.rateSlots().begin());
+    int calls = 0;
+    double sum_seen = 0.0;
+    const auto table = allanDeviationTableInPlace(workspace, x.size(), 0.02, ms, {}, [&] {
+      ++calls;
+      for (std::size_t i = 0; i < x.size(); ++i) sum_seen += workspace.rateSlots()[i];
+    });
+    double sum = 0.0;
+    for (double v : x) sum += v;
+    EXPECT_EQ(calls, 1) << threads << " threads";
+    EXPECT_EQ(bitsOf(sum_seen), bitsOf(sum)) << threads << " threads";
+    ASSERT_EQ(table.size(), reference.size());
+    for (std::size_t k = 0; k < table.size(); ++k) EXPECT_EQ(bitsOf(table[k].oadev), bitsOf(reference[k].oadev));
   }
 }
