@@ -267,104 +267,6 @@ class IntegratedPhase {
   double lo_term_bound_ = 0.0;  // bound on |(lc − lb) − (lb − la)| over the phase
 };
 
-// Lag-1 autocorrelation r1 = Σ (z_i − z̄)(z_{i+1} − z̄) / Σ (z_i − z̄)² and the spread
-// Σ (z_i − z̄)² it was normalised by.
-struct Lag1 {
-  double r1 = 0.0;
-  double sum_sq = 0.0;
-};
-
-// The D-th differences (D ≤ 2) of the series z in order, formed as differencing it D times
-// in place would (z′_i = z_{i+1} − z_i, z″_i = z′_{i+1} − z′_i: the same operations, the
-// same bits), each z read once. D is a template parameter: no branch per value.
-template <int D, typename Series>
-class DifferenceStream {
- public:
-  explicit DifferenceStream(const Series& z) : z_(z) {
-    if constexpr (D >= 1) z0_ = z_(next_++);
-    if constexpr (D >= 2) z1_ = z_(next_++);
-  }
-  double next() {
-    const double v = z_(next_++);
-    if constexpr (D == 0) {
-      return v;
-    } else if constexpr (D == 1) {
-      const double diff = v - z0_;
-      z0_ = v;
-      return diff;
-    } else {
-      const double diff = (v - z1_) - (z1_ - z0_);
-      z0_ = z1_;
-      z1_ = v;
-      return diff;
-    }
-  }
-
- private:
-  const Series& z_;
-  std::size_t next_ = 0;
-  double z0_ = 0.0, z1_ = 0.0;
-};
-
-// lag1Autocorrelation of the D-th difference of z (`len` points before differencing), each
-// value formed when it is needed: no copy of the series. The sums Σ (z_i − z̄)² and
-// Σ (z_i − z̄)(z_{i+1} − z̄) (z̄ the plain mean) are each kept in four lanes, i mod 4, added
-// at the end: four independent addition chains where one would wait on each addition's
-// latency. The order differs from one running sum's by a few ε, which moves a decision only
-// for a ρ within ~10⁻¹⁵ of a rounding boundary of α.
-template <int D, typename Series>
-Lag1 lag1AutocorrelationOfDifference(const Series& z, std::size_t len) {
-  const std::size_t n = len - static_cast<std::size_t>(D);
-  constexpr std::size_t kLanes = 4;
-  DifferenceStream<D, Series> first_pass(z);
-  double m0 = 0.0, m1 = 0.0, m2 = 0.0, m3 = 0.0;
-  std::size_t i = 0;
-  for (; i + kLanes <= n; i += kLanes) {
-    m0 += first_pass.next();
-    m1 += first_pass.next();
-    m2 += first_pass.next();
-    m3 += first_pass.next();
-  }
-  double mean = (m0 + m1) + (m2 + m3);
-  for (; i < n; ++i) mean += first_pass.next();
-  mean /= static_cast<double>(n);
-  // den over all n values, num over the n − 1 neighbouring pairs (a_i, a_{i+1}).
-  DifferenceStream<D, Series> second_pass(z);
-  double n0 = 0.0, n1 = 0.0, n2 = 0.0, n3 = 0.0, d0 = 0.0, d1 = 0.0, d2 = 0.0, d3 = 0.0;
-  double a = second_pass.next() - mean;
-  i = 0;
-  for (; i + kLanes < n; i += kLanes) {
-    const double b = second_pass.next() - mean, c = second_pass.next() - mean, e = second_pass.next() - mean,
-                 f = second_pass.next() - mean;
-    d0 += a * a;
-    n0 += a * b;
-    d1 += b * b;
-    n1 += b * c;
-    d2 += c * c;
-    n2 += c * e;
-    d3 += e * e;
-    n3 += e * f;
-    a = f;
-  }
-  double num = (n0 + n1) + (n2 + n3), den = (d0 + d1) + (d2 + d3);
-  for (; i < n; ++i) {
-    den += a * a;
-    if (i + 1 < n) {
-      const double next = second_pass.next() - mean;
-      num += a * next;
-      a = next;
-    }
-  }
-  return {den > 0.0 ? num / den : 0.0, den};
-}
-
-template <typename Series>
-Lag1 lag1AutocorrelationOfDifference(const Series& z, std::size_t len, int d) {
-  if (d == 0) return lag1AutocorrelationOfDifference<0>(z, len);
-  if (d == 1) return lag1AutocorrelationOfDifference<1>(z, len);
-  return lag1AutocorrelationOfDifference<2>(z, len);
-}
-
 int clampAlpha(double alpha) { return static_cast<int>(std::clamp(std::round(alpha), -2.0, 2.0)); }
 
 // Riley & Greenhall (2004), lag-1 ACF method for frequency data, dmax = 2: average the
@@ -374,8 +276,7 @@ int clampAlpha(double alpha) { return static_cast<int>(std::clamp(std::round(alp
 // A level that is numerically constant (spread ≤ 1e-10 of the undifferenced spread:
 // rounding only, e.g. the first difference of a pure ramp) has no correlation to measure;
 // it is taken as ρ = 0, i.e. the series is a polynomial of degree d − 1, α = −2d (clamped).
-template <typename Series>
-int lag1NoiseIdOf(const Series& z, std::size_t n);
+int lag1NoiseIdOf(allan_kernels::AveragedSeries series, const double* data, double mean, double divisor, std::size_t n);
 
 int lag1NoiseId(std::span<const double> rate, std::size_t m, double mean) {
   const std::size_t n = rate.size() / m;
@@ -403,18 +304,18 @@ int lag1NoiseId(std::span<const double> rate, std::size_t m, double mean) {
     for (std::size_t i = k * m; i < (k + 1) * m; ++i) s += rate[i] - mean;
     z[k] = s / md;
   }
-  return lag1NoiseIdOf([&z](std::size_t i) { return z[i]; }, n);
+  return lag1NoiseIdOf(allan_kernels::AveragedSeries::Sums, z.data(), 0.0, 1.0, n);  // z / 1.0 is z
 }
 
-// The lag-1 decision on the averaged series z(0 … n−1), read as often as needed (each
-// difference level is formed on the fly, never stored).
-template <typename Series>
-int lag1NoiseIdOf(const Series& z, std::size_t n) {
+// The lag-1 decision on the averaged series z(0 … n−1) (allan_kernels::AveragedSeries),
+// read as often as needed (each difference level is formed on the fly, never stored).
+int lag1NoiseIdOf(allan_kernels::AveragedSeries series, const double* data, double mean, double divisor,
+                  std::size_t n) {
   constexpr int kMaxDifferences = 2;
   double level0_spread = -1.0;
   for (int d = 0;; ++d) {
     const std::size_t len = n - static_cast<std::size_t>(d);
-    const Lag1 acf = lag1AutocorrelationOfDifference(z, n, d);
+    const allan_kernels::Lag1Correlation acf = allan_kernels::lag1OfDifference(series, data, mean, divisor, n, d);
     const double spread = std::sqrt(acf.sum_sq / static_cast<double>(len));
     if (level0_spread < 0.0) level0_spread = spread;
     if (spread <= 1e-10 * level0_spread) return clampAlpha(-2.0 * d);
@@ -480,21 +381,23 @@ std::vector<int> noiseTypesForTable(std::span<const double> rate, std::span<cons
                                             : nullptr;
   };
   // The cluster sums of m = 1, 2 and 4 are read from the rate when needed (the additions of
-  // the pairwise cascade, the same bits) rather than held: a copy of the series would cost 8
-  // bytes a sample while the phase is also held (allanDeviationTable forms the two at once).
+  // the pairwise cascade, the same bits: allan_kernels::AveragedSeries, four at a time there)
+  // rather than held: a copy of the series would cost 8 bytes a sample while the phase is
+  // also held (allanDeviationTable forms the two at once).
   const auto sum1 = [&](std::size_t i) { return rate[i] - mean; };
   const auto sum2 = [&](std::size_t k) { return sum1(2 * k) + sum1(2 * k + 1); };
   const auto firstLevel = [&] {
-    if (int* alpha = top >= 1 ? alphaAt(1) : nullptr) *alpha = lag1NoiseIdOf(sum1, count);  // v / 1.0 is v
+    if (int* alpha = top >= 1 ? alphaAt(1) : nullptr)
+      *alpha = lag1NoiseIdOf(allan_kernels::AveragedSeries::Rate, rate.data(), mean, 1.0, count);
   };
   const auto secondLevel = [&] {
     if (int* alpha = top >= 2 ? alphaAt(2) : nullptr)
-      *alpha = lag1NoiseIdOf([&](std::size_t k) { return sum2(k) / 2.0; }, count / 2);
+      *alpha = lag1NoiseIdOf(allan_kernels::AveragedSeries::Pairs, rate.data(), mean, 2.0, count / 2);
   };
   const auto levelsFromFour = [&] {
     const auto sum4 = [&](std::size_t k) { return sum2(2 * k) + sum2(2 * k + 1); };
     if (int* alpha = top >= 4 ? alphaAt(4) : nullptr)
-      *alpha = lag1NoiseIdOf([&](std::size_t k) { return sum4(k) / 4.0; }, count / 4);
+      *alpha = lag1NoiseIdOf(allan_kernels::AveragedSeries::Quads, rate.data(), mean, 4.0, count / 4);
     if (top < 8) return;
     // From m = 8 on, level by level in one buffer of 1 byte a sample (not zeroed first: every
     // value is written before it is read): each level's averages are read as sum / m, and the
@@ -506,7 +409,7 @@ std::vector<int> noiseTypesForTable(std::span<const double> rate, std::span<cons
     for (std::size_t m = 8; m <= top; m *= 2) {
       if (int* alpha = alphaAt(m)) {
         const double md = static_cast<double>(m);
-        *alpha = lag1NoiseIdOf([&sums, md](std::size_t k) { return sums[k] / md; }, level_size);
+        *alpha = lag1NoiseIdOf(allan_kernels::AveragedSeries::Sums, sums.get(), 0.0, md, level_size);
       }
       level_size /= 2;
       for (std::size_t k = 0; k < level_size; ++k) sums[k] = sums[2 * k] + sums[2 * k + 1];

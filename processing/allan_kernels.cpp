@@ -164,6 +164,158 @@ double compensatedSumLanes(const double* rate, std::size_t count) {
 
 double compensatedSum(const double* rate, std::size_t count) { return compensatedSumLanes(rate, count); }
 
+namespace {
+
+// z_k … z_{k+3} of the series (AveragedSeries), and z_k alone: the same operations, so the
+// same bits, lane by lane.
+template <AveragedSeries S>
+[[gnu::always_inline]] inline double seriesPoint(const double* data, double mean, double divisor, std::size_t k) {
+  if constexpr (S == AveragedSeries::Rate) {
+    return data[k] - mean;
+  } else if constexpr (S == AveragedSeries::Pairs) {
+    return ((data[2 * k] - mean) + (data[2 * k + 1] - mean)) / 2.0;
+  } else if constexpr (S == AveragedSeries::Quads) {
+    const double* q = data + 4 * k;
+    return (((q[0] - mean) + (q[1] - mean)) + ((q[2] - mean) + (q[3] - mean))) / 4.0;
+  } else {
+    return data[k] / divisor;
+  }
+}
+
+// The four pair sums s2_{j} … s2_{j+3} (rate[2j … 2j+7]).
+[[gnu::always_inline]] inline void pairSums(const double* data, const Doubles4& mean4, std::size_t j, Doubles4& out) {
+  Doubles4 p, q;
+  loadDoubles(data + 2 * j, p);
+  loadDoubles(data + 2 * j + 4, q);
+  p -= mean4;
+  q -= mean4;
+  out = __builtin_shufflevector(p, q, 0, 2, 4, 6) + __builtin_shufflevector(p, q, 1, 3, 5, 7);
+}
+
+template <AveragedSeries S>
+[[gnu::always_inline]] inline void seriesPoints(const double* data, const Doubles4& mean4, const Doubles4& divisor4,
+                                                std::size_t k, Doubles4& out) {
+  if constexpr (S == AveragedSeries::Rate) {
+    loadDoubles(data + k, out);
+    out -= mean4;
+  } else if constexpr (S == AveragedSeries::Pairs) {
+    pairSums(data, mean4, k, out);
+    out /= Doubles4{2.0, 2.0, 2.0, 2.0};
+  } else if constexpr (S == AveragedSeries::Quads) {
+    Doubles4 low, high;
+    pairSums(data, mean4, 2 * k, low);
+    pairSums(data, mean4, 2 * k + 4, high);
+    out = __builtin_shufflevector(low, high, 0, 2, 4, 6) + __builtin_shufflevector(low, high, 1, 3, 5, 7);
+    out /= Doubles4{4.0, 4.0, 4.0, 4.0};
+  } else {
+    loadDoubles(data + k, out);
+    out /= divisor4;
+  }
+}
+
+// The d-th difference at i: z_i, z_{i+1} − z_i, or (z_{i+2} − z_{i+1}) − (z_{i+1} − z_i).
+template <int D, AveragedSeries S>
+[[gnu::always_inline]] inline double differencePoint(const double* data, double mean, double divisor, std::size_t i) {
+  const double z0 = seriesPoint<S>(data, mean, divisor, i);
+  if constexpr (D == 0) {
+    return z0;
+  } else if constexpr (D == 1) {
+    return seriesPoint<S>(data, mean, divisor, i + 1) - z0;
+  } else {
+    const double z1 = seriesPoint<S>(data, mean, divisor, i + 1);
+    return (seriesPoint<S>(data, mean, divisor, i + 2) - z1) - (z1 - z0);
+  }
+}
+
+template <int D, AveragedSeries S>
+[[gnu::always_inline]] inline void differencePoints(const double* data, const Doubles4& mean4, const Doubles4& divisor4,
+                                                    std::size_t i, Doubles4& out) {
+  Doubles4 z0;
+  seriesPoints<S>(data, mean4, divisor4, i, z0);
+  if constexpr (D == 0) {
+    out = z0;
+  } else if constexpr (D == 1) {
+    seriesPoints<S>(data, mean4, divisor4, i + 1, out);
+    out -= z0;
+  } else {
+    Doubles4 z1, z2;
+    seriesPoints<S>(data, mean4, divisor4, i + 1, z1);
+    seriesPoints<S>(data, mean4, divisor4, i + 2, z2);
+    out = (z2 - z1) - (z1 - z0);
+  }
+}
+
+template <int D, AveragedSeries S>
+[[gnu::always_inline]] inline Lag1Correlation lag1OfDifferenceLanes(const double* data, double series_mean,
+                                                                    double divisor, std::size_t len) {
+  const std::size_t n = len - static_cast<std::size_t>(D);
+  const Doubles4 mean4 = {series_mean, series_mean, series_mean, series_mean};
+  const Doubles4 divisor4 = {divisor, divisor, divisor, divisor};
+  // The mean of the differences.
+  Doubles4 lanes = {0.0, 0.0, 0.0, 0.0};
+  std::size_t i = 0;
+  for (; i + 4 <= n; i += 4) {
+    Doubles4 v;
+    differencePoints<D, S>(data, mean4, divisor4, i, v);
+    lanes += v;
+  }
+  double mean = (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
+  for (; i < n; ++i) mean += differencePoint<D, S>(data, series_mean, divisor, i);
+  mean /= static_cast<double>(n);
+  // den over all n values, num over the n − 1 neighbouring pairs (a_i, a_{i+1}).
+  const Doubles4 centre = {mean, mean, mean, mean};
+  Doubles4 num_lanes = {0.0, 0.0, 0.0, 0.0}, den_lanes = {0.0, 0.0, 0.0, 0.0};
+  i = 0;
+  for (; i + 4 < n; i += 4) {
+    Doubles4 a, b;
+    differencePoints<D, S>(data, mean4, divisor4, i, a);
+    differencePoints<D, S>(data, mean4, divisor4, i + 1, b);
+    a -= centre;
+    b -= centre;
+    den_lanes += a * a;
+    num_lanes += a * b;
+  }
+  double num = (num_lanes[0] + num_lanes[1]) + (num_lanes[2] + num_lanes[3]);
+  double den = (den_lanes[0] + den_lanes[1]) + (den_lanes[2] + den_lanes[3]);
+  double a = differencePoint<D, S>(data, series_mean, divisor, i) - mean;
+  for (; i < n; ++i) {
+    den += a * a;
+    if (i + 1 < n) {
+      const double next = differencePoint<D, S>(data, series_mean, divisor, i + 1) - mean;
+      num += a * next;
+      a = next;
+    }
+  }
+  return {den > 0.0 ? num / den : 0.0, den};
+}
+
+template <AveragedSeries S>
+[[gnu::always_inline]] inline Lag1Correlation lag1OfSeries(const double* data, double mean, double divisor,
+                                                           std::size_t len, int d) {
+  if (d == 0) return lag1OfDifferenceLanes<0, S>(data, mean, divisor, len);
+  if (d == 1) return lag1OfDifferenceLanes<1, S>(data, mean, divisor, len);
+  return lag1OfDifferenceLanes<2, S>(data, mean, divisor, len);
+}
+
+GYROD_ISA_CLONES
+Lag1Correlation lag1OfDifferenceClones(AveragedSeries series, const double* data, double mean, double divisor,
+                                       std::size_t len, int d) {
+  switch (series) {
+    case AveragedSeries::Rate: return lag1OfSeries<AveragedSeries::Rate>(data, mean, divisor, len, d);
+    case AveragedSeries::Pairs: return lag1OfSeries<AveragedSeries::Pairs>(data, mean, divisor, len, d);
+    case AveragedSeries::Quads: return lag1OfSeries<AveragedSeries::Quads>(data, mean, divisor, len, d);
+    case AveragedSeries::Sums: break;
+  }
+  return lag1OfSeries<AveragedSeries::Sums>(data, mean, divisor, len, d);
+}
+
+}  // namespace
+
+Lag1Correlation lag1OfDifference(AveragedSeries series, const double* data, double mean, double divisor,
+                                 std::size_t len, int d) {
+  return lag1OfDifferenceClones(series, data, mean, divisor, len, d);
+}
+
 double overlappingBlockTotal(const double* hi, const float* lo, std::size_t m, std::size_t k, std::size_t block_end) {
   double full = 0.0, high = 0.0;
   blockTotalLanes(hi, lo, m, k, block_end, full, high);

@@ -1,5 +1,5 @@
 #pragma once
-// The two inner loops of the overlapping Allan sweep (processing/allan.cpp), kept apart so
+// The inner loops of the Allan tables (processing/allan.cpp), kept apart so
 // that each is compiled for the machine it runs on: on x86-64 an AVX2 clone is chosen at
 // load time when the CPU has it (GCC/Clang function multiversioning), else the baseline
 // (SSE2); on ARM the one portable build (NEON on arm64). Every path does the same IEEE
@@ -37,6 +37,26 @@ double overlappingHighTotal(const double* hi, std::size_t m, std::size_t k, std:
 // sum, and the same bits on every ISA. A non-finite sample makes the result non-finite
 // (so can an overflow).
 double compensatedSum(const double* rate, std::size_t count);
+
+// The averaged series whose lag-1 autocorrelation the noise identification measures
+// (allan.cpp's noise types), point z_k of each as the table forms it from the rate's cluster
+// sums, s1_i = rate[i] − mean:
+//   Rate:  z_k = s1_k                                   (m = 1)
+//   Pairs: z_k = s2_k / 2,  s2_k = s1_{2k} + s1_{2k+1}  (m = 2)
+//   Quads: z_k = (s2_{2k} + s2_{2k+1}) / 4              (m = 4)
+//   Sums:  z_k = data[k] / divisor                      (cluster sums formed elsewhere)
+enum class AveragedSeries { Rate, Pairs, Quads, Sums };
+struct Lag1Correlation {
+  double r1 = 0.0;      // Σ (z_i − z̄)(z_{i+1} − z̄) / Σ (z_i − z̄)², 0 when the latter is 0
+  double sum_sq = 0.0;  // Σ (z_i − z̄)²
+};
+// The lag-1 autocorrelation of the d-th difference (d ≤ 2; z′_i = z_{i+1} − z_i, applied d
+// times) of the series' first `len` points (`mean` is read by Rate, Pairs and Quads, `divisor`
+// by Sums). The mean and both sums are kept in four lanes, lane j taking the values
+// 4q + j, the tail lane 0 for the mean and the last values serially for the sums, the lanes
+// added as (0 + 1) + (2 + 3): the same bits on every ISA.
+Lag1Correlation lag1OfDifference(AveragedSeries series, const double* data, double mean, double divisor,
+                                 std::size_t len, int d);
 
 // The phase of the mean-removed rate as the unevaluated sum hi[k] + lo[k], k = 0 … count
 // (hi[0] = lo[0] = 0): the double-double running sum of (rate[i] − mean), lo rounded to
