@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <functional>
+#include <optional>
 #include <stdexcept>
 
 #include "processing/isa_clones.hpp"
@@ -164,18 +166,30 @@ AxisAnalysis analyzeAxis(std::vector<double>&& rate_dps, const AnalysisOptions& 
   a.samples = rate_dps.size();
 
   // 1. Tests on the raw series, before any preprocessing (paper §3.2.1); they only read it,
-  // so two run beside the third.
-  runBoth(
-      [&] {
-        a.zero_mean = zeroMeanTest(rate_dps);
-        a.reverse_arrangements = reverseArrangementsTest(rate_dps, options.reverse_arrangements_segments);
-      },
-      [&] { a.normality = chiSquareNormalityTest(rate_dps); });
+  // and so does the fit of the trend that step 2 removes: three tasks on the cores.
+  std::optional<LinearTrend> trend;
+  std::vector<std::function<void()>> tests = {[&] {
+                                                a.zero_mean = zeroMeanTest(rate_dps);
+                                                a.reverse_arrangements = reverseArrangementsTest(
+                                                    rate_dps, options.reverse_arrangements_segments);
+                                              },
+                                              [&] { a.normality = chiSquareNormalityTest(rate_dps); }};
+  if (options.detrend) tests.emplace_back([&] { trend = fitLinearTrend(rate_dps, tau0); });
+  runTasksOnBothCores(std::span(tests));
   step("tests");
 
-  // 2. Preprocessing (§3.2.2), in place: the raw series is not needed again.
+  // 2. Preprocessing (§3.2.2), in place: the raw series is not needed again. Each sample's
+  // subtraction is its own: in shares on the cores, the same bits as removeLinearTrend.
   std::vector<double> x = std::move(rate_dps);
-  if (options.detrend) a.trend_removed = removeLinearTrend(x, tau0);
+  if (trend) {
+    a.trend_removed = *trend;
+    forEachShare(
+        x.size(),
+        [&](std::size_t first, std::size_t end) {
+          subtractLinearTrend(std::span(x).subspan(first, end - first), *trend, tau0, first);
+        },
+        std::size_t{1} << 16);
+  }
   step("detrend");
 
   // 3. Allan deviation and noise terms (§3.2.3, Table 2). One workspace holds the phase of

@@ -41,8 +41,13 @@ double removeConstant(std::span<double> x) {
 
 LinearTrend removeLinearTrend(std::span<double> x, double dt_s) {
   const LinearTrend t = fitLinearTrend(x, dt_s);
-  for (std::size_t i = 0; i < x.size(); ++i) x[i] -= t.offset + t.slope_per_s * (static_cast<double>(i) * dt_s);
+  subtractLinearTrend(x, t, dt_s);
   return t;
+}
+
+void subtractLinearTrend(std::span<double> x, const LinearTrend& trend, double dt_s, std::size_t first_index) {
+  for (std::size_t k = 0; k < x.size(); ++k)
+    x[k] -= trend.offset + trend.slope_per_s * (static_cast<double>(first_index + k) * dt_s);
 }
 
 }  // namespace gyrod::processing

@@ -1,5 +1,6 @@
 #pragma once
 // Preprocessing (paper §3.2.2): remove the constant and the least-squares linear trend.
+#include <cstddef>
 #include <span>
 
 namespace gyrod::processing {
@@ -16,5 +17,8 @@ LinearTrend fitLinearTrend(std::span<const double> x, double dt_s);
 double removeConstant(std::span<double> x);
 // In place: x[i] −= offset + slope·i·dt. Returns the trend removed. Throws as fitLinearTrend.
 LinearTrend removeLinearTrend(std::span<double> x, double dt_s);
+// In place, a trend fitted before: x[k] −= offset + slope·(i·dt) with i = first_index + k,
+// the operations of removeLinearTrend (so that shares of a series give its bits).
+void subtractLinearTrend(std::span<double> x, const LinearTrend& trend, double dt_s, std::size_t first_index = 0);
 
 }  // namespace gyrod::processing

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <random>
+#include <span>
 #include <stdexcept>
 #include <vector>
 
@@ -81,4 +82,24 @@ TEST(Detrend, RejectsBadInput) {
   EXPECT_THROW(fitLinearTrend(two, NAN), std::invalid_argument);
   EXPECT_THROW(removeLinearTrend(one, 0.02), std::invalid_argument);
   EXPECT_THROW(removeConstant(std::span<double>{}), std::invalid_argument);
+}
+
+// The analysis fits the trend beside the tests and subtracts it in shares on the cores: any
+// cut of the series must give removeLinearTrend's bits.
+TEST(Detrend, SubtractingAFittedTrendInSharesIsRemoveLinearTrendBitForBit) {
+  std::mt19937 gen(17);
+  std::normal_distribution<double> noise(0.0, 0.3);
+  std::vector<double> x(10007);
+  for (std::size_t i = 0; i < x.size(); ++i) x[i] = 1.7 + 0.002 * static_cast<double>(i) + noise(gen);
+  std::vector<double> whole = x;
+  const LinearTrend removed = removeLinearTrend(whole, 0.02);
+  const LinearTrend fitted = fitLinearTrend(x, 0.02);
+  EXPECT_EQ(fitted.offset, removed.offset);
+  EXPECT_EQ(fitted.slope_per_s, removed.slope_per_s);
+  for (std::size_t cut : {std::size_t{1}, std::size_t{4096}, x.size() / 2, x.size() - 1}) {
+    std::vector<double> shares = x;
+    subtractLinearTrend(std::span(shares).first(cut), fitted, 0.02, 0);
+    subtractLinearTrend(std::span(shares).subspan(cut), fitted, 0.02, cut);
+    for (std::size_t i = 0; i < x.size(); ++i) ASSERT_EQ(shares[i], whole[i]) << "cut " << cut << ", sample " << i;
+  }
 }
