@@ -372,8 +372,8 @@ void writeKalibrImu(const AnalyzeOptions& opt, const LoadedInput& in, const std:
 }
 
 // Every selected axis analysed, in axis order. Two at a time on two cores, each with a
-// workspace of its own: an axis's serial steps (detrend, Kalman, the in-place table's noise
-// types) then leave no core idle.
+// workspace of its own: an axis's serial steps (the Kalman filter, the long-double spreads,
+// the tables' serial passes) then leave no core idle.
 std::vector<AxisAnalysis> analyzeEveryAxis(const AnalyzeOptions& opt, LoadedInput& in, const AnalysisOptions& options,
                                            StepTimer& step_timer) {
   auto& rec = in.recording;
