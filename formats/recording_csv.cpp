@@ -346,8 +346,9 @@ class FrontSliceWorker {
     start_.arrive_and_wait();
     thread_.join();
   }
-  // One batch: `parse` on the worker beside `parse_here` on this thread, then `after_worker`
-  // beside `after_here`; returns once all four are done, rethrowing the first failure.
+  // One batch: `parse` on the worker beside `parse_here` on this thread, then `after` on the
+  // worker beside `after_here` (neither once a parse failed); returns once all are done,
+  // rethrowing the worker's failure first.
   void batch(const Work& parse, const Work& after, const Work& parse_here, const Work& after_here) {
     parse_ = &parse;
     after_ = &after;
@@ -488,8 +489,8 @@ void readSampleLines(ChunkedLineReader& reader, const SliceParser& parser,
     worker->batch(parse_front, copy_back, parse_back, report_and_read_on);
     append(front_slice, first_sample, true);
     append(back_slice, first_sample + front_slice.samples, true);
-    // Half the measured imbalance moved over: a few batches settle it, one slow batch (the
-    // machine busy elsewhere) does not throw it far.
+    // A quarter of the measured relative imbalance moved over each batch: a few batches settle
+    // it, and one slow batch (the machine busy elsewhere) does not throw it far.
     if (front_seconds > 0.0 && back_seconds > 0.0)
       front_share =
           std::clamp(front_share - 0.25 * (front_seconds - back_seconds) / (front_seconds + back_seconds), 0.2, 0.8);
