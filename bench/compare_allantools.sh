@@ -185,9 +185,9 @@ if [ "$have_allantools" = yes ]; then
   if [ ! -s "$workdir/agreement" ]; then  # one round: compare once more, untimed
     /usr/bin/python3 "$workdir/allantools_oadev.py" "$allantools" "$one" "$rate" "$json" | sed -n 2p > "$workdir/agreement"
   fi
-  set -- $(cat "$workdir/agreement")
-  if [ $# -eq 2 ]; then
-    echo "OADEV, gyroctl against allantools at the $1 octave m both print: largest relative difference $2"
+  read -r compared worst < "$workdir/agreement" || true
+  if [ -n "${worst:-}" ]; then
+    echo "OADEV, gyroctl against allantools at the $compared octave m both print: largest relative difference $worst"
   fi
 fi
 if [ -s "$times/oadev-core" ]; then
