@@ -113,6 +113,12 @@ find "$root/usr/share/man" -type f -name '*.[0-9]' -exec gzip -9n {} +
 # library packages, with the same shlibs, on every architecture).
 cross_depends() {  # cross_depends SONAME -> the dependency the host's shlibs file gives for it
   local soname=$1 multiarch owner name soversion dependency
+  # The dynamic loader is named per architecture (ld-linux-aarch64.so.1, which an arm64 binary
+  # built with -fstack-protector-strong needs for __stack_chk_guard), so the host has no copy of
+  # the target's; on every architecture libc6 ships it beside libc.so.6.
+  case $soname in
+    ld-linux*.so.* | ld-*.so.*) soname=libc.so.6 ;;
+  esac
   multiarch=$(gcc -print-multiarch 2>/dev/null || echo x86_64-linux-gnu)
   owner=$(dpkg -S "/lib/$multiarch/$soname" "/usr/lib/$multiarch/$soname" 2>/dev/null | head -1 | cut -d: -f1) || true
   [ -n "$owner" ] || die "no package on this machine provides $soname: install its $(dpkg --print-architecture) package"
