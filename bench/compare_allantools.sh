@@ -186,8 +186,10 @@ if [ "$have_allantools" = yes ]; then
     /usr/bin/python3 "$workdir/allantools_oadev.py" "$allantools" "$one" "$rate" "$json" | sed -n 2p > "$workdir/agreement"
   fi
   read -r compared worst < "$workdir/agreement" || true
-  if [ -n "${worst:-}" ]; then
+  if [ "${compared:-0}" -gt 0 ]; then
     echo "OADEV, gyroctl against allantools at the $compared octave m both print: largest relative difference $worst"
+  else
+    echo "OADEV: allantools and gyroctl printed no m in common; nothing compared"
   fi
 fi
 if [ -s "$times/oadev-core" ]; then
