@@ -107,26 +107,10 @@ commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
 # Debian compresses man pages (dh_compress does the same).
 find "$root/usr/share/man" -type f -name '*.[0-9]' -exec gzip -9n {} +
 
-# Depends: from the binaries' shared libraries. Natively dpkg-shlibdeps works them out. For a cross
-# build the target's libraries are not in the dpkg database, so each library is looked up in the
-# shlibs file of the package owning the host's copy of it (the same Debian release ships the same
-# library packages, with the same shlibs, on every architecture).
-cross_depends() {  # cross_depends SONAME -> the dependency the host's shlibs file gives for it
-  local soname=$1 multiarch owner name soversion dependency
-  # The dynamic loader is named per architecture (ld-linux-aarch64.so.1, which an arm64 binary
-  # built with -fstack-protector-strong needs for __stack_chk_guard), so the host has no copy of
-  # the target's; on every architecture libc6 ships it beside libc.so.6.
-  case $soname in
-    ld-linux*.so.* | ld-*.so.*) soname=libc.so.6 ;;
-  esac
-  multiarch=$(gcc -print-multiarch 2>/dev/null || echo x86_64-linux-gnu)
-  owner=$(dpkg -S "/lib/$multiarch/$soname" "/usr/lib/$multiarch/$soname" 2>/dev/null | head -1 | cut -d: -f1) || true
-  [ -n "$owner" ] || die "no package on this machine provides $soname: install its $(dpkg --print-architecture) package"
-  name=${soname%%.so.*} soversion=${soname#*.so.}
-  dependency=$(awk -v n="$name" -v v="$soversion" '$1 == n && $2 == v { $1 = ""; $2 = ""; sub(/^ +/, ""); print; exit }' \
-    "$(dpkg-query --control-path "$owner" shlibs 2>/dev/null)" 2>/dev/null) || true
-  echo "${dependency:-$owner (>= $(dpkg-query -W -f='${Version}' "$owner" | sed -E 's/^[0-9]+://; s/-[^-]*$//'))}"
-}
+# Depends: from the binaries' shared libraries. Natively dpkg-shlibdeps works them out; for a
+# cross build, cross_depends (scripts/deb-depends.sh) does.
+# shellcheck source=scripts/deb-depends.sh
+. scripts/deb-depends.sh
 binaries=("$root/usr/sbin/gyrod" "$root/usr/bin/gyroctl")
 # dpkg-shlibdeps is in dpkg-dev, which a machine set up by scripts/install-deps.sh may lack.
 if [ "$arch" = "$(dpkg --print-architecture)" ] && [ -z "${GYROD_DEB_CROSS_DEPENDS:-}" ] &&
