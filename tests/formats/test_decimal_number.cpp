@@ -125,9 +125,13 @@ TEST(DecimalNumber, PrintedDoublesAreReadAsFromCharsReadsThem) {
       rounded_here += roundedHere(printed("%.17g", v)) ? 1 : 0;
     }
   }
-  // The recordings' own form is rounded here, not handed back (the point of the function).
+  // The recordings' own form is rounded here, not handed back (the point of the function),
+  // where the 128-bit route exists; without __int128 (armhf) most 17-digit values go to
+  // std::from_chars, which the equality above still checks.
   EXPECT_GT(seventeen_digit, 40000u);
+#if defined(__SIZEOF_INT128__)
   EXPECT_GE(static_cast<double>(rounded_here), 0.99 * static_cast<double>(seventeen_digit));
+#endif
 }
 
 TEST(DecimalNumber, RandomDigitStringsAreReadAsFromCharsReadsThem) {

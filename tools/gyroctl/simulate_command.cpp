@@ -162,8 +162,10 @@ int runSimulate(const SimulateOptions& opt) {
     std::fputc('\n', f);
   }
   out.commit();
-  std::fprintf(stderr, "wrote %zu samples at %g Hz (%s%s, seed %llu) to %s\n", n, model.rate_hz,
-               model.dlpf_cfg ? ("DLPF_CFG " + std::to_string(*model.dlpf_cfg)).c_str() : "no DLPF",
+  // n is 64-bit on every ABI (a long simulation overflows a 32-bit size_t): %llu, not %zu,
+  // which on armhf read the wrong varargs and crashed in strlen.
+  std::fprintf(stderr, "wrote %llu samples at %g Hz (%s%s, seed %llu) to %s\n", static_cast<unsigned long long>(n),
+               model.rate_hz, model.dlpf_cfg ? ("DLPF_CFG " + std::to_string(*model.dlpf_cfg)).c_str() : "no DLPF",
                model.fs_sel ? (", FS_SEL " + std::to_string(*model.fs_sel)).c_str() : ", not quantised",
                static_cast<unsigned long long>(opt.seed), opt.output.c_str());
   return kExitOk;
