@@ -145,14 +145,17 @@ while [ "$r" -lt "$rounds" ]; do
 done
 echo "load at the end: $(cut -d' ' -f1-3 /proc/loadavg)"
 
+# middle FORMAT: the median of the numbers on standard input, one a line, printed with FORMAT.
+middle() {
+  sort -g | awk -v f="$1" '{ v[NR] = $1 } END { printf f, NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'
+}
 # median FILE COLUMN: the median of one column.
 median() {
-  awk -v c="$2" '{ print $c }' "$1" | sort -g | awk '{ v[NR] = $1 } END { if (NR % 2) print v[(NR + 1) / 2]; else print (v[NR / 2] + v[NR / 2 + 1]) / 2 }'
+  awk -v c="$2" '{ print $c }' "$1" | middle '%.10g\n'
 }
 # ratio_median A B: the median over rounds of A's wall / B's wall (line i of each file).
 ratio_median() {
-  paste -d' ' "$times/$1" "$times/$2" | awk '{ print $1 / $3 }' | sort -g |
-    awk '{ v[NR] = $1 } END { if (NR % 2) printf "%.2f", v[(NR + 1) / 2]; else printf "%.2f", (v[NR / 2] + v[NR / 2 + 1]) / 2 }'
+  paste -d' ' "$times/$1" "$times/$2" | awk '{ print $1 / $3 }' | middle '%.2f'
 }
 row() {
   key=$1
@@ -181,7 +184,7 @@ row three "gyroctl analyze FILE3 (three axes and temperature, everything)"
 if [ "$have_allantools" = yes ]; then
   echo
   echo "peak memory, gyroctl (everything) / allantools: $(paste -d' ' "$times/everything" "$times/allantools" |
-    awk '{ print $2 / $4 }' | sort -g | awk '{ v[NR] = $1 } END { printf "%.2f", v[int((NR + 1) / 2)] }')"
+    awk '{ print $2 / $4 }' | middle '%.2f')"
   if [ ! -s "$workdir/agreement" ]; then  # one round: compare once more, untimed
     /usr/bin/python3 "$workdir/allantools_oadev.py" "$allantools" "$one" "$rate" "$json" | sed -n 2p > "$workdir/agreement"
   fi
@@ -197,10 +200,9 @@ if [ -s "$times/oadev-core" ]; then
   echo "| OADEV at every octave τ on 10⁷ samples, in memory | wall (median) | this / one streaming sum | allantools' oadev / this |"
   echo "|---|---|---|---|"
   core=$(median "$times/oadev-core" 1)
-  sum_ratio=$(awk '{ print $1 / $2 }' "$times/oadev-core" | sort -g | awk '{ v[NR] = $1 } END { printf "%.1f", v[int((NR + 1) / 2)] }')
+  sum_ratio=$(awk '{ print $1 / $2 }' "$times/oadev-core" | middle '%.1f')
   if [ "$have_allantools" = yes ] && [ "$samples" -eq 10000000 ]; then  # bench_allan's size
-    oadev_ratio=$(paste -d' ' "$times/allantools-parts" "$times/oadev-core" | awk '{ print $2 / $4 }' | sort -g |
-      awk '{ v[NR] = $1 } END { printf "%.1f×", v[int((NR + 1) / 2)] }')
+    oadev_ratio="$(paste -d' ' "$times/allantools-parts" "$times/oadev-core" | awk '{ print $2 / $4 }' | middle '%.1f')×"
   else
     oadev_ratio="(only with --samples 10000000, bench_allan's size)"
   fi
