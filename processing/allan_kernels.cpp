@@ -344,7 +344,7 @@ constexpr std::size_t kPhaseLanes = 4;
 
 // The double-double running sum of (rate[i] − mean) over `count` samples of kPhaseLanes
 // runs `run_stride` apart, one per lane, each from its state in `states` (updated to the
-// run's end); writes hi[i] and lo[i] (rounded to float) after each sample when hi is given.
+// run's end); writes hi[i] and lo[i] (rounded to float) after each sample.
 GYROD_ISA_CLONES
 void integrateRuns(const double* rate, double mean, std::size_t run_stride, std::size_t count, PhaseState* states,
                    double* hi, float* lo) {
@@ -357,19 +357,17 @@ void integrateRuns(const double* rate, double mean, std::size_t run_stride, std:
     const Doubles4 y = {rate[i], rate[i + s1], rate[i + s2], rate[i + s3]};
     const Doubles4 v = y - mean4;
     accumulate(s_hi, s_lo, v);
-    if (hi != nullptr) {
-      const Floats4 low = __builtin_convertvector(s_lo, Floats4);
-      const Floats4 abs_low = low < 0.0F ? -low : low;
-      max_abs = max_abs < abs_low ? abs_low : max_abs;
-      hi[i] = s_hi[0];
-      hi[i + s1] = s_hi[1];
-      hi[i + s2] = s_hi[2];
-      hi[i + s3] = s_hi[3];
-      lo[i] = low[0];
-      lo[i + s1] = low[1];
-      lo[i + s2] = low[2];
-      lo[i + s3] = low[3];
-    }
+    const Floats4 low = __builtin_convertvector(s_lo, Floats4);
+    const Floats4 abs_low = low < 0.0F ? -low : low;
+    max_abs = max_abs < abs_low ? abs_low : max_abs;
+    hi[i] = s_hi[0];
+    hi[i + s1] = s_hi[1];
+    hi[i + s2] = s_hi[2];
+    hi[i + s3] = s_hi[3];
+    lo[i] = low[0];
+    lo[i + s1] = low[1];
+    lo[i + s2] = low[2];
+    lo[i + s3] = low[3];
   }
   for (std::size_t q = 0; q < kPhaseLanes; ++q) states[q] = {s_hi[q], s_lo[q], max_abs[q]};
 }
@@ -380,11 +378,9 @@ void integrateRun(const double* rate, double mean, std::size_t count, PhaseState
   float max_abs = 0.0F;
   for (std::size_t i = 0; i < count; ++i) {
     accumulate(s_hi, s_lo, rate[i] - mean);
-    if (hi != nullptr) {
-      hi[i] = s_hi;
-      lo[i] = static_cast<float>(s_lo);
-      max_abs = std::max(max_abs, std::abs(lo[i]));
-    }
+    hi[i] = s_hi;
+    lo[i] = static_cast<float>(s_lo);
+    max_abs = std::max(max_abs, std::abs(lo[i]));
   }
   state = {s_hi, s_lo, max_abs};
 }
@@ -398,9 +394,36 @@ PhaseState doubleDoubleSum(PhaseState a, PhaseState b) {
   return {hi, e - (hi - s), 0.0F};
 }
 
+// The double-double total of (rate[i] − mean) over one full run (kPhaseRun samples):
+// kTotalChains chains of four lanes, chain c's lane q taking the samples i ≡ 4c + q
+// (mod 4·kTotalChains), then the chains added by double-double addition lane by lane, chain
+// by chain. Independent chains keep the pipes busy where one running sum waits on its own
+// latency (seven dependent additions a sample); the order is fixed, so the total is the same
+// bits on every ISA and for any number of threads.
+constexpr std::size_t kTotalChains = 4;
+static_assert(kPhaseRun % (kPhaseLanes * kTotalChains) == 0, "a run is whole steps of the chains");
+GYROD_ISA_CLONES
+PhaseState runTotal(const double* rate, double mean) {
+  const Doubles4 mean4 = {mean, mean, mean, mean};
+  Doubles4 chain_hi[kTotalChains] = {};
+  Doubles4 chain_lo[kTotalChains] = {};
+  for (std::size_t i = 0; i < kPhaseRun; i += kPhaseLanes * kTotalChains) {
+    for (std::size_t c = 0; c < kTotalChains; ++c) {
+      Doubles4 y;
+      loadDoubles(rate + i + kPhaseLanes * c, y);
+      accumulate(chain_hi[c], chain_lo[c], y - mean4);
+    }
+  }
+  PhaseState total;
+  for (std::size_t c = 0; c < kTotalChains; ++c)
+    for (std::size_t q = 0; q < kPhaseLanes; ++q)
+      total = doubleDoubleSum(total, {chain_hi[c][q], chain_lo[c][q], 0.0F});
+  return total;
+}
+
 // Runs r·kPhaseRun … of the rate from the states given (updated to the runs' ends), writing
-// the phase when hi is given: groups of four full runs through the four-lane kernel, the
-// others (the last, shorter run among them) one by one.
+// the phase: groups of four full runs through the four-lane kernel, the others (the last,
+// shorter run among them) one by one.
 void forEachRunGroup(const double* rate, std::size_t count, double mean, std::vector<PhaseState>& states, double* hi,
                      float* lo) {
   const std::size_t groups = count / kPhaseRun / kPhaseLanes;
@@ -411,12 +434,10 @@ void forEachRunGroup(const double* rate, std::size_t count, double mean, std::ve
         for (std::size_t task = first; task < end; ++task) {
           const std::size_t run = task < groups ? task * kPhaseLanes : groups * kPhaseLanes + (task - groups);
           const std::size_t begin = run * kPhaseRun;
-          double* run_hi = hi != nullptr ? hi + begin : nullptr;
-          float* run_lo = hi != nullptr ? lo + begin : nullptr;
           if (task < groups)
-            integrateRuns(rate + begin, mean, kPhaseRun, kPhaseRun, &states[run], run_hi, run_lo);
+            integrateRuns(rate + begin, mean, kPhaseRun, kPhaseRun, &states[run], hi + begin, lo + begin);
           else
-            integrateRun(rate + begin, mean, std::min(kPhaseRun, count - begin), states[run], run_hi, run_lo);
+            integrateRun(rate + begin, mean, std::min(kPhaseRun, count - begin), states[run], hi + begin, lo + begin);
         }
       },
       4);
@@ -429,7 +450,13 @@ float integratePhase(const double* rate, std::size_t count, double mean, double*
   lo[0] = 0.0;
   const std::size_t runs = (count + kPhaseRun - 1) / kPhaseRun;
   std::vector<PhaseState> totals(runs), starts(runs);
-  forEachRunGroup(rate, count, mean, totals, nullptr, nullptr);
+  // Every run but the last is full, and only those runs' totals start another.
+  forEachShare(
+      runs > 0 ? runs - 1 : 0,
+      [&](std::size_t first, std::size_t end) {
+        for (std::size_t r = first; r < end; ++r) totals[r] = runTotal(rate + r * kPhaseRun, mean);
+      },
+      4);
   for (std::size_t r = 1; r < runs; ++r) starts[r] = doubleDoubleSum(starts[r - 1], totals[r - 1]);
   forEachRunGroup(rate, count, mean, starts, hi + 1, lo + 1);
   float max_abs_lo = 0.0F;

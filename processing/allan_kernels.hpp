@@ -60,12 +60,13 @@ Lag1Correlation lag1OfDifference(AveragedSeries series, const double* data, doub
 
 // The phase of the mean-removed rate as the unevaluated sum hi[k] + lo[k], k = 0 … count
 // (hi[0] = lo[0] = 0): the double-double running sum of (rate[i] − mean), lo rounded to
-// float. Formed in fixed runs of kPhaseRun samples: every run's double-double total (pass 1),
-// the runs' starting sums by double-double addition of the totals before them (pass 2), then
-// every run's running sum from its start (pass 3). Passes 1 and 3 take four runs at once, one
-// per lane (independent chains: the latency of one hides behind the others), and share the
-// runs among threads. The run length is fixed, so the phase is the same bits for any number
-// of threads and any ISA; it differs from one serial running sum only by the errors of the
+// float. Formed in fixed runs of kPhaseRun samples: every run's double-double total (pass 1,
+// each run in sixteen interleaved chains added at its end), the runs' starting sums by
+// double-double addition of the totals before them (pass 2), then every run's running sum
+// from its start (pass 3, four runs at once, one per lane). Independent chains hide the
+// latency of one running sum behind the others; both passes share the runs among threads.
+// The run length and every order are fixed, so the phase is the same bits for any number of
+// threads and any ISA; it differs from one serial running sum only by the errors of the
 // double-double additions (~ε²·|x| each, far below the float lo's 2⁻⁷⁷·|x|).
 // Returns the largest |lo[k]| written (a float, exact).
 inline constexpr std::size_t kPhaseRun = std::size_t{1} << 13;
