@@ -31,12 +31,12 @@ void requireClusterSize(std::size_t m, const char* where) {
   if (m == 0) throw std::invalid_argument(std::string(where) + " needs an averaging factor m of at least 1 (got 0)");
 }
 
-// Mean of the series by Neumaier-compensated summation (four lanes: allan_kernels); throws
-// on a non-finite sample so that no estimator ever silently turns a NaN reading into a
-// number. Only a non-finite lane sum sends it through the serial loop that names the sample.
-double compensatedMean(std::span<const double> rate, const char* where) {
+// Mean of the series from its double-double sum (allan_kernels::sumInRuns, both cores);
+// throws on a non-finite sample so that no estimator ever silently turns a NaN reading into a
+// number. Only a non-finite sum sends it through the serial loop that names the sample.
+double checkedMean(std::span<const double> rate, const char* where) {
   if (rate.empty()) return 0.0;
-  const double sum = allan_kernels::compensatedSum(rate.data(), rate.size());
+  const double sum = allan_kernels::sumInRuns(rate.data(), rate.size());
   if (std::isfinite(sum)) return sum / static_cast<double>(rate.size());
   for (std::size_t i = 0; i < rate.size(); ++i) {
     const double v = rate[i];
@@ -82,8 +82,8 @@ constexpr double kHighOnlyTolerance = 1e-13;
 class IntegratedPhase {
  public:
   explicit IntegratedPhase(std::span<const double> rate, const char* where)
-      : IntegratedPhase(rate, compensatedMean(rate, where)) {}
-  // With the mean already formed (by compensatedMean, which has checked every sample).
+      : IntegratedPhase(rate, checkedMean(rate, where)) {}
+  // With the mean already formed (by checkedMean, which has checked every sample).
   IntegratedPhase(std::span<const double> rate, double mean)
       : IntegratedPhase(rate, mean, allan_kernels::allocatePhaseStorage<double>(rate.size() + 1),
                         allan_kernels::allocatePhaseStorage<float>(rate.size() + 1)) {}
@@ -354,7 +354,7 @@ int identifyWithMean(std::span<const double> rate, std::size_t m, double mean, c
 // averagings are formed pairwise from the level below, a different rounding from the
 // one-by-one sum of lag1NoiseId (both within a few ε of the exact sum): the decision
 // differs only for a ρ within ~10⁻¹⁵ of a rounding boundary of α. Empty for a series shorter than kMinAveragedPointsForNoiseId, whose fallback
-// needs the phase. `mean` is compensatedMean's, which has rejected any non-finite sample.
+// needs the phase. `mean` is checkedMean's, which has rejected any non-finite sample.
 // `alongside`, when given, runs as one more task beside them (work that only reads the rate).
 std::vector<int> noiseTypesForTable(std::span<const double> rate, std::span<const std::size_t> ms, double mean,
                                     const std::function<void()>& alongside = {}) {
@@ -518,7 +518,7 @@ std::vector<std::size_t> clusterSizesForTaus(std::span<const double> taus_s, dou
 double allanVariance(std::span<const double> rate, std::size_t m) {
   requireClusterSize(m, "the Allan variance");
   if (rate.size() / m < 2) {
-    compensatedMean(rate, "the Allan variance");  // still reject non-finite input
+    checkedMean(rate, "the Allan variance");  // still reject non-finite input
     return kNaN;
   }
   return IntegratedPhase(rate, "the Allan variance").allanVariance(m);
@@ -527,7 +527,7 @@ double allanVariance(std::span<const double> rate, std::size_t m) {
 double overlappingAllanVariance(std::span<const double> rate, std::size_t m) {
   requireClusterSize(m, "the overlapping Allan variance");
   if (2 * m > rate.size()) {
-    compensatedMean(rate, "the overlapping Allan variance");
+    checkedMean(rate, "the overlapping Allan variance");
     return kNaN;
   }
   return IntegratedPhase(rate, "the overlapping Allan variance").overlappingAllanVariance(m);
@@ -545,7 +545,7 @@ int identifyPowerLawNoise(std::span<const double> rate, std::size_t m) {
     throw std::invalid_argument("the power-law noise identification needs at least 3 samples (got " +
                                 std::to_string(rate.size()) + ")");
   }
-  const double mean = compensatedMean(rate, "the power-law noise identification");
+  const double mean = checkedMean(rate, "the power-law noise identification");
   if (rate.size() >= kMinAveragedPointsForNoiseId) return identifyWithMean(rate, m, mean, nullptr);
   const IntegratedPhase phase(rate, "the power-law noise identification");
   return identifyWithMean(rate, m, mean, &phase);
@@ -624,7 +624,7 @@ std::vector<AllanPoint> tableWithPhaseAt(std::span<const double> rate, double ta
   for (std::size_t m : ms) requireClusterSize(m, "the Allan deviation table");
 
   const std::size_t count = rate.size();
-  const double mean = compensatedMean(rate, "the Allan deviation table");  // one pass for both
+  const double mean = checkedMean(rate, "the Allan deviation table");  // one pass for both
   std::vector<int> alphas;
   std::optional<IntegratedPhase> integrated;
   std::vector<double> overlapping, non_overlapping;
@@ -724,7 +724,7 @@ std::vector<double> overlappingAllanVariances(std::span<const double> rate, std:
                                               AllanWorkspace& workspace) {
   for (std::size_t m : ms) requireClusterSize(m, "the overlapping Allan variances");
   requireCapacity(workspace, rate.size());
-  const IntegratedPhase phase(rate, compensatedMean(rate, "the overlapping Allan variances"), workspace.phaseHi(),
+  const IntegratedPhase phase(rate, checkedMean(rate, "the overlapping Allan variances"), workspace.phaseHi(),
                               workspace.phaseLo());
   return phase.overlappingAllanVariances(ms);
 }

@@ -130,42 +130,6 @@ double highTotalLanes(const double* hi, std::size_t m, std::size_t k, std::size_
 
 namespace {
 
-// One Neumaier step, s + v with the lost low part added to c; branch-free so that lanes can
-// take it at once (each lane the scalar operations in the scalar order).
-template <typename T>
-inline void neumaierStep(T& s, T& c, const T& v) {
-  const T t = s + v;
-  const T abs_s = s < 0.0 ? -s : s;
-  const T abs_v = v < 0.0 ? -v : v;
-  c += abs_s >= abs_v ? (s - t) + v : (v - t) + s;
-  s = t;
-}
-
-GYROD_ISA_CLONES
-double compensatedSumLanes(const double* rate, std::size_t count) {
-  Doubles4 s = {0.0, 0.0, 0.0, 0.0};
-  Doubles4 c = {0.0, 0.0, 0.0, 0.0};
-  std::size_t i = 0;
-  for (; i + 4 <= count; i += 4) {
-    Doubles4 v;
-    loadDoubles(rate + i, v);
-    neumaierStep(s, c, v);
-  }
-  double s0 = s[0], c0 = c[0];
-  for (; i < count; ++i) neumaierStep(s0, c0, rate[i]);
-  double total = s0, compensation = 0.0;
-  neumaierStep(total, compensation, s[1]);
-  neumaierStep(total, compensation, s[2]);
-  neumaierStep(total, compensation, s[3]);
-  return total + (compensation + ((c0 + c[1]) + (c[2] + c[3])));
-}
-
-}  // namespace
-
-double compensatedSum(const double* rate, std::size_t count) { return compensatedSumLanes(rate, count); }
-
-namespace {
-
 // z_k … z_{k+3} of the series (AveragedSeries), and z_k alone: the same operations, so the
 // same bits, lane by lane.
 template <AveragedSeries S>
@@ -394,27 +358,31 @@ PhaseState doubleDoubleSum(PhaseState a, PhaseState b) {
   return {hi, e - (hi - s), 0.0F};
 }
 
-// The double-double total of (rate[i] − mean) over one full run (kPhaseRun samples):
-// kTotalChains chains of four lanes, chain c's lane q taking the samples i ≡ 4c + q
-// (mod 4·kTotalChains), then the chains added by double-double addition lane by lane, chain
-// by chain. Independent chains keep the pipes busy where one running sum waits on its own
-// latency (seven dependent additions a sample); the order is fixed, so the total is the same
-// bits on every ISA and for any number of threads.
+// The double-double total of (rate[i] − shift) over `count` samples (one run): the last
+// count mod 4·kTotalChains samples serially, then kTotalChains chains of four lanes, chain c's
+// lane q taking the samples i ≡ 4c + q (mod 4·kTotalChains), added to it by double-double
+// addition lane by lane, chain by chain. Independent chains keep the pipes busy where one
+// running sum waits on its own latency (seven dependent additions a sample); the order is
+// fixed, so the total is the same bits on every ISA and for any number of threads.
 constexpr std::size_t kTotalChains = 4;
-static_assert(kPhaseRun % (kPhaseLanes * kTotalChains) == 0, "a run is whole steps of the chains");
+constexpr std::size_t kTotalStep = kPhaseLanes * kTotalChains;
+static_assert(kPhaseRun % kTotalStep == 0, "a full run is whole steps of the chains");
 GYROD_ISA_CLONES
-PhaseState runTotal(const double* rate, double mean) {
-  const Doubles4 mean4 = {mean, mean, mean, mean};
+PhaseState runTotal(const double* rate, double shift, std::size_t count) {
+  const Doubles4 shift4 = {shift, shift, shift, shift};
   Doubles4 chain_hi[kTotalChains] = {};
   Doubles4 chain_lo[kTotalChains] = {};
-  for (std::size_t i = 0; i < kPhaseRun; i += kPhaseLanes * kTotalChains) {
+  const std::size_t whole = count - count % kTotalStep;
+  for (std::size_t i = 0; i < whole; i += kTotalStep) {
     for (std::size_t c = 0; c < kTotalChains; ++c) {
       Doubles4 y;
       loadDoubles(rate + i + kPhaseLanes * c, y);
-      accumulate(chain_hi[c], chain_lo[c], y - mean4);
+      accumulate(chain_hi[c], chain_lo[c], y - shift4);
     }
   }
-  PhaseState total;
+  double tail_hi = 0.0, tail_lo = 0.0;
+  for (std::size_t i = whole; i < count; ++i) accumulate(tail_hi, tail_lo, rate[i] - shift);
+  PhaseState total{tail_hi, tail_lo, 0.0F};
   for (std::size_t c = 0; c < kTotalChains; ++c)
     for (std::size_t q = 0; q < kPhaseLanes; ++q)
       total = doubleDoubleSum(total, {chain_hi[c][q], chain_lo[c][q], 0.0F});
@@ -454,7 +422,7 @@ float integratePhase(const double* rate, std::size_t count, double mean, double*
   forEachShare(
       runs > 0 ? runs - 1 : 0,
       [&](std::size_t first, std::size_t end) {
-        for (std::size_t r = first; r < end; ++r) totals[r] = runTotal(rate + r * kPhaseRun, mean);
+        for (std::size_t r = first; r < end; ++r) totals[r] = runTotal(rate + r * kPhaseRun, mean, kPhaseRun);
       },
       4);
   for (std::size_t r = 1; r < runs; ++r) starts[r] = doubleDoubleSum(starts[r - 1], totals[r - 1]);
@@ -462,6 +430,21 @@ float integratePhase(const double* rate, std::size_t count, double mean, double*
   float max_abs_lo = 0.0F;
   for (const PhaseState& s : starts) max_abs_lo = std::max(max_abs_lo, s.max_abs_lo);
   return max_abs_lo;
+}
+
+double sumInRuns(const double* rate, std::size_t count) {
+  const std::size_t runs = (count + kPhaseRun - 1) / kPhaseRun;
+  std::vector<PhaseState> totals(runs);
+  forEachShare(
+      runs,
+      [&](std::size_t first, std::size_t end) {
+        for (std::size_t r = first; r < end; ++r)
+          totals[r] = runTotal(rate + r * kPhaseRun, 0.0, std::min(kPhaseRun, count - r * kPhaseRun));
+      },
+      4);
+  PhaseState sum;
+  for (const PhaseState& t : totals) sum = doubleDoubleSum(sum, t);
+  return sum.hi;
 }
 
 void* allocatePhaseBytes(std::size_t bytes) {

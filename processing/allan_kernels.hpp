@@ -31,12 +31,13 @@ BlockTotals overlappingBlockTotals(const double* hi, const float* lo, std::size_
 // The hi-only sum alone, reading hi only: the same bits as BlockTotals::high.
 double overlappingHighTotal(const double* hi, std::size_t m, std::size_t k, std::size_t block_end);
 
-// Σ rate[i] by Neumaier-compensated summation in four lanes (lane j takes i ≡ j mod 4, the
-// tail lane 0), the lanes' sums then added in order with compensation and the four
-// compensations added last: error ≲ 2ε·|Σ| + O(ε²)·Σ|rate|, like one serial compensated
-// sum, and the same bits on every ISA. A non-finite sample makes the result non-finite
-// (so can an overflow).
-double compensatedSum(const double* rate, std::size_t count);
+// Σ rate[i] to double-double accuracy, rounded once: the double-double totals of fixed runs
+// of kPhaseRun samples (each in independent chains, as the phase's run totals), shared among
+// threads, then added in run order. The error is ~ε²·Σ|partial sums| before the one rounding,
+// so the result is the correctly rounded sum but in rare ties; the order is fixed, so it is
+// the same bits on every ISA and for any number of threads. A non-finite sample makes the
+// result non-finite (so can an overflow).
+double sumInRuns(const double* rate, std::size_t count);
 
 // The averaged series whose lag-1 autocorrelation the noise identification measures
 // (allan.cpp's noise types), point z_k of each as the table forms it from the rate's cluster

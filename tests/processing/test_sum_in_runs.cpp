@@ -1,0 +1,109 @@
+// allan_kernels::sumInRuns, the sample sum behind every Allan estimator's mean: the exact sum
+// rounded once, for lengths that leave every kind of tail (inside the sixteen chains of a run,
+// a partial last run), the same bits for any thread count, and a non-finite sample never
+// hidden. The exact sums come from integers: every sample is a whole multiple k of 2⁻³⁰ with
+// |k| < 2⁵⁶, so the sum of up to 10⁵ of them is an exact int64 times 2⁻³⁰, and converting
+// that int64 to double is the correctly rounded sum.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "processing/allan_kernels.hpp"
+#include "processing/parallel_share.hpp"
+
+using namespace gyrod::processing;
+
+namespace {
+
+constexpr double kScale = 0x1p-30;
+
+struct ScaledSeries {
+  std::vector<double> samples;
+  std::int64_t exact_units = 0;  // Σ k_i: the exact sum is exact_units·2⁻³⁰
+};
+
+// A bias of `bias_units` with noise of ±noise_units, and every 97th sample a spike of
+// ±2⁵⁴ units that the next sample takes back: beside a spike a double's last bit is 4 units,
+// so a naive sum loses the noise's low bits there.
+ScaledSeries scaledSeries(std::size_t n, std::int64_t bias_units, std::int64_t noise_units, std::uint64_t seed) {
+  std::mt19937_64 gen(seed);
+  std::uniform_int_distribution<std::int64_t> noise(-noise_units, noise_units);
+  ScaledSeries s;
+  s.samples.resize(n);
+  std::int64_t pending_spike = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    std::int64_t k = bias_units + noise(gen);
+    if (pending_spike != 0) {
+      k -= pending_spike;
+      pending_spike = 0;
+    } else if (i % 97 == 96) {
+      pending_spike = (gen() & 1U) != 0 ? (std::int64_t{1} << 54) : -(std::int64_t{1} << 54);
+      k += pending_spike;
+    }
+    // k rounded to a double (a spike's sample keeps 53 bits), then scaled exactly; the exact
+    // sum counts the sample as stored.
+    s.samples[i] = static_cast<double>(k) * kScale;
+    s.exact_units += static_cast<std::int64_t>(s.samples[i] / kScale);
+  }
+  return s;
+}
+
+class FixedThreads {
+ public:
+  explicit FixedThreads(std::size_t n) { shareThreadOverride().store(n); }
+  ~FixedThreads() { shareThreadOverride().store(0); }
+  FixedThreads(const FixedThreads&) = delete;
+  FixedThreads& operator=(const FixedThreads&) = delete;
+};
+
+}  // namespace
+
+TEST(SumInRuns, IsTheExactSumRoundedOnceForEveryKindOfTail) {
+  const std::size_t run = allan_kernels::kPhaseRun;
+  // Inside the first chain step, inside a run, a whole run, runs with a partial last one.
+  for (std::size_t n : {std::size_t{1}, std::size_t{15}, std::size_t{17}, std::size_t{1000}, run, run + 1, 3 * run + 37,
+                        7 * run + 16, std::size_t{100000}}) {
+    const ScaledSeries s = scaledSeries(n, 1'000'000'007, 50'000'000, 20261126 + n);
+    const double expected = static_cast<double>(s.exact_units) * kScale;
+    EXPECT_EQ(allan_kernels::sumInRuns(s.samples.data(), n), expected) << n << " samples";
+  }
+}
+
+TEST(SumInRuns, KeepsTheNoiseThatANaiveSumLosesBesideSpikes) {
+  const ScaledSeries s = scaledSeries(50'000, 3, 1'000, 7);
+  const double expected = static_cast<double>(s.exact_units) * kScale;
+  double naive = 0.0;
+  for (double v : s.samples) naive += v;
+  ASSERT_NE(naive, expected);  // the series is hard for a plain sum
+  EXPECT_EQ(allan_kernels::sumInRuns(s.samples.data(), s.samples.size()), expected);
+}
+
+TEST(SumInRuns, IsTheSameBitsForAnyThreadCount) {
+  const ScaledSeries s = scaledSeries(9 * allan_kernels::kPhaseRun + 5, -400'000'000, 30'000'000, 11);
+  double one = 0.0;
+  {
+    const FixedThreads threads(1);
+    one = allan_kernels::sumInRuns(s.samples.data(), s.samples.size());
+  }
+  for (std::size_t t : {2U, 3U, 5U}) {
+    const FixedThreads threads(t);
+    EXPECT_EQ(allan_kernels::sumInRuns(s.samples.data(), s.samples.size()), one) << t << " threads";
+  }
+}
+
+TEST(SumInRuns, ANonFiniteSampleMakesTheSumNonFinite) {
+  ScaledSeries s = scaledSeries(2 * allan_kernels::kPhaseRun + 3, 5, 5, 3);
+  for (double bad : {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
+                     -std::numeric_limits<double>::infinity()}) {
+    for (std::size_t at : {std::size_t{0}, std::size_t{4}, allan_kernels::kPhaseRun + 9, s.samples.size() - 1}) {
+      std::vector<double> samples = s.samples;
+      samples[at] = bad;
+      EXPECT_FALSE(std::isfinite(allan_kernels::sumInRuns(samples.data(), samples.size())))
+          << "sample " << at << " = " << bad;
+    }
+  }
+}
