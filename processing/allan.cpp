@@ -69,6 +69,9 @@ constexpr std::size_t kSumBlock = 4096;
 // Relative change of a block's sum of squares up to which the multi-m sweep may leave the
 // phase's lo parts out (IntegratedPhase::highOnlySuffices).
 constexpr double kHighOnlyTolerance = 1e-13;
+// The largest m whose block sums in the multi-m sweep read the block's lo parts widened once
+// (a block and 2·kWideReach phase points past it).
+constexpr std::size_t kWideReach = 64;
 
 // The phase (integrated rate, NIST SP 1065 x_k with x₀ = 0 and τ0 = 1 sample) of the
 // mean-removed series, held as an unevaluated sum hi[k] + lo[k]. Removing the mean keeps
@@ -181,16 +184,22 @@ class IntegratedPhase {
   // it may stand for the full one, else the full total (overlappingBlockTotal's bits). The
   // hi-only total is the same bits from either kernel, so the result depends only on the
   // block, never on `try_high_first` (a guess from the share's previous block that spares
-  // the lo reads when the hi-only total is likely to suffice).
-  double sweepBlockTotal(std::size_t m, std::size_t k, std::size_t block_end, bool& try_high_first) const {
+  // the lo reads when the hi-only total is likely to suffice). `wide`, when given, holds the
+  // block's lo parts from lo[k] on widened to double (the same values, so the same bits).
+  double sweepBlockTotal(std::size_t m, std::size_t k, std::size_t block_end, bool& try_high_first,
+                         const double* wide) const {
     const std::size_t terms = block_end - k;
+    const auto bothTotals = [&] {
+      return wide != nullptr ? allan_kernels::overlappingBlockTotals(hi_ + k, wide, m, 0, terms)
+                             : allan_kernels::overlappingBlockTotals(hi_, lo_, m, k, block_end);
+    };
     if (try_high_first) {
       const double high = allan_kernels::overlappingHighTotal(hi_, m, k, block_end);
       if (highOnlySuffices(high, terms)) return high;
       try_high_first = false;
-      return overlappingBlockTotal(m, k, block_end);
+      return wide != nullptr ? bothTotals().full : overlappingBlockTotal(m, k, block_end);
     }
-    const allan_kernels::BlockTotals t = allan_kernels::overlappingBlockTotals(hi_, lo_, m, k, block_end);
+    const allan_kernels::BlockTotals t = bothTotals();
     if (highOnlySuffices(t.high, terms)) {
       try_high_first = true;
       return t.high;
@@ -204,19 +213,34 @@ class IntegratedPhase {
   // offsets are still in cache when the next m needs them. The blocks are shared among
   // threads; each block's total (sweepBlockTotal: hi-only where that is proven within
   // kHighOnlyTolerance) is kept and the totals are added in block order, so the result is
-  // the same bits for any number of threads.
+  // the same bits for any number of threads. The m up to kWideReach that need the lo parts
+  // share one widening of the block's lo floats to double (the float-to-double conversions
+  // cost more than the rest of those sums).
   std::vector<double> overlappingAllanVariances(std::span<const std::size_t> ms) const {
     const std::size_t block_count = (rate_count_ + kSumBlock - 1) / kSumBlock;
     std::vector<double> block_totals(ms.size() * block_count, 0.0);
     const auto sweep = [&](std::size_t first_block, std::size_t end_block) {
       std::vector<char> try_high_first(ms.size(), 0);
+      std::vector<double> wide(kSumBlock + 2 * kWideReach);
       for (std::size_t b = first_block; b < end_block; ++b) {
         const std::size_t k = b * kSumBlock;
+        bool widened = false;
         for (std::size_t j = 0; j < ms.size(); ++j) {
           const std::size_t terms = overlappingTerms(ms[j]);
           if (k < terms) {
             bool guess = try_high_first[j] != 0;
-            block_totals[j * block_count + b] = sweepBlockTotal(ms[j], k, std::min(terms, k + kSumBlock), guess);
+            const double* block_wide = nullptr;
+            if (ms[j] <= kWideReach && !guess) {
+              if (!widened) {
+                // Phase points k … k + kSumBlock + 2·kWideReach − 1, as far as they go (the
+                // last is x_M, M = rate_count_).
+                allan_kernels::widenLo(lo_ + k, std::min(wide.size(), rate_count_ + 1 - k), wide.data());
+                widened = true;
+              }
+              block_wide = wide.data();
+            }
+            block_totals[j * block_count + b] =
+                sweepBlockTotal(ms[j], k, std::min(terms, k + kSumBlock), guess, block_wide);
             try_high_first[j] = guess ? 1 : 0;
           }
         }

@@ -26,18 +26,23 @@ inline void loadWidened(const float* p, Doubles4& v) {
   v = __builtin_convertvector(f, Doubles4);
 }
 
+inline void loadLo(const float* p, Doubles4& v) { loadWidened(p, v); }
+inline void loadLo(const double* p, Doubles4& v) { loadDoubles(p, v); }
+
 // The second differences of four consecutive start indices: `high` from the hi parts alone,
 // `full` with the lo corrections added (full = high + lo combination, the same rounding as
-// the scalar secondDifference).
-inline void secondDifferences(const double* h, const float* l, std::size_t i, std::size_t m, Doubles4& high,
+// the scalar secondDifference). The lo parts are the stored floats, or the same values
+// already widened to double (exact): the same bits either way.
+template <typename Lo>
+inline void secondDifferences(const double* h, const Lo* l, std::size_t i, std::size_t m, Doubles4& high,
                               Doubles4& full) {
   Doubles4 ha, hb, hc, la, lb, lc;
   loadDoubles(h + i, ha);
   loadDoubles(h + i + m, hb);
   loadDoubles(h + i + 2 * m, hc);
-  loadWidened(l + i, la);
-  loadWidened(l + i + m, lb);
-  loadWidened(l + i + 2 * m, lc);
+  loadLo(l + i, la);
+  loadLo(l + i + m, lb);
+  loadLo(l + i + 2 * m, lc);
   high = (hc - hb) - (hb - ha);
   full = high + ((lc - lb) - (lb - la));
 }
@@ -66,12 +71,12 @@ inline void accumulate(T& s_hi, T& s_lo, const T& v) {
 namespace {
 
 // The clones are internal functions behind the declared one (Clang multiversions only a
-// function whose every declaration carries the attribute). Both kernels add the squares of
-// the hi-only differences in the same lanes and order, so the hi-only total is the same bits
-// from either.
-GYROD_ISA_CLONES
-void blockTotalLanes(const double* hi, const float* lo, std::size_t m, std::size_t k, std::size_t block_end,
-                     double& full_total, double& high_total) {
+// function whose every declaration carries the attribute, and no template). Both kernels add
+// the squares of the hi-only differences in the same lanes and order, so the hi-only total is
+// the same bits from either.
+template <typename Lo>
+[[gnu::always_inline]] inline void blockTotalLanesOf(const double* hi, const Lo* lo, std::size_t m, std::size_t k,
+                                                     std::size_t block_end, double& full_total, double& high_total) {
   Doubles4 acc = {0.0, 0.0, 0.0, 0.0};
   Doubles4 acc_high = {0.0, 0.0, 0.0, 0.0};
   // Two groups of four per step: both are computed independently, then added in order.
@@ -101,6 +106,18 @@ void blockTotalLanes(const double* hi, const float* lo, std::size_t m, std::size
   }
   full_total = (p0 + acc[1]) + (acc[2] + acc[3]);
   high_total = (q0 + acc_high[1]) + (acc_high[2] + acc_high[3]);
+}
+
+GYROD_ISA_CLONES
+void blockTotalLanes(const double* hi, const float* lo, std::size_t m, std::size_t k, std::size_t block_end,
+                     double& full_total, double& high_total) {
+  blockTotalLanesOf(hi, lo, m, k, block_end, full_total, high_total);
+}
+
+GYROD_ISA_CLONES
+void blockTotalLanesWide(const double* hi, const double* lo, std::size_t m, std::size_t k, std::size_t block_end,
+                         double& full_total, double& high_total) {
+  blockTotalLanesOf(hi, lo, m, k, block_end, full_total, high_total);
 }
 
 GYROD_ISA_CLONES
@@ -291,6 +308,17 @@ BlockTotals overlappingBlockTotals(const double* hi, const float* lo, std::size_
   BlockTotals t;
   blockTotalLanes(hi, lo, m, k, block_end, t.full, t.high);
   return t;
+}
+
+BlockTotals overlappingBlockTotals(const double* hi, const double* lo, std::size_t m, std::size_t k,
+                                   std::size_t block_end) {
+  BlockTotals t;
+  blockTotalLanesWide(hi, lo, m, k, block_end, t.full, t.high);
+  return t;
+}
+
+void widenLo(const float* lo, std::size_t count, double* wide) {
+  for (std::size_t i = 0; i < count; ++i) wide[i] = lo[i];
 }
 
 double overlappingHighTotal(const double* hi, std::size_t m, std::size_t k, std::size_t block_end) {

@@ -28,6 +28,12 @@ struct BlockTotals {
 };
 BlockTotals overlappingBlockTotals(const double* hi, const float* lo, std::size_t m, std::size_t k,
                                    std::size_t block_end);
+// The same with the lo parts already widened to double (lo[i] the float's exact value, e.g.
+// from widenLo): the same bits as from the floats. A block sweep that needs the lo parts at
+// several m widens them once instead of at every m.
+BlockTotals overlappingBlockTotals(const double* hi, const double* lo, std::size_t m, std::size_t k,
+                                   std::size_t block_end);
+void widenLo(const float* lo, std::size_t count, double* wide);
 // The hi-only sum alone, reading hi only: the same bits as BlockTotals::high.
 double overlappingHighTotal(const double* hi, std::size_t m, std::size_t k, std::size_t block_end);
 
