@@ -317,9 +317,22 @@ BlockTotals overlappingBlockTotals(const double* hi, const double* lo, std::size
   return t;
 }
 
-void widenLo(const float* lo, std::size_t count, double* wide) {
-  for (std::size_t i = 0; i < count; ++i) wide[i] = lo[i];
+namespace {
+
+GYROD_ISA_CLONES
+void widenLanes(const float* lo, std::size_t count, double* wide) {
+  std::size_t i = 0;
+  for (; i + 4 <= count; i += 4) {
+    Doubles4 v;
+    loadWidened(lo + i, v);
+    std::memcpy(wide + i, &v, sizeof v);
+  }
+  for (; i < count; ++i) wide[i] = lo[i];
 }
+
+}  // namespace
+
+void widenLo(const float* lo, std::size_t count, double* wide) { widenLanes(lo, count, wide); }
 
 double overlappingHighTotal(const double* hi, std::size_t m, std::size_t k, std::size_t block_end) {
   return highTotalLanes(hi, m, k, block_end);
