@@ -31,13 +31,22 @@ void requireClusterSize(std::size_t m, const char* where) {
   if (m == 0) throw std::invalid_argument(std::string(where) + " needs an averaging factor m of at least 1 (got 0)");
 }
 
-// Mean of the series from its double-double sum (allan_kernels::sumInRuns, both cores);
-// throws on a non-finite sample so that no estimator ever silently turns a NaN reading into a
-// number. Only a non-finite sum sends it through the serial loop that names the sample.
-double checkedMean(std::span<const double> rate, const char* where) {
-  if (rate.empty()) return 0.0;
-  const double sum = allan_kernels::sumInRuns(rate.data(), rate.size());
-  if (std::isfinite(sum)) return sum / static_cast<double>(rate.size());
+// The series' mean from its double-double sum, with the sums of its runs, which spare the
+// phase integration a pass (allan_kernels::sumRuns, both cores). Throws on a non-finite sample
+// so that no estimator ever silently turns a NaN reading into a number; only a non-finite sum
+// sends it through the serial loop that names the sample.
+struct CheckedSums {
+  double mean = 0.0;
+  std::vector<allan_kernels::RunSum> runs;
+};
+
+CheckedSums checkedSums(std::span<const double> rate, const char* where) {
+  if (rate.empty()) return {};
+  CheckedSums sums;
+  sums.runs = allan_kernels::sumRuns(rate.data(), rate.size());
+  const double sum = allan_kernels::totalOfRuns(sums.runs);
+  sums.mean = sum / static_cast<double>(rate.size());
+  if (std::isfinite(sum)) return sums;
   for (std::size_t i = 0; i < rate.size(); ++i) {
     const double v = rate[i];
     if (!std::isfinite(v)) {
@@ -45,8 +54,10 @@ double checkedMean(std::span<const double> rate, const char* where) {
                                   ": it is not finite (" + formatNumber(v) + ")");
     }
   }
-  return sum / static_cast<double>(rate.size());  // finite samples whose sum overflows
+  return sums;  // finite samples whose sum overflows
 }
+
+double checkedMean(std::span<const double> rate, const char* where) { return checkedSums(rate, where).mean; }
 
 // Sum of squares accumulated in blocks: four interleaved partial sums inside a block
 // (independent chains the compiler can vectorise), block totals added with Neumaier
@@ -85,35 +96,35 @@ constexpr std::size_t kWideReach = 64;
 class IntegratedPhase {
  public:
   explicit IntegratedPhase(std::span<const double> rate, const char* where)
-      : IntegratedPhase(rate, checkedMean(rate, where)) {}
-  // With the mean already formed (by checkedMean, which has checked every sample).
-  IntegratedPhase(std::span<const double> rate, double mean)
-      : IntegratedPhase(rate, mean, allan_kernels::allocatePhaseStorage<double>(rate.size() + 1),
+      : IntegratedPhase(rate, checkedSums(rate, where)) {}
+  // With the mean and run sums already formed (by checkedSums, which has checked every sample).
+  IntegratedPhase(std::span<const double> rate, const CheckedSums& sums)
+      : IntegratedPhase(rate, sums, allan_kernels::allocatePhaseStorage<double>(rate.size() + 1),
                         allan_kernels::allocatePhaseStorage<float>(rate.size() + 1)) {}
   // In storage the caller keeps (at least rate.size() + 1 points each). The rate may lie at
   // hi + 1 itself: each sample is read before the phase point written over it.
-  IntegratedPhase(std::span<const double> rate, double mean, double* hi, float* lo)
-      : rate_count_(rate.size()), mean_(mean), hi_(hi), lo_(lo) {
-    integrate(rate);
+  IntegratedPhase(std::span<const double> rate, const CheckedSums& sums, double* hi, float* lo)
+      : rate_count_(rate.size()), mean_(sums.mean), hi_(hi), lo_(lo) {
+    integrate(rate, sums.runs);
   }
 
   std::size_t rateCount() const { return rate_count_; }
   double mean() const { return mean_; }
 
  private:
-  IntegratedPhase(std::span<const double> rate, double mean, allan_kernels::PhaseStorage<double> hi,
+  IntegratedPhase(std::span<const double> rate, const CheckedSums& sums, allan_kernels::PhaseStorage<double> hi,
                   allan_kernels::PhaseStorage<float> lo)
       : rate_count_(rate.size()),
-        mean_(mean),
+        mean_(sums.mean),
         owned_hi_(std::move(hi)),
         owned_lo_(std::move(lo)),
         hi_(owned_hi_.get()),
         lo_(owned_lo_.get()) {
-    integrate(rate);
+    integrate(rate, sums.runs);
   }
 
-  void integrate(std::span<const double> rate) {
-    const float max_abs_lo = allan_kernels::integratePhase(rate.data(), rate.size(), mean_, hi_, lo_);
+  void integrate(std::span<const double> rate, std::span<const allan_kernels::RunSum> run_sums) {
+    const float max_abs_lo = allan_kernels::integratePhase(rate.data(), rate.size(), mean_, run_sums, hi_, lo_);
     // Each lo combination (lc − lb) − (lb − la) of four floats is at most 4·max|lo| (its
     // two roundings in double add at most 2⁻⁵² of that; the margin covers them).
     lo_term_bound_ = 4.0 * static_cast<double>(max_abs_lo) * (1.0 + 1e-12);
@@ -648,15 +659,16 @@ std::vector<AllanPoint> tableWithPhaseAt(std::span<const double> rate, double ta
   for (std::size_t m : ms) requireClusterSize(m, "the Allan deviation table");
 
   const std::size_t count = rate.size();
-  const double mean = checkedMean(rate, "the Allan deviation table");  // one pass for both
+  const CheckedSums sums = checkedSums(rate, "the Allan deviation table");  // one pass for both
+  const double mean = sums.mean;
   std::vector<int> alphas;
   std::optional<IntegratedPhase> integrated;
   std::vector<double> overlapping, non_overlapping;
   const auto phaseAndSweeps = [&] {
     if (place.hi != nullptr)
-      integrated.emplace(rate, mean, place.hi, place.lo);
+      integrated.emplace(rate, sums, place.hi, place.lo);
     else
-      integrated.emplace(rate, mean);
+      integrated.emplace(rate, sums);
     overlapping = integrated->overlappingAllanVariances(ms);
     non_overlapping = nonOverlappingVariances(*integrated, ms);
   };
@@ -748,7 +760,7 @@ std::vector<double> overlappingAllanVariances(std::span<const double> rate, std:
                                               AllanWorkspace& workspace) {
   for (std::size_t m : ms) requireClusterSize(m, "the overlapping Allan variances");
   requireCapacity(workspace, rate.size());
-  const IntegratedPhase phase(rate, checkedMean(rate, "the overlapping Allan variances"), workspace.phaseHi(),
+  const IntegratedPhase phase(rate, checkedSums(rate, "the overlapping Allan variances"), workspace.phaseHi(),
                               workspace.phaseLo());
   return phase.overlappingAllanVariances(ms);
 }

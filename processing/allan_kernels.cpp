@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <new>
 #include <vector>
 
@@ -404,30 +405,53 @@ PhaseState doubleDoubleSum(PhaseState a, PhaseState b) {
 // lane q taking the samples i ≡ 4c + q (mod 4·kTotalChains), added to it by double-double
 // addition lane by lane, chain by chain. Independent chains keep the pipes busy where one
 // running sum waits on its own latency (seven dependent additions a sample); the order is
-// fixed, so the total is the same bits on every ISA and for any number of threads.
+// fixed, so the total is the same bits on every ISA and for any number of threads. Also the
+// smallest and the largest sample (for a finite run).
 constexpr std::size_t kTotalChains = 4;
 constexpr std::size_t kTotalStep = kPhaseLanes * kTotalChains;
 static_assert(kPhaseRun % kTotalStep == 0, "a full run is whole steps of the chains");
 GYROD_ISA_CLONES
-PhaseState runTotal(const double* rate, double shift, std::size_t count) {
+RunSum runTotal(const double* rate, double shift, std::size_t count) {
   const Doubles4 shift4 = {shift, shift, shift, shift};
   Doubles4 chain_hi[kTotalChains] = {};
   Doubles4 chain_lo[kTotalChains] = {};
+  const double first = count > 0 ? rate[0] : 0.0;
+  Doubles4 low = {first, first, first, first};
+  Doubles4 high = low;
   const std::size_t whole = count - count % kTotalStep;
   for (std::size_t i = 0; i < whole; i += kTotalStep) {
     for (std::size_t c = 0; c < kTotalChains; ++c) {
       Doubles4 y;
       loadDoubles(rate + i + kPhaseLanes * c, y);
+      low = y < low ? y : low;
+      high = high < y ? y : high;
       accumulate(chain_hi[c], chain_lo[c], y - shift4);
     }
   }
   double tail_hi = 0.0, tail_lo = 0.0;
-  for (std::size_t i = whole; i < count; ++i) accumulate(tail_hi, tail_lo, rate[i] - shift);
+  double smallest = std::min(std::min(low[0], low[1]), std::min(low[2], low[3]));
+  double largest = std::max(std::max(high[0], high[1]), std::max(high[2], high[3]));
+  for (std::size_t i = whole; i < count; ++i) {
+    accumulate(tail_hi, tail_lo, rate[i] - shift);
+    smallest = std::min(smallest, rate[i]);
+    largest = std::max(largest, rate[i]);
+  }
   PhaseState total{tail_hi, tail_lo, 0.0F};
   for (std::size_t c = 0; c < kTotalChains; ++c)
     for (std::size_t q = 0; q < kPhaseLanes; ++q)
       total = doubleDoubleSum(total, {chain_hi[c][q], chain_lo[c][q], 0.0F});
-  return total;
+  return {total.hi, total.lo, smallest, largest};
+}
+
+// Whether rate[i] − mean is exact for every sample in [smallest, largest]: Sterbenz's lemma
+// (y − μ is a double when μ/2 ≤ y ≤ 2μ, or 2μ ≤ y ≤ μ/2 for μ < 0). μ/2 and 2μ are exact
+// away from the ends of the range, which the bounds on |μ| keep.
+bool differencesFromMeanAreExact(double smallest, double largest, double mean) {
+  const double magnitude = std::abs(mean);
+  if (!(magnitude >= 4.0 * std::numeric_limits<double>::min() && magnitude <= std::numeric_limits<double>::max() / 4.0))
+    return false;
+  if (mean > 0.0) return smallest >= mean / 2.0 && largest <= 2.0 * mean;
+  return largest <= mean / 2.0 && smallest >= 2.0 * mean;
 }
 
 // Runs r·kPhaseRun … of the rate from the states given (updated to the runs' ends), writing
@@ -454,16 +478,28 @@ void forEachRunGroup(const double* rate, std::size_t count, double mean, std::ve
 
 }  // namespace
 
-float integratePhase(const double* rate, std::size_t count, double mean, double* hi, float* lo) {
+float integratePhase(const double* rate, std::size_t count, double mean, std::span<const RunSum> sums, double* hi,
+                     float* lo) {
   hi[0] = 0.0;
   lo[0] = 0.0;
   const std::size_t runs = (count + kPhaseRun - 1) / kPhaseRun;
+  const bool have_sums = sums.size() == runs;
   std::vector<PhaseState> totals(runs), starts(runs);
-  // Every run but the last is full, and only those runs' totals start another.
+  // Every run but the last is full, and only those runs' totals start another. Where every
+  // rate[i] − mean of a run is exact, its total is the run's sample sum less kPhaseRun·mean
+  // (exact: kPhaseRun is a power of two), without reading the run again.
   forEachShare(
       runs > 0 ? runs - 1 : 0,
       [&](std::size_t first, std::size_t end) {
-        for (std::size_t r = first; r < end; ++r) totals[r] = runTotal(rate + r * kPhaseRun, mean, kPhaseRun);
+        for (std::size_t r = first; r < end; ++r) {
+          if (have_sums && differencesFromMeanAreExact(sums[r].min, sums[r].max, mean)) {
+            totals[r] =
+                doubleDoubleSum({sums[r].hi, sums[r].lo, 0.0F}, {-static_cast<double>(kPhaseRun) * mean, 0.0, 0.0F});
+          } else {
+            const RunSum t = runTotal(rate + r * kPhaseRun, mean, kPhaseRun);
+            totals[r] = {t.hi, t.lo, 0.0F};
+          }
+        }
       },
       4);
   for (std::size_t r = 1; r < runs; ++r) starts[r] = doubleDoubleSum(starts[r - 1], totals[r - 1]);
@@ -473,20 +509,26 @@ float integratePhase(const double* rate, std::size_t count, double mean, double*
   return max_abs_lo;
 }
 
-double sumInRuns(const double* rate, std::size_t count) {
+std::vector<RunSum> sumRuns(const double* rate, std::size_t count) {
   const std::size_t runs = (count + kPhaseRun - 1) / kPhaseRun;
-  std::vector<PhaseState> totals(runs);
+  std::vector<RunSum> sums(runs);
   forEachShare(
       runs,
       [&](std::size_t first, std::size_t end) {
         for (std::size_t r = first; r < end; ++r)
-          totals[r] = runTotal(rate + r * kPhaseRun, 0.0, std::min(kPhaseRun, count - r * kPhaseRun));
+          sums[r] = runTotal(rate + r * kPhaseRun, 0.0, std::min(kPhaseRun, count - r * kPhaseRun));
       },
       4);
-  PhaseState sum;
-  for (const PhaseState& t : totals) sum = doubleDoubleSum(sum, t);
-  return sum.hi;
+  return sums;
 }
+
+double totalOfRuns(std::span<const RunSum> sums) {
+  PhaseState total;
+  for (const RunSum& s : sums) total = doubleDoubleSum(total, {s.hi, s.lo, 0.0F});
+  return total.hi;
+}
+
+double sumInRuns(const double* rate, std::size_t count) { return totalOfRuns(sumRuns(rate, count)); }
 
 void* allocatePhaseBytes(std::size_t bytes) {
   constexpr std::size_t kHugePage = std::size_t{2} << 20;

@@ -9,6 +9,8 @@
 #include <cstddef>
 #include <cstdlib>
 #include <memory>
+#include <span>
+#include <vector>
 
 namespace gyrod::processing::allan_kernels {
 
@@ -37,12 +39,25 @@ void widenLo(const float* lo, std::size_t count, double* wide);
 // The hi-only sum alone, reading hi only: the same bits as BlockTotals::high.
 double overlappingHighTotal(const double* hi, std::size_t m, std::size_t k, std::size_t block_end);
 
-// Σ rate[i] to double-double accuracy, rounded once: the double-double totals of fixed runs
-// of kPhaseRun samples (each in independent chains, as the phase's run totals), shared among
-// threads, then added in run order. The error is ~ε²·Σ|partial sums| before the one rounding,
-// so the result is the correctly rounded sum but in rare ties; the order is fixed, so it is
-// the same bits on every ISA and for any number of threads. A non-finite sample makes the
-// result non-finite (so can an overflow).
+// The length of the runs in which the sums and the phase below are formed.
+inline constexpr std::size_t kPhaseRun = std::size_t{1} << 13;
+
+// The samples in fixed runs of kPhaseRun (the phase's runs; the last may be shorter): each
+// run's sum to double-double accuracy (hi + lo, formed in independent chains, as the phase's
+// run totals), and its smallest and largest sample. The runs are shared among threads.
+struct RunSum {
+  double hi = 0.0;
+  double lo = 0.0;
+  double min = 0.0;
+  double max = 0.0;
+};
+std::vector<RunSum> sumRuns(const double* rate, std::size_t count);
+// Σ of the runs' sums by double-double addition in run order, rounded once: the error before
+// that rounding is ~ε²·Σ|partial sums|, so the result is the correctly rounded sum but in rare
+// ties. The order is fixed, so it is the same bits on every ISA and for any number of threads.
+// A non-finite sample makes the result non-finite (so can an overflow).
+double totalOfRuns(std::span<const RunSum> sums);
+// totalOfRuns(sumRuns(rate, count)).
 double sumInRuns(const double* rate, std::size_t count);
 
 // The averaged series whose lag-1 autocorrelation the noise identification measures
@@ -75,9 +90,12 @@ Lag1Correlation lag1OfDifference(AveragedSeries series, const double* data, doub
 // The run length and every order are fixed, so the phase is the same bits for any number of
 // threads and any ISA; it differs from one serial running sum only by the errors of the
 // double-double additions (~ε²·|x| each, far below the float lo's 2⁻⁷⁷·|x|).
-// Returns the largest |lo[k]| written (a float, exact).
-inline constexpr std::size_t kPhaseRun = std::size_t{1} << 13;
-float integratePhase(const double* rate, std::size_t count, double mean, double* hi, float* lo);
+// `sums`, sumRuns of the same samples (or empty), spares pass 1 every run whose differences
+// rate[i] − mean are all exact (Sterbenz: every sample within a factor 2 of the mean, as on a
+// gyro whose bias outweighs its noise): its total is then its sum less kPhaseRun·mean, to the
+// same double-double accuracy. Returns the largest |lo[k]| written (a float, exact).
+float integratePhase(const double* rate, std::size_t count, double mean, std::span<const RunSum> sums, double* hi,
+                     float* lo);
 
 // Storage for a phase array, written once in full by its owner (not zero-filled). Blocks of
 // 4 MB or more are aligned to 2 MiB and, on Linux, marked for transparent huge pages: a

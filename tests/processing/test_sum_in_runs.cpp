@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <limits>
 #include <random>
+#include <span>
 #include <vector>
 
 #include "processing/allan_kernels.hpp"
@@ -106,4 +107,62 @@ TEST(SumInRuns, ANonFiniteSampleMakesTheSumNonFinite) {
           << "sample " << at << " = " << bad;
     }
   }
+}
+
+namespace {
+
+struct Phase {
+  std::vector<double> hi;
+  std::vector<float> lo;
+};
+
+Phase integrated(const std::vector<double>& rate, double mean, std::span<const allan_kernels::RunSum> sums) {
+  Phase p{std::vector<double>(rate.size() + 1), std::vector<float>(rate.size() + 1)};
+  allan_kernels::integratePhase(rate.data(), rate.size(), mean, sums, p.hi.data(), p.lo.data());
+  return p;
+}
+
+std::vector<double> biasAndNoise(std::size_t n, double bias, double sigma, std::uint64_t seed) {
+  std::mt19937_64 gen(seed);
+  std::normal_distribution<double> noise(0.0, sigma);
+  std::vector<double> rate(n);
+  for (double& v : rate) v = bias + noise(gen);
+  return rate;
+}
+
+}  // namespace
+
+// Where every sample lies within a factor 2 of the mean (a gyro whose bias outweighs its
+// noise), rate[i] − mean is exact and a run's total is its sum less kPhaseRun·mean: the phase
+// is the one pass 1 gives (a difference of ~ε² of the phase could move a last bit; none does
+// here). That the sums are read is shown by corrupting one: the phase after it moves.
+TEST(PhaseFromRunSums, AGyroBiasAboveItsNoiseTakesTheRunTotalsFromTheSums) {
+  const std::size_t run = allan_kernels::kPhaseRun;
+  const std::vector<double> rate = biasAndNoise(6 * run + 100, 1.367, 0.05, 5);
+  const std::vector<allan_kernels::RunSum> sums = allan_kernels::sumRuns(rate.data(), rate.size());
+  const double mean = allan_kernels::totalOfRuns(sums) / static_cast<double>(rate.size());
+  const Phase from_sums = integrated(rate, mean, sums);
+  const Phase from_pass = integrated(rate, mean, {});
+  EXPECT_EQ(from_sums.hi, from_pass.hi);
+  EXPECT_EQ(from_sums.lo, from_pass.lo);
+
+  std::vector<allan_kernels::RunSum> corrupted = sums;
+  corrupted[2].hi += 1.0;
+  const Phase moved = integrated(rate, mean, corrupted);
+  EXPECT_EQ(moved.hi[3 * run], from_pass.hi[3 * run]);  // the last point of run 2, from its own start
+  EXPECT_NEAR(moved.hi[3 * run + 1] - from_pass.hi[3 * run + 1], 1.0, 1e-9);  // run 3 starts 1 higher
+}
+
+// A mean near zero puts samples on both sides of it: rate[i] − mean rounds, so every run's total
+// comes from pass 1 and the sums are not read.
+TEST(PhaseFromRunSums, SamplesFarFromTheMeanAreIntegratedAgain) {
+  const std::size_t run = allan_kernels::kPhaseRun;
+  const std::vector<double> rate = biasAndNoise(5 * run + 7, 0.01, 0.05, 6);
+  std::vector<allan_kernels::RunSum> sums = allan_kernels::sumRuns(rate.data(), rate.size());
+  const double mean = allan_kernels::totalOfRuns(sums) / static_cast<double>(rate.size());
+  const Phase from_pass = integrated(rate, mean, {});
+  for (auto& s : sums) s.hi += 1.0;
+  const Phase ignored = integrated(rate, mean, sums);
+  EXPECT_EQ(ignored.hi, from_pass.hi);
+  EXPECT_EQ(ignored.lo, from_pass.lo);
 }
