@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "fixed_threads.hpp"
 #include "formats/csv_fields.hpp"
 #include "formats/recording_csv.hpp"
 #include "formats/recording_format.hpp"
@@ -132,14 +133,6 @@ TEST(RecordingReading, TheFirstBadLineIsNamedWhereverItFalls) {
 }
 
 // Runs a block with the reader's thread count fixed (processing/parallel_share.hpp).
-class FixedThreads {
- public:
-  explicit FixedThreads(std::size_t n) { gyrod::processing::shareThreadOverride().store(n); }
-  ~FixedThreads() { gyrod::processing::shareThreadOverride().store(0); }
-  FixedThreads(const FixedThreads&) = delete;
-  FixedThreads& operator=(const FixedThreads&) = delete;
-};
-
 // A bad line as the last line of a front slice, the first of a back slice, the last of a
 // batch and the first of the next, on one core and on two: always the one named. The edges
 // are found as the reader cuts them today (a buffer of 1 MiB + the line limit + 2 bytes, each

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "fixed_threads.hpp"
 #include "processing/allan.hpp"
 #include "processing/axis_analysis.hpp"
 #include "processing/parallel_share.hpp"
@@ -23,14 +24,6 @@
 using namespace gyrod::processing;
 
 namespace {
-
-class FixedThreads {
- public:
-  explicit FixedThreads(std::size_t n) { shareThreadOverride().store(n); }
-  ~FixedThreads() { shareThreadOverride().store(0); }
-  FixedThreads(const FixedThreads&) = delete;
-  FixedThreads& operator=(const FixedThreads&) = delete;
-};
 
 std::uint64_t bitsOf(double v) {
   std::uint64_t b = 0;

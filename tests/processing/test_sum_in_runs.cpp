@@ -13,6 +13,7 @@
 #include <span>
 #include <vector>
 
+#include "fixed_threads.hpp"
 #include "processing/allan_kernels.hpp"
 #include "processing/parallel_share.hpp"
 
@@ -52,14 +53,6 @@ ScaledSeries scaledSeries(std::size_t n, std::int64_t bias_units, std::int64_t n
   }
   return s;
 }
-
-class FixedThreads {
- public:
-  explicit FixedThreads(std::size_t n) { shareThreadOverride().store(n); }
-  ~FixedThreads() { shareThreadOverride().store(0); }
-  FixedThreads(const FixedThreads&) = delete;
-  FixedThreads& operator=(const FixedThreads&) = delete;
-};
 
 }  // namespace
 
