@@ -195,22 +195,21 @@ class IntegratedPhase {
   // it may stand for the full one, else the full total (overlappingBlockTotal's bits). The
   // hi-only total is the same bits from either kernel, so the result depends only on the
   // block, never on `try_high_first` (a guess from the share's previous block that spares
-  // the lo reads when the hi-only total is likely to suffice). `wide`, when given, holds the
-  // block's lo parts from lo[k] on widened to double (the same values, so the same bits).
+  // the lo reads when the hi-only total is likely to suffice). `wide`, given only when the guess
+  // is the full kernel, holds the block's lo parts from lo[k] on widened to double (the same
+  // values, so the same bits).
   double sweepBlockTotal(std::size_t m, std::size_t k, std::size_t block_end, bool& try_high_first,
                          const double* wide) const {
     const std::size_t terms = block_end - k;
-    const auto bothTotals = [&] {
-      return wide != nullptr ? allan_kernels::overlappingBlockTotals(hi_ + k, wide, m, 0, terms)
-                             : allan_kernels::overlappingBlockTotals(hi_, lo_, m, k, block_end);
-    };
     if (try_high_first) {
       const double high = allan_kernels::overlappingHighTotal(hi_, m, k, block_end);
       if (highOnlySuffices(high, terms)) return high;
       try_high_first = false;
-      return wide != nullptr ? bothTotals().full : overlappingBlockTotal(m, k, block_end);
+      return overlappingBlockTotal(m, k, block_end);
     }
-    const allan_kernels::BlockTotals t = bothTotals();
+    const allan_kernels::BlockTotals t = wide != nullptr
+                                             ? allan_kernels::overlappingBlockTotals(hi_ + k, wide, m, 0, terms)
+                                             : allan_kernels::overlappingBlockTotals(hi_, lo_, m, k, block_end);
     if (highOnlySuffices(t.high, terms)) {
       try_high_first = true;
       return t.high;

@@ -528,8 +528,6 @@ double totalOfRuns(std::span<const RunSum> sums) {
   return total.hi;
 }
 
-double sumInRuns(const double* rate, std::size_t count) { return totalOfRuns(sumRuns(rate, count)); }
-
 void* allocatePhaseBytes(std::size_t bytes) {
   constexpr std::size_t kHugePage = std::size_t{2} << 20;
   bytes = std::max<std::size_t>(bytes, 1);

@@ -57,8 +57,6 @@ std::vector<RunSum> sumRuns(const double* rate, std::size_t count);
 // ties. The order is fixed, so it is the same bits on every ISA and for any number of threads.
 // A non-finite sample makes the result non-finite (so can an overflow).
 double totalOfRuns(std::span<const RunSum> sums);
-// totalOfRuns(sumRuns(rate, count)).
-double sumInRuns(const double* rate, std::size_t count);
 
 // The averaged series whose lag-1 autocorrelation the noise identification measures
 // (allan.cpp's noise types), point z_k of each as the table forms it from the rate's cluster

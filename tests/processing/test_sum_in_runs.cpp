@@ -1,5 +1,5 @@
-// allan_kernels::sumInRuns, the sample sum behind every Allan estimator's mean: the exact sum
-// rounded once, for lengths that leave every kind of tail (inside the sixteen chains of a run,
+// allan_kernels::totalOfRuns(sumRuns(…)), the sample sum behind every Allan estimator's
+// mean: the exact sum rounded once, for lengths that leave every kind of tail (inside the sixteen chains of a run,
 // a partial last run), the same bits for any thread count, and a non-finite sample never
 // hidden. The exact sums come from integers: every sample is a whole multiple k of 2⁻³⁰ with
 // |k| < 2⁵⁶, so the sum of up to 10⁵ of them is an exact int64 times 2⁻³⁰, and converting
@@ -54,6 +54,10 @@ ScaledSeries scaledSeries(std::size_t n, std::int64_t bias_units, std::int64_t n
   return s;
 }
 
+double sampleSum(const double* rate, std::size_t count) {
+  return allan_kernels::totalOfRuns(allan_kernels::sumRuns(rate, count));
+}
+
 }  // namespace
 
 TEST(SumInRuns, IsTheExactSumRoundedOnceForEveryKindOfTail) {
@@ -63,7 +67,7 @@ TEST(SumInRuns, IsTheExactSumRoundedOnceForEveryKindOfTail) {
                         7 * run + 16, std::size_t{100000}}) {
     const ScaledSeries s = scaledSeries(n, 1'000'000'007, 50'000'000, 20261126 + n);
     const double expected = static_cast<double>(s.exact_units) * kScale;
-    EXPECT_EQ(allan_kernels::sumInRuns(s.samples.data(), n), expected) << n << " samples";
+    EXPECT_EQ(sampleSum(s.samples.data(), n), expected) << n << " samples";
   }
 }
 
@@ -73,7 +77,7 @@ TEST(SumInRuns, KeepsTheNoiseThatANaiveSumLosesBesideSpikes) {
   double naive = 0.0;
   for (double v : s.samples) naive += v;
   ASSERT_NE(naive, expected);  // the series is hard for a plain sum
-  EXPECT_EQ(allan_kernels::sumInRuns(s.samples.data(), s.samples.size()), expected);
+  EXPECT_EQ(sampleSum(s.samples.data(), s.samples.size()), expected);
 }
 
 TEST(SumInRuns, IsTheSameBitsForAnyThreadCount) {
@@ -81,11 +85,11 @@ TEST(SumInRuns, IsTheSameBitsForAnyThreadCount) {
   double one = 0.0;
   {
     const FixedThreads threads(1);
-    one = allan_kernels::sumInRuns(s.samples.data(), s.samples.size());
+    one = sampleSum(s.samples.data(), s.samples.size());
   }
   for (std::size_t t : {2U, 3U, 5U}) {
     const FixedThreads threads(t);
-    EXPECT_EQ(allan_kernels::sumInRuns(s.samples.data(), s.samples.size()), one) << t << " threads";
+    EXPECT_EQ(sampleSum(s.samples.data(), s.samples.size()), one) << t << " threads";
   }
 }
 
@@ -96,8 +100,7 @@ TEST(SumInRuns, ANonFiniteSampleMakesTheSumNonFinite) {
     for (std::size_t at : {std::size_t{0}, std::size_t{4}, allan_kernels::kPhaseRun + 9, s.samples.size() - 1}) {
       std::vector<double> samples = s.samples;
       samples[at] = bad;
-      EXPECT_FALSE(std::isfinite(allan_kernels::sumInRuns(samples.data(), samples.size())))
-          << "sample " << at << " = " << bad;
+      EXPECT_FALSE(std::isfinite(sampleSum(samples.data(), samples.size()))) << "sample " << at << " = " << bad;
     }
   }
 }
