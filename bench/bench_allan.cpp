@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "processing/allan.hpp"
+#include "processing/allan/allan.hpp"
 
 namespace {
 

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "daemon/sample_pipeline.hpp"
-#include "processing/rate_estimator.hpp"
+#include "processing/motion/rate_estimator.hpp"
 
 namespace {
 

@@ -10,8 +10,8 @@
 #include <random>
 #include <vector>
 
-#include "processing/allan.hpp"
-#include "processing/rolling_allan.hpp"
+#include "processing/allan/allan.hpp"
+#include "processing/allan/rolling_allan.hpp"
 
 namespace {
 

@@ -20,9 +20,9 @@ git -C "$repo" archive "$base" processing | tar -x -C "$tmp/base"
 cp "$repo/bench/simulator_speed.cpp" "$tmp/base/simulator_speed.cpp"
 # The simulator's sources as processing/CMakeLists.txt builds them (RelWithDebInfo's -O2,
 # no FMA contraction for the four reproducible ones).
-sources="processing/noise_simulator.cpp processing/sensor_model.cpp processing/portable_math.cpp processing/portable_random.cpp"
+sources="processing/simulation/noise_simulator.cpp processing/simulation/sensor_model.cpp processing/base/portable_math.cpp processing/base/portable_random.cpp"
 build() {  # root, output, extra flags
-  ( cd "$1" && g++ -std=c++20 -O2 -DNDEBUG -ffp-contract=off $3 -I. $sources processing/noise_terms.cpp \
+  ( cd "$1" && g++ -std=c++20 -O2 -DNDEBUG -ffp-contract=off $3 -I. $sources processing/base/noise_terms.cpp \
       "$2.cpp" -o "$2" )
 }
 build "$tmp/base" "$tmp/base/simulator_speed" -DGYROD_BENCH_BASELINE

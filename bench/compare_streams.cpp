@@ -1,5 +1,5 @@
 // compare_streams: the table of docs/motion.md — raw, mean, kalman and rate side by side on
-// simulated records from one seed (processing/stream_comparison.hpp says what each stream and
+// simulated records from one seed (processing/motion/stream_comparison.hpp says what each stream and
 // each figure is). scripts/motion-table.sh runs the whole calibration workflow around it:
 //   compare_streams --write-sensor true.toml            the simulated sensor, as a model file
 //   gyroctl simulate --model true.toml --warm-up 15,300 --duration 1800 -o cal.csv
@@ -15,7 +15,7 @@
 #include "formats/calibration.hpp"
 #include "formats/model_toml.hpp"
 #include "formats/output_file.hpp"
-#include "processing/stream_comparison.hpp"
+#include "processing/motion/stream_comparison.hpp"
 
 namespace {
 

@@ -1,6 +1,6 @@
 // Coverage of the model check's stated 95 % parameter intervals (docs/model-check.md,
 // "Intervals"): each effect hidden alone at a known, seeded parameter in a clean gyrod-like
-// record (processing/hidden_effect_generator.hpp), the check run on that axis, and for each
+// record (processing/model_check/hidden_effect_generator.hpp), the check run on that axis, and for each
 // parameter: trials, detected, intervals stated, intervals containing the truth (count,
 // fraction, two-sided 95 % Clopper–Pearson interval of the coverage). The goal of issue 13 is
 // coverage ≥ 90 %. Not a unit test and not run by ctest: scripts/model-check-coverage.sh.
@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "bench/binomial_bounds.hpp"
-#include "processing/hidden_effect_generator.hpp"
-#include "processing/model_check.hpp"
+#include "processing/model_check/hidden_effect_generator.hpp"
+#include "processing/model_check/model_check.hpp"
 
 using namespace gyrod::processing;
 

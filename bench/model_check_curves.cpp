@@ -1,7 +1,7 @@
 // Detection curves of the model check: for each effect of the catalogue that has a size
 // (bias step, sinusoid, temperature response, Gauss–Markov), the probability that the blind
-// check (processing/model_check.hpp) names it, against the effect's size and the record's
-// length, beside the detector that knows the effect's form (processing/known_form_detectors.hpp)
+// check (processing/model_check/model_check.hpp) names it, against the effect's size and the record's
+// length, beside the detector that knows the effect's form (processing/model_check/known_form_detectors.hpp)
 // on the same records at a 1 % false-alarm threshold calibrated on clean records.
 // Not a unit test (minutes); scripts/model-check-curves.sh runs it and draws the PNGs of
 // docs/model-check.md; ctest runs its --quick mode (scripts/check-model-check-curves.sh).
@@ -28,12 +28,12 @@
 #include <string>
 #include <vector>
 
-#include "processing/known_form_detectors.hpp"
-#include "processing/model_check.hpp"
-#include "processing/model_check_detail.hpp"
-#include "processing/noise_simulator.hpp"
-#include "processing/noise_terms.hpp"
-#include "processing/portable_random.hpp"
+#include "processing/model_check/known_form_detectors.hpp"
+#include "processing/model_check/model_check.hpp"
+#include "processing/model_check/detail.hpp"
+#include "processing/simulation/noise_simulator.hpp"
+#include "processing/base/noise_terms.hpp"
+#include "processing/base/portable_random.hpp"
 
 using namespace gyrod;
 using namespace gyrod::processing;

@@ -1,5 +1,5 @@
 // False discoveries of the model check on clean gyrod-like recordings made through every DLPF
-// setting (processing/hidden_effect_generator.hpp with its dlpf_cfg set; the check told the
+// setting (processing/model_check/hidden_effect_generator.hpp with its dlpf_cfg set; the check told the
 // chain, as gyrod's '# device' header tells it), and without a DLPF (`--cfg none`: 50 Hz,
 // FS_SEL 0 told, no DLPF — where the Gauss–Markov null is the joint fit's). Any effect
 // reported on an axis is a false discovery. Not a unit test and not run by ctest: scripts/model-check-dlpf-fdr.sh builds and
@@ -23,8 +23,8 @@
 #include <vector>
 
 #include "bench/binomial_bounds.hpp"
-#include "processing/hidden_effect_generator.hpp"
-#include "processing/model_check.hpp"
+#include "processing/model_check/hidden_effect_generator.hpp"
+#include "processing/model_check/model_check.hpp"
 
 using namespace gyrod::processing;
 

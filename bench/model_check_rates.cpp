@@ -1,5 +1,5 @@
 // Detection rate, false-discovery rate and parameter errors of the model check over many
-// seeds of the hidden-effect generator (processing/hidden_effect_generator.hpp).
+// seeds of the hidden-effect generator (processing/model_check/hidden_effect_generator.hpp).
 // Not a unit test and not run by ctest: scripts/model-check-rates.sh builds and runs it.
 //
 //   model_check_rates [--seeds N] [--first S] [--duration SEC] [--rate HZ] [--replicas R]
@@ -19,8 +19,8 @@
 #include <string>
 #include <vector>
 
-#include "processing/hidden_effect_generator.hpp"
-#include "processing/model_check.hpp"
+#include "processing/model_check/hidden_effect_generator.hpp"
+#include "processing/model_check/model_check.hpp"
 
 using namespace gyrod;
 using processing::ModelEffect;
@@ -35,7 +35,7 @@ struct Tally {
 };
 
 // How large a hidden effect is against the noise of its axis, in the generator's own terms
-// (processing/hidden_effect_generator.hpp draws each of these uniformly in a range):
+// (processing/model_check/hidden_effect_generator.hpp draws each of these uniformly in a range):
 // what the detection rate depends on. Computed from the truth after the fact, for the table only.
 std::vector<std::pair<std::string, double>> effectSizes(const processing::HiddenEffect& h,
                                                         const processing::GeneratedRecording& rec, double duration) {

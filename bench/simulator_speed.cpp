@@ -20,8 +20,8 @@
 #include <string>
 #include <vector>
 
-#include "processing/noise_simulator.hpp"
-#include "processing/portable_random.hpp"
+#include "processing/simulation/noise_simulator.hpp"
+#include "processing/base/portable_random.hpp"
 
 using namespace gyrod::processing;
 

@@ -19,7 +19,7 @@
 #include "driver/mock/mock_mpu6050.hpp"
 #include "driver/mock/mock_signal_source.hpp"
 #include "driver/mpu6050_types.hpp"
-#include "processing/noise_simulator.hpp"
+#include "processing/simulation/noise_simulator.hpp"
 
 namespace gyrod::daemon {
 

@@ -12,7 +12,7 @@
 
 #include "daemon/recorder.hpp"
 #include "formats/toml_document.hpp"
-#include "processing/rolling_allan.hpp"
+#include "processing/allan/rolling_allan.hpp"
 
 namespace gyrod::daemon {
 namespace {

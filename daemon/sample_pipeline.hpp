@@ -1,6 +1,6 @@
 #pragma once
 // What gyrod does with each sample, per axis, in order (issue: "the loop"):
-//   bias removal → mean filter → Kalman (processing/filter_chain.hpp, the same code and
+//   bias removal → mean filter → Kalman (processing/paper/filter_chain.hpp, the same code and
 //   numbers as `gyroctl filter`) → rolling Allan update of the raw, mean and Kalman streams.
 // Pure computation: no I/O, no logging, no clock. process() allocates nothing.
 //
@@ -27,11 +27,11 @@
 #include <string>
 #include <vector>
 
-#include "processing/filter_chain.hpp"
-#include "processing/noise_fit.hpp"
-#include "processing/rate_estimator.hpp"
-#include "processing/rolling_allan.hpp"
-#include "processing/still_period_check.hpp"
+#include "processing/paper/filter_chain.hpp"
+#include "processing/allan/noise_fit.hpp"
+#include "processing/motion/rate_estimator.hpp"
+#include "processing/allan/rolling_allan.hpp"
+#include "processing/motion/still_period_check.hpp"
 
 namespace gyrod::daemon {
 
@@ -63,7 +63,7 @@ struct PipelineSettings {
 
 enum class PipelinePhase { Estimating, Running };
 
-// The motion check of the start-up still period (processing/still_period_check.hpp). A window
+// The motion check of the start-up still period (processing/motion/still_period_check.hpp). A window
 // in which the board moved is discarded and collected again, up to kMaxStillAttempts windows;
 // if the last one moved too it is used (gyrod cannot wait for ever on a board that never
 // rests) and the state says its bias is suspect.

@@ -8,8 +8,8 @@
 
 #include "formats/model_toml.hpp"
 #include "formats/recording_csv.hpp"
-#include "processing/rate_estimator.hpp"
-#include "processing/temperature_bias_fit.hpp"
+#include "processing/motion/rate_estimator.hpp"
+#include "processing/motion/temperature_bias_fit.hpp"
 
 namespace gyrod::recording {
 

@@ -13,8 +13,8 @@
 #include <string>
 #include <string_view>
 
-#include "processing/motion_profile.hpp"
-#include "processing/noise_simulator.hpp"
+#include "processing/simulation/motion_profile.hpp"
+#include "processing/simulation/noise_simulator.hpp"
 
 namespace gyrod::recording {
 

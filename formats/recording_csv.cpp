@@ -29,7 +29,7 @@
 #include "formats/csv_fields.hpp"
 #include "formats/decimal_number.hpp"
 #include "formats/quoted_value.hpp"
-#include "processing/parallel_share.hpp"
+#include "processing/base/parallel_share.hpp"
 
 namespace gyrod::recording {
 namespace {

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "formats/recording_csv.hpp"
-#include "processing/parallel_share.hpp"
+#include "processing/base/parallel_share.hpp"
 
 namespace gyrod::recording {
 namespace {

@@ -6,7 +6,7 @@
 #include <span>
 #include <vector>
 
-#include "processing/allan.hpp"
+#include "processing/allan/allan.hpp"
 
 namespace gyrod::protocol {
 

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "processing/units.hpp"
+#include "processing/base/units.hpp"
 
 namespace gyrod::protocol {
 namespace {

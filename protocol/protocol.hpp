@@ -17,8 +17,8 @@
 #include <variant>
 #include <vector>
 
-#include "processing/allan.hpp"
-#include "processing/noise_terms.hpp"
+#include "processing/allan/allan.hpp"
+#include "processing/base/noise_terms.hpp"
 
 namespace gyrod::protocol {
 

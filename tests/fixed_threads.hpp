@@ -4,7 +4,7 @@
 // 64-core one.
 #include <cstddef>
 
-#include "processing/parallel_share.hpp"
+#include "processing/base/parallel_share.hpp"
 
 class FixedThreads {
  public:

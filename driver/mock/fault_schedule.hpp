@@ -11,7 +11,7 @@
 
 #include "driver/mock/mock_faults.hpp"
 #include "driver/mock/mock_time.hpp"
-#include "processing/portable_random.hpp"
+#include "processing/base/portable_random.hpp"
 
 namespace gyrod::driver::mock {
 

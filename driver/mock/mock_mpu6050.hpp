@@ -2,7 +2,7 @@
 // A register-level emulator of the InvenSense MPU-6050 on an I2C bus: the mock IS the bus
 // and the chip at its address (other addresses NACK). It keeps the chip's registers with
 // their reset values, samples a SignalSource at the internal gyro rate through the DLPF
-// model of processing/sensor_model.hpp, decimates by SMPLRT_DIV, latches the output
+// model of processing/simulation/sensor_model.hpp, decimates by SMPLRT_DIV, latches the output
 // registers, fills the 1024-byte FIFO, raises INT_STATUS bits and drives the INT line.
 // Time comes from a Clock: virtual (tests step it) or CLOCK_MONOTONIC (demo); the chip
 // catches up to the clock whenever it is touched. Faults are scripted with a FaultPlan.
@@ -29,7 +29,7 @@
 #include "driver/mock/register_file.hpp"
 #include "driver/mock/tick_train.hpp"
 #include "driver/mpu6050_registers.hpp"
-#include "processing/sensor_model.hpp"
+#include "processing/simulation/sensor_model.hpp"
 
 namespace gyrod::driver {
 

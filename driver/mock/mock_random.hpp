@@ -7,7 +7,7 @@
 #include <numbers>
 #include <optional>
 
-#include "processing/portable_random.hpp"
+#include "processing/base/portable_random.hpp"
 
 namespace gyrod::driver::mock {
 

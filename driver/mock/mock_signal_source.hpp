@@ -6,7 +6,7 @@
 //
 // Implementations here: constant, sinusoid (tests), replay of in-memory arrays (a caller
 // reads recordings elsewhere; the driver parses no files). An adapter for the noise
-// simulator (processing/noise_simulator.hpp) is another small class implementing
+// simulator (processing/simulation/noise_simulator.hpp) is another small class implementing
 // SignalSource: expectedTickRateHz() returns the simulator's rate, nextTick() draws one
 // sample.
 #include <array>

@@ -1,5 +1,5 @@
 #pragma once
-// The noise simulator (processing/noise_simulator.hpp) as what the mock MPU-6050 "feels":
+// The noise simulator (processing/simulation/noise_simulator.hpp) as what the mock MPU-6050 "feels":
 // one analog sample per internal gyro tick (bias, ARW, bias instability, RRW, ramp and
 // the temperature curve, plus the true rate of a motion profile when the board is turned).
 // The mock applies the DLPF, decimation, saturation and quantisation itself, so they act on
@@ -20,7 +20,7 @@
 #include <memory>
 
 #include "driver/mock/mock_signal_source.hpp"
-#include "processing/noise_simulator.hpp"
+#include "processing/simulation/noise_simulator.hpp"
 
 namespace gyrod::driver {
 

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "daemon/sample_pipeline.hpp"
-#include "processing/allan.hpp"
+#include "processing/allan/allan.hpp"
 
 using namespace gyrod::daemon;
 using namespace gyrod::processing;
@@ -328,7 +328,7 @@ TEST(SamplePipeline, AStillPeriodWithoutVarianceIsRefusedOnceAndStartsAgain) {
   }
 }
 
-// The start-up still window is checked for motion (processing/still_period_check.hpp): a
+// The start-up still window is checked for motion (processing/motion/still_period_check.hpp): a
 // window in which the board turned is discarded and collected again; the bias comes from the
 // first window at rest, and STATUS's state says what happened.
 TEST(SamplePipeline, AStillWindowInWhichTheBoardTurnedIsCollectedAgain) {

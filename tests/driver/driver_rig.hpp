@@ -17,7 +17,7 @@
 #include "driver/mock/mock_mpu6050.hpp"
 #include "driver/mpu6050_driver.hpp"
 #include "driver/polling_data_ready.hpp"
-#include "processing/portable_random.hpp"
+#include "processing/base/portable_random.hpp"
 
 namespace gyrod::driver::test {
 

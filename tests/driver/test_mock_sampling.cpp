@@ -7,7 +7,7 @@
 #include <numbers>
 
 #include "driver/mock/mock_signal_source.hpp"
-#include "processing/sensor_model.hpp"
+#include "processing/simulation/sensor_model.hpp"
 #include "tests/driver/mock_rig.hpp"
 
 namespace gyrod::driver::test {

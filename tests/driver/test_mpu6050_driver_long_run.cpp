@@ -7,7 +7,7 @@
 #include <numeric>
 
 #include "driver/mock/mock_signal_source.hpp"
-#include "processing/portable_random.hpp"
+#include "processing/base/portable_random.hpp"
 #include "tests/driver/driver_rig.hpp"
 
 namespace gyrod::driver::test {

@@ -8,7 +8,7 @@
 
 #include "driver/mock/simulator_signal_source.hpp"
 #include "mock_rig.hpp"
-#include "processing/allan.hpp"
+#include "processing/allan/allan.hpp"
 
 using namespace gyrod::driver;
 using namespace gyrod::driver::test;

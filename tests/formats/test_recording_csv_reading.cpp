@@ -19,7 +19,7 @@
 #include "formats/csv_fields.hpp"
 #include "formats/recording_csv.hpp"
 #include "formats/recording_format.hpp"
-#include "processing/parallel_share.hpp"
+#include "processing/base/parallel_share.hpp"
 
 using namespace gyrod::recording;
 namespace fs = std::filesystem;
@@ -132,7 +132,7 @@ TEST(RecordingReading, TheFirstBadLineIsNamedWhereverItFalls) {
   }
 }
 
-// Runs a block with the reader's thread count fixed (processing/parallel_share.hpp).
+// Runs a block with the reader's thread count fixed (processing/base/parallel_share.hpp).
 // A bad line as the last line of a front slice, the first of a back slice, the last of a
 // batch and the first of the next, on one core and on two: always the one named. The edges
 // are found as the reader cuts them today (a buffer of 1 MiB + the line limit + 2 bytes, each

@@ -13,7 +13,7 @@
 
 #include "formats/recording_csv.hpp"
 #include "gyrod_process.hpp"
-#include "processing/allan.hpp"
+#include "processing/allan/allan.hpp"
 #include "tools/run_command.hpp"
 
 using namespace gyrod::test;

@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "processing/allan.hpp"
-#include "processing/motion_profile.hpp"
-#include "processing/noise_simulator.hpp"
+#include "processing/allan/allan.hpp"
+#include "processing/simulation/motion_profile.hpp"
+#include "processing/simulation/noise_simulator.hpp"
 
 using namespace gyrod::processing;
 

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "processing/allan.hpp"
+#include "processing/allan/allan.hpp"
 
 using namespace gyrod::processing;
 

@@ -10,7 +10,7 @@
 #include <random>
 #include <vector>
 
-#include "processing/allan.hpp"
+#include "processing/allan/allan.hpp"
 
 using namespace gyrod::processing;
 

@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "processing/allan.hpp"
-#include "processing/axis_analysis.hpp"
-#include "processing/parallel_share.hpp"
+#include "processing/allan/allan.hpp"
+#include "processing/paper/axis_analysis.hpp"
+#include "processing/base/parallel_share.hpp"
 
 using namespace gyrod::processing;
 

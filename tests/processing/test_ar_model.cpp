@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "processing/ar_model.hpp"
+#include "processing/paper/ar_model.hpp"
 
 using namespace gyrod::processing;
 

@@ -10,8 +10,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "processing/axis_analysis.hpp"
-#include "processing/filter_chain.hpp"
+#include "processing/paper/axis_analysis.hpp"
+#include "processing/paper/filter_chain.hpp"
 
 using namespace gyrod::processing;
 

@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "processing/detrend.hpp"
+#include "processing/base/detrend.hpp"
 
 using namespace gyrod::processing;
 

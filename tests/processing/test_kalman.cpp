@@ -9,7 +9,7 @@
 #include <type_traits>
 #include <vector>
 
-#include "processing/kalman.hpp"
+#include "processing/paper/kalman.hpp"
 
 using namespace gyrod::processing;
 

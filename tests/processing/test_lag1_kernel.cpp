@@ -11,7 +11,7 @@
 #include <tuple>
 #include <vector>
 
-#include "processing/allan_kernels.hpp"
+#include "processing/allan/allan_kernels.hpp"
 
 using namespace gyrod::processing::allan_kernels;
 

@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "processing/mean_filter.hpp"
+#include "processing/paper/mean_filter.hpp"
 
 using namespace gyrod::processing;
 

@@ -1,4 +1,4 @@
-// The model check, blind: data from processing/hidden_effect_generator.hpp (base-model
+// The model check, blind: data from processing/model_check/hidden_effect_generator.hpp (base-model
 // noise, a moving temperature channel, hidden effects with random parameters on random
 // axes, all from a seed); the check sees only the columns. Each test states its tolerance.
 // Short recordings (10 min at 50 Hz) and few replicas keep them at about a second each in
@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "processing/hidden_effect_generator.hpp"
-#include "processing/model_check.hpp"
+#include "processing/model_check/hidden_effect_generator.hpp"
+#include "processing/model_check/model_check.hpp"
 
 using namespace gyrod::processing;
 

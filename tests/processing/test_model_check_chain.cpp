@@ -9,11 +9,11 @@
 #include <string>
 #include <vector>
 
-#include "processing/allan.hpp"
-#include "processing/hidden_effect_generator.hpp"
-#include "processing/model_check.hpp"
-#include "processing/model_check_pipeline.hpp"
-#include "processing/noise_simulator.hpp"
+#include "processing/allan/allan.hpp"
+#include "processing/model_check/hidden_effect_generator.hpp"
+#include "processing/model_check/model_check.hpp"
+#include "processing/model_check/pipeline.hpp"
+#include "processing/simulation/noise_simulator.hpp"
 
 using namespace gyrod::processing;
 

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "processing/hidden_effect_generator.hpp"
-#include "processing/model_check.hpp"
+#include "processing/model_check/hidden_effect_generator.hpp"
+#include "processing/model_check/model_check.hpp"
 
 using namespace gyrod::processing;
 

@@ -1,4 +1,4 @@
-// The model check's 95 % parameter intervals (processing/model_check_intervals.hpp;
+// The model check's 95 % parameter intervals (processing/model_check/intervals.hpp;
 // docs/model-check.md, "Intervals"): the generic pieces against known values, and a check of a
 // hidden sinusoid whose interval must hold the truth. Their
 // measured coverage over many seeds is bench/model_check_coverage.cpp's.
@@ -8,10 +8,10 @@
 #include <cmath>
 #include <vector>
 
-#include "processing/hidden_effect_generator.hpp"
-#include "processing/model_check.hpp"
-#include "processing/model_check_intervals.hpp"
-#include "processing/portable_random.hpp"
+#include "processing/model_check/hidden_effect_generator.hpp"
+#include "processing/model_check/model_check.hpp"
+#include "processing/model_check/intervals.hpp"
+#include "processing/base/portable_random.hpp"
 
 using namespace gyrod::processing;
 

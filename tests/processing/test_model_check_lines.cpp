@@ -8,8 +8,8 @@
 #include <numbers>
 #include <vector>
 
-#include "processing/model_check.hpp"
-#include "processing/noise_simulator.hpp"
+#include "processing/model_check/model_check.hpp"
+#include "processing/simulation/noise_simulator.hpp"
 
 using namespace gyrod::processing;
 

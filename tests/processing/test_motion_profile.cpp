@@ -11,8 +11,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "processing/motion_profile.hpp"
-#include "processing/noise_simulator.hpp"
+#include "processing/simulation/motion_profile.hpp"
+#include "processing/simulation/noise_simulator.hpp"
 
 using namespace gyrod::processing;
 

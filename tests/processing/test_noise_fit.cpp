@@ -12,8 +12,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "processing/allan.hpp"
-#include "processing/noise_fit.hpp"
+#include "processing/allan/allan.hpp"
+#include "processing/allan/noise_fit.hpp"
 
 using namespace gyrod::processing;
 

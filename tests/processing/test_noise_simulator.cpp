@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "processing/noise_simulator.hpp"
+#include "processing/simulation/noise_simulator.hpp"
 
 using namespace gyrod::processing;
 

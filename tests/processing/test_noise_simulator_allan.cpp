@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "processing/allan.hpp"
-#include "processing/noise_fit.hpp"
-#include "processing/noise_simulator.hpp"
+#include "processing/allan/allan.hpp"
+#include "processing/allan/noise_fit.hpp"
+#include "processing/simulation/noise_simulator.hpp"
 
 using namespace gyrod::processing;
 

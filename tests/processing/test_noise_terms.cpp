@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "processing/noise_terms.hpp"
+#include "processing/base/noise_terms.hpp"
 
 using namespace gyrod::processing;
 

@@ -1,5 +1,5 @@
-// The SI and accelerometer units of the noise terms (processing/units.hpp,
-// processing/noise_units.hpp) against values computed by hand and against the Allan
+// The SI and accelerometer units of the noise terms (processing/base/units.hpp,
+// processing/base/noise_units.hpp) against values computed by hand and against the Allan
 // variance formulas of noise_terms.hpp.
 #include <gtest/gtest.h>
 
@@ -7,9 +7,9 @@
 #include <numbers>
 #include <string>
 
-#include "processing/noise_terms.hpp"
-#include "processing/noise_units.hpp"
-#include "processing/units.hpp"
+#include "processing/base/noise_terms.hpp"
+#include "processing/base/noise_units.hpp"
+#include "processing/base/units.hpp"
 
 using namespace gyrod::processing;
 using namespace gyrod::units;

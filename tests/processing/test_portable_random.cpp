@@ -14,9 +14,9 @@
 #include <stdexcept>
 #include <vector>
 
-#include "processing/distributions.hpp"
-#include "processing/portable_math.hpp"
-#include "processing/portable_random.hpp"
+#include "processing/base/distributions.hpp"
+#include "processing/base/portable_math.hpp"
+#include "processing/base/portable_random.hpp"
 
 using namespace gyrod::processing;
 

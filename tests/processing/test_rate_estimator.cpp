@@ -14,12 +14,12 @@
 #include <random>
 #include <vector>
 
-#include "processing/allan.hpp"
-#include "processing/filter_chain.hpp"
-#include "processing/kalman.hpp"
-#include "processing/noise_fit.hpp"
-#include "processing/noise_simulator.hpp"
-#include "processing/rate_estimator.hpp"
+#include "processing/allan/allan.hpp"
+#include "processing/paper/filter_chain.hpp"
+#include "processing/paper/kalman.hpp"
+#include "processing/allan/noise_fit.hpp"
+#include "processing/simulation/noise_simulator.hpp"
+#include "processing/motion/rate_estimator.hpp"
 
 // Counts every allocation in this test program, to show that update() makes none.
 namespace {

@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "processing/allan.hpp"
-#include "processing/rolling_allan.hpp"
+#include "processing/allan/allan.hpp"
+#include "processing/allan/rolling_allan.hpp"
 
 using namespace gyrod::processing;
 

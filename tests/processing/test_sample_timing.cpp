@@ -1,5 +1,5 @@
 // The streaming timing check: gaps, jitter and the nominal spacing, on generated time columns.
-#include "processing/sample_timing.hpp"
+#include "processing/base/sample_timing.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "processing/portable_random.hpp"
+#include "processing/base/portable_random.hpp"
 
 namespace gyrod::processing {
 namespace {

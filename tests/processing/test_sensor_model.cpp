@@ -10,7 +10,7 @@
 #include <random>
 #include <stdexcept>
 
-#include "processing/sensor_model.hpp"
+#include "processing/simulation/sensor_model.hpp"
 
 using namespace gyrod::processing;
 

@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "processing/statistics_tests.hpp"
+#include "processing/paper/statistics_tests.hpp"
 
 using namespace gyrod::processing;
 

@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "processing/still_period_check.hpp"
+#include "processing/motion/still_period_check.hpp"
 
 using namespace gyrod::processing;
 

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "fixed_threads.hpp"
-#include "processing/allan_kernels.hpp"
-#include "processing/parallel_share.hpp"
+#include "processing/allan/allan_kernels.hpp"
+#include "processing/base/parallel_share.hpp"
 
 using namespace gyrod::processing;
 

@@ -1,7 +1,7 @@
-// The bias against temperature of a still record (processing/temperature_bias_fit.hpp): on
+// The bias against temperature of a still record (processing/motion/temperature_bias_fit.hpp): on
 // synthetic records with a known bias, coefficient and warm-up shape, each estimate lies within
 // three of its own standard errors of the truth, and what the record cannot show is not fitted.
-#include "processing/temperature_bias_fit.hpp"
+#include "processing/motion/temperature_bias_fit.hpp"
 
 #include <gtest/gtest.h>
 

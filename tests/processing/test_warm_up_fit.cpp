@@ -8,8 +8,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "processing/portable_random.hpp"
-#include "processing/warm_up_fit.hpp"
+#include "processing/base/portable_random.hpp"
+#include "processing/motion/warm_up_fit.hpp"
 
 using namespace gyrod::processing;
 

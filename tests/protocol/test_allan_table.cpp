@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "processing/allan.hpp"
+#include "processing/allan/allan.hpp"
 #include "protocol/allan_table.hpp"
 #include "protocol/protocol.hpp"
 

@@ -10,7 +10,7 @@
 #include <numbers>
 #include <string>
 
-#include "processing/hidden_effect_generator.hpp"
+#include "processing/model_check/hidden_effect_generator.hpp"
 #include "tools/run_command.hpp"
 
 using gyrod::test::readWholeFile;

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "formats/recording_header.hpp"
-#include "processing/hidden_effect_generator.hpp"
+#include "processing/model_check/hidden_effect_generator.hpp"
 #include "tools/run_command.hpp"
 
 using gyrod::test::runGyroctl;

@@ -10,7 +10,7 @@
 
 #include "formats/calibration.hpp"
 #include "formats/model_toml.hpp"
-#include "processing/stream_comparison.hpp"
+#include "processing/motion/stream_comparison.hpp"
 #include "tools/run_command.hpp"
 
 using namespace gyrod::processing;

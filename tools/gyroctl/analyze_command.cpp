@@ -19,14 +19,14 @@
 #include "formats/kalibr_yaml.hpp"
 #include "formats/model_toml.hpp"
 #include "formats/output_file.hpp"
-#include "processing/allan.hpp"
-#include "processing/axis_analysis.hpp"
-#include "processing/detrend.hpp"
-#include "processing/noise_fit.hpp"
-#include "processing/noise_terms.hpp"
-#include "processing/noise_units.hpp"
-#include "processing/parallel_share.hpp"
-#include "processing/warm_up_fit.hpp"
+#include "processing/allan/allan.hpp"
+#include "processing/paper/axis_analysis.hpp"
+#include "processing/base/detrend.hpp"
+#include "processing/allan/noise_fit.hpp"
+#include "processing/base/noise_terms.hpp"
+#include "processing/base/noise_units.hpp"
+#include "processing/base/parallel_share.hpp"
+#include "processing/motion/warm_up_fit.hpp"
 #include "protocol/allan_table.hpp"
 #include "tools/gyroctl/analyze_imu.hpp"
 #include "tools/gyroctl/commands.hpp"
@@ -152,7 +152,7 @@ std::vector<std::size_t> clusterSizesFor(const std::string& spec, double rate_hz
 }
 
 // Each term in the paper's units (or the accelerometer's counterparts) and in SI
-// (processing/noise_units.hpp names the keys).
+// (processing/base/noise_units.hpp names the keys).
 json noiseTermsJson(const NoiseTerms& t, SensorKind sensor) {
   json j = json::object();
   for (NoiseTerm term : kAllNoiseTerms)

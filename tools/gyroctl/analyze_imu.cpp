@@ -6,7 +6,7 @@
 #include <utility>
 
 #include "formats/recording_csv.hpp"
-#include "processing/noise_units.hpp"
+#include "processing/base/noise_units.hpp"
 
 namespace gyrod::gyroctl {
 namespace {

@@ -4,7 +4,7 @@
 #include <vector>
 
 #include "formats/kalibr_yaml.hpp"
-#include "processing/axis_analysis.hpp"
+#include "processing/paper/axis_analysis.hpp"
 #include "tools/gyroctl/input.hpp"
 
 namespace gyrod::gyroctl {

@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "formats/recording_format.hpp"
-#include "processing/allan.hpp"
-#include "processing/noise_terms.hpp"
+#include "processing/allan/allan.hpp"
+#include "processing/base/noise_terms.hpp"
 #include "protocol/protocol.hpp"
 #include "protocol/socket_path.hpp"
 #include "tools/gyroctl/commands.hpp"

@@ -13,9 +13,9 @@
 
 #include "formats/calibration.hpp"
 #include "formats/output_file.hpp"
-#include "processing/detrend.hpp"
-#include "processing/filter_chain.hpp"
-#include "processing/rate_estimator.hpp"
+#include "processing/base/detrend.hpp"
+#include "processing/paper/filter_chain.hpp"
+#include "processing/motion/rate_estimator.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
 #include "tools/gyroctl/series_checks.hpp"

@@ -1,5 +1,5 @@
 // gyroctl model-check: where the paper's model fails on a recording, the named cause, and
-// the gain of the extended model (processing/model_check.hpp, docs/model-check.md).
+// the gain of the extended model (processing/model_check/model_check.hpp, docs/model-check.md).
 #include <unistd.h>
 
 #include <algorithm>
@@ -26,10 +26,10 @@
 #include "formats/model_toml.hpp"
 #include "formats/output_file.hpp"
 #include "formats/recording_header.hpp"
-#include "processing/model_check.hpp"
-#include "processing/noise_terms.hpp"
-#include "processing/sensor_model.hpp"
-#include "processing/warm_up_fit.hpp"
+#include "processing/model_check/model_check.hpp"
+#include "processing/base/noise_terms.hpp"
+#include "processing/simulation/sensor_model.hpp"
+#include "processing/motion/warm_up_fit.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
 #include "tools/gyroctl/model_check_support.hpp"

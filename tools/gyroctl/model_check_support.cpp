@@ -9,7 +9,7 @@
 
 #include "formats/recording_csv.hpp"
 #include "formats/recording_header.hpp"
-#include "processing/sensor_model.hpp"
+#include "processing/simulation/sensor_model.hpp"
 
 namespace gyrod::gyroctl {
 

@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-#include "processing/model_check.hpp"
+#include "processing/model_check/model_check.hpp"
 #include "tools/gyroctl/input.hpp"
 
 namespace gyrod::gyroctl {

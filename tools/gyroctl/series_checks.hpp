@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "formats/recording_csv.hpp"
-#include "processing/sample_timing.hpp"
+#include "processing/base/sample_timing.hpp"
 
 namespace gyrod::gyroctl {
 

@@ -19,7 +19,7 @@
 #include "formats/model_toml.hpp"
 #include "formats/motion_spec.hpp"
 #include "formats/output_file.hpp"
-#include "processing/noise_simulator.hpp"
+#include "processing/simulation/noise_simulator.hpp"
 #include "tools/gyroctl/commands.hpp"
 
 namespace gyrod::gyroctl {

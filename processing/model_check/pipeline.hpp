@@ -1,0 +1,227 @@
+#pragma once
+// Internal: the stages of checkAxisModel (processing/model_check/model_check.cpp) and what they share.
+// Each detector tests the measured series against the replicas' null of its statistic, names
+// its effect in the result and removes it from the working series. Not a stable interface.
+//
+// Files: model_check_series.cpp (what every series is measured by), model_check_replicas.cpp
+// (replicas, their thread pool, the Allan band), model_check_timing.cpp, _outliers.cpp,
+// _sinusoids.cpp, _steps.cpp (temperature against steps), _gauss_markov.cpp, and
+// model_check_extension.cpp (the extended model, what it leaves unexplained, the gain).
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "processing/allan/allan.hpp"
+#include "processing/model_check/model_check.hpp"
+#include "processing/model_check/detail.hpp"
+#include "processing/allan/noise_fit.hpp"
+#include "processing/simulation/noise_simulator.hpp"
+
+namespace gyrod::processing::model_check_detail {
+
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+inline constexpr std::size_t kOutlierHalfWindow = 10;
+
+// ---- the acquisition chain (model_check_chain.cpp) --------------------------------------
+
+struct ChainModel {
+  std::optional<int> dlpf_cfg, fs_sel;
+  std::vector<double> white_shape;    // s(m) per Allan point (1 without a DLPF)
+  std::vector<double> white_ma;       // MA coefficients of unit long-τ white coefficient (empty: no DLPF)
+  std::vector<double> flicker_shape;  // s_B(m): the flicker (bias instability) term's, 1 without a DLPF
+  std::vector<double> flicker_ma;     // output-rate filter of the chain's gain for flicker (empty: no DLPF)
+  double lsb_dps = 0.0;               // 0: no quantisation
+  double quantisation_white = 0.0;    // white coefficient the rounding adds: LSB²·τ0/12
+};
+
+// ---- what every replica (and the measured series) is measured by ----------------------
+
+struct Context {
+  std::size_t n = 0;
+  double rate = 0.0, tau0 = 0.0;
+  std::vector<std::size_t> ms;
+  std::vector<double> taus, edf;
+  std::vector<double> t_grid;         // Gauss–Markov correlation times tried
+  std::size_t block = 1, blocks = 0;  // block length [samples], number of blocks
+  std::vector<double> temp_blocks;    // detrended block means of temperature (empty: none)
+  std::vector<std::size_t> scales;    // Haar scales [blocks]
+  std::size_t k_lo = 0, k_hi = 0;     // periodogram bins searched for a sinusoid
+  std::vector<double> psd_edges;
+  ChainModel chain;
+};
+
+ChainModel makeChainModel(const AcquisitionChain& chain, double rate_hz, std::span<const std::size_t> ms);
+// The white coefficient c (σ² = c/τ) of a set of terms.
+double whiteCoefficientOf(const NoiseTerms& terms);
+// Allan variances with the white and flicker power the DLPF took at short τ added back (for
+// the white and bias-instability terms given; the quantisation's white share is not
+// filtered): what the five terms describe.
+std::vector<double> chainCorrectedVariances(std::span<const double> variance, const Context& c,
+                                            const NoiseTerms& terms);
+// The five terms of an Allan curve made through c.chain (fitNoiseTerms when there is no DLPF).
+NoiseTermFit fitChainTerms(const std::vector<AllanPoint>& curve, const Context& c);
+// The chain's white noise of coefficient c (less the quantisation's) added to x, its own stream.
+void addChainWhiteNoise(std::vector<double>& x, const ChainModel& chain, double white_coefficient, std::uint64_t seed);
+// n samples of x filtered by the chain's flicker filter (x has n + flicker_ma.size() − 1
+// samples: the first ones only fill the filter).
+std::vector<double> filterChainFlicker(std::span<const double> x, const ChainModel& chain, std::size_t n);
+// Rounded to the chain's LSB at a random offset (nothing without FS_SEL).
+void quantiseLikeTheChip(std::vector<double>& x, const ChainModel& chain, std::uint64_t seed);
+
+// The Allan grid, Gauss–Markov grid, blocks, Haar scales, sinusoid bins and PSD bands of the
+// detrended series xd; `curve` gets its Allan deviation table.
+Context makeContext(const AxisModelCheckInput& in, std::span<const double> xd, std::vector<AllanPoint>& curve);
+
+enum StatMask : unsigned {
+  kStatAllan = 1u,
+  kStatOutliers = 2u,
+  kStatSpectrum = 4u,
+  kStatTemperature = 8u,
+  kStatSteps = 16u,
+  kStatGaussMarkov = 32u,
+  kStatPsd = 64u,
+  kStatAll = 127u,
+};
+
+struct SeriesStats {
+  std::vector<double> log_adev;  // ln σ per m
+  double outlier_max_z = kNaN;
+  double spectral_log_ratio = kNaN;
+  std::size_t spectral_bin = 0;
+  double temp_slope = kNaN;
+  // Per Haar scale of c.scales: the largest |D_W| of the low-passed residual and the mean of
+  // D_W² over its positions (the replicas' pooled mean square standardises the scan).
+  std::vector<double> step_scale_max, step_scale_ms;
+  double gm_statistic = kNaN;
+  std::vector<double> psd, psd_max;
+};
+
+SeriesStats measureSeries(std::span<const double> xd, const Context& c, unsigned mask);
+
+// Least-squares slope of the low-passed residual y on the temperature blocks tb (no intercept).
+double temperatureSlope(const std::vector<double>& y, const std::vector<double>& tb);
+// √(χ² gain) of the Allan fit with a Gauss–Markov term.
+double gaussMarkovStatistic(const GaussMarkovCurveFit& fit);
+// Block means of x with their least-squares line removed.
+std::vector<double> lowPassedResidual(std::span<const double> x, const Context& c);
+// The step scan's per-scale measures of y (model_check_steps.cpp) into s.step_scale_*.
+void measureStepScales(const std::vector<double>& y, const Context& c, SeriesStats& s);
+
+// ---- nulls and what the result reports of a statistic ----------------------------------
+
+std::vector<double> column(const std::vector<SeriesStats>& reps, double SeriesStats::*field);
+double medianOf(std::vector<double> v);
+CheckStatistic makeStatistic(const std::string& name, double value, const NullSummary& null);
+// The evidence of a statistic that fired: its value, threshold and null.
+EffectEvidence nullEvidence(double value, const NullSummary& null, std::size_t replicas);
+
+// ---- replicas ------------------------------------------------------------------------------
+
+SimulationModel pureModel(double rate, const NoiseTerms& terms);
+// The 1-σ uncertainty of a fit without noise_fit's reduced-χ² scale.
+NoiseTerms statisticalUncertainty(const NoiseTermFit& fit);
+// o.replicas replicas of `model` (terms perturbed by `uncertainty`) plus `added`, measured by
+// `mask`; replica i of `round` is seeded from (o.seed, round, i) alone. `per_series`, when
+// given, also sees each replica series (with its index; called from the pool's threads).
+using ReplicaSeriesHook = std::function<void(std::size_t, std::span<const double>)>;
+std::vector<SeriesStats> runReplicas(const SimulationModel& model, const NoiseTerms& uncertainty, const Context& c,
+                                     std::span<const double> added, const ModelCheckOptions& o, std::uint64_t round,
+                                     unsigned mask, const ReplicaSeriesHook& per_series = {});
+
+// The Allan band of the replicas around the measured curve and the null of its largest |z|.
+struct AllanNull {
+  AllanBand band;
+  std::vector<double> median_log, spread_log;
+  NullSummary max_z;
+};
+AllanNull allanNull(const std::vector<SeriesStats>& reps, const std::vector<double>& measured_log, const Context& c,
+                    double alpha);
+double maxAbsZ(const std::vector<double>& log_adev, const std::vector<double>& med, const std::vector<double>& spread,
+               std::vector<double>* z_out = nullptr);
+
+// ---- effects found, removed from the working series -----------------------------------------
+
+struct Removal {
+  std::vector<SinusoidFit> sinusoids;
+  double k = 0.0;
+  bool temperature = false;
+  std::vector<std::size_t> step_samples;
+  std::vector<double> step_sizes;
+};
+
+// The deterministic part of the named effects, per sample.
+std::vector<double> deterministicPart(const Removal& r, std::size_t n, double rate,
+                                      const std::vector<double>& temp_detrended);
+
+// ---- the detectors ---------------------------------------------------------------------------
+
+// Gaps in t: no replicas needed (a regular sampler never leaves a 1.5·τ0 gap).
+void checkSampleTiming(std::span<const double> time_s, AxisModelCheck& out);
+
+struct OutliersFound {
+  bool found = false;
+  std::size_t count = 0;
+  double median_amplitude = 0.0;
+};
+// Samples of xc beyond the null of the largest robust z, each replaced in xc by the mean of
+// its neighbours in xd that are not outliers themselves.
+OutliersFound checkOutliers(std::span<const double> xd, std::vector<double>& xc, const NullSummary& null,
+                            std::size_t replicas, AxisModelCheck& out);
+
+// Up to three narrow lines, each fitted and subtracted from xc; returns whether one was named.
+bool checkSinusoids(std::vector<double>& xc, const Context& c, const NullSummary& null, std::size_t replicas,
+                    Removal& removal, AxisModelCheck& out);
+
+// The temperature channel detrended as the rate is, and its block means.
+struct TemperatureChannel {
+  std::vector<double> detrended;
+  std::vector<double> raw_blocks;  // block means of the measured temperature (plots)
+  // `detrended` smoothed over a block (centred moving average): the regressor of the extended
+  // model. The channel's own noise and its 1/340 °C steps times k would otherwise add white
+  // noise to the replicas and to the Kalman filter's regressor (seen: an extension with a
+  // true temperature response scored worse than the base model).
+  std::vector<double> smoothed;
+};
+
+// A temperature response and bias steps on the low-passed residual of xc, told apart, fitted
+// and subtracted from xc; base_reps give the first null. Returns whether one was named.
+bool checkTemperatureAndSteps(const AxisModelCheckInput& input, std::vector<double>& xc, const Context& c,
+                              const TemperatureChannel& temp, const std::vector<SeriesStats>& base_reps,
+                              const ModelCheckOptions& o, Removal& removal, AxisModelCheck& out);
+
+struct GaussMarkovFound {
+  bool found = false;
+  GaussMarkovCurveFit fit;
+  NoiseTermFit clean_fit;     // five terms of the cleaned series
+  NoiseTerms extended_terms;  // the model's terms: with the Gauss–Markov term's when found
+};
+// A bump in the Allan curve of the cleaned series xc; `curve` is the measured series' table,
+// used when nothing deterministic was removed.
+GaussMarkovFound checkGaussMarkov(std::span<const double> xc, const Context& c, bool deterministic_found,
+                                  const std::vector<AllanPoint>& curve, const std::vector<SeriesStats>& base_reps,
+                                  const ModelCheckOptions& o, AxisModelCheck& out);
+
+// ---- the extended model --------------------------------------------------------------------
+
+struct ExtensionInputs {
+  std::span<const double> xd;  // measured series, detrended
+  std::span<const double> xc;  // with the named effects removed
+  const std::vector<double>* measured_log_adev = nullptr;
+  const AllanNull* base_allan = nullptr;
+  const Removal* removal = nullptr;
+  const std::vector<double>* temp_detrended = nullptr;
+  const GaussMarkovFound* gauss_markov = nullptr;
+  OutliersFound outliers;
+  bool deterministic_found = false;
+};
+
+// Replicas of the extended model: its Allan band, what it leaves unexplained, and the gain
+// (Allan band and Kalman innovations, base against extended).
+void checkExtendedModel(const ExtensionInputs& in, const Context& c, const ModelCheckOptions& o, AxisModelCheck& out);
+
+}  // namespace gyrod::processing::model_check_detail

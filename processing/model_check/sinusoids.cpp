@@ -1,0 +1,74 @@
+// The model check's sinusoid detector: narrow lines in the spectrum, each fitted and removed.
+#include <cmath>
+#include <numbers>
+
+#include "processing/base/golden_section.hpp"
+#include "processing/model_check/pipeline.hpp"
+
+namespace gyrod::processing::model_check_detail {
+namespace {
+
+constexpr std::size_t kMaxSinusoids = 3;
+constexpr double kSameLineBins = 3.0;  // peaks closer than this (periodogram bins) are one line
+
+// The least-squares sinusoid at the frequency within ±1 bin of `bin` of largest amplitude.
+SinusoidFit fitLineNearBin(std::span<const double> x, double rate, std::size_t bin, double df) {
+  const double a = (static_cast<double>(bin) - 1.0) * df, b = (static_cast<double>(bin) + 1.0) * df;
+  const GoldenSectionBracket found =
+      goldenSectionMinimum(a, b, {40, 1e-6 * df}, [&](double f) { return -fitSinusoidAt(x, rate, f).amp_dps; });
+  return fitSinusoidAt(x, rate, found.midpoint());
+}
+
+// The effect already named within a few bins of `freq_hz`, if any (the last such).
+DetectedEffect* sameLine(std::vector<DetectedEffect>& effects, double freq_hz, double df) {
+  DetectedEffect* same_line = nullptr;
+  for (DetectedEffect& prev : effects)
+    if (prev.effect == ModelEffect::Sinusoid && std::fabs(prev.freq_hz - freq_hz) <= kSameLineBins * df)
+      same_line = &prev;
+  return same_line;
+}
+
+}  // namespace
+
+bool checkSinusoids(std::vector<double>& xc, const Context& c, const NullSummary& null, std::size_t replicas,
+                    Removal& removal, AxisModelCheck& out) {
+  const double rate = c.rate;
+  bool found = false;
+  for (std::size_t s = 0; s < kMaxSinusoids; ++s) {
+    const Periodogram p = hannPeriodogram(xc);
+    const SpectralPeak peak = largestSpectralPeak(p.power, spectralBackground(p.power), c.k_lo, c.k_hi);
+    const double stat = std::log(peak.ratio);
+    if (s == 0) out.statistics.push_back(makeStatistic("spectral_peak_log_ratio", stat, null));
+    if (!null.fires(stat)) break;
+    const double df = rate / static_cast<double>(p.nfft);
+    const SinusoidFit fit = fitLineNearBin(xc, rate, peak.bin, df);
+    const double w = 2.0 * std::numbers::pi * fit.freq_hz / rate;
+    for (std::size_t i = 0; i < xc.size(); ++i)
+      xc[i] -= fit.amp_dps * std::sin(w * static_cast<double>(i) + fit.phase_rad);
+    removal.sinusoids.push_back(fit);
+    // A second peak within a few bins of one already named is the same line: a fixed
+    // sinusoid did not take it out because its amplitude or phase wanders over the record
+    // (or gaps in the record shifted its phase). Both components stay in the extended model;
+    // the report names one line, its frequency power-weighted and its amplitude the rms sum.
+    if (DetectedEffect* same_line = sameLine(out.effects, fit.freq_hz, df)) {
+      const double p0 = same_line->amp_dps * same_line->amp_dps, p1 = fit.amp_dps * fit.amp_dps;
+      same_line->evidence.further_components.push_back({fit.freq_hz, fit.amp_dps, peak.ratio});
+      same_line->freq_hz = (p0 * same_line->freq_hz + p1 * fit.freq_hz) / (p0 + p1);
+      same_line->amp_dps = std::sqrt(p0 + p1);
+      continue;
+    }
+    DetectedEffect e;
+    e.effect = ModelEffect::Sinusoid;
+    e.freq_hz = fit.freq_hz;
+    e.amp_dps = fit.amp_dps;
+    e.phase_rad = fit.phase_rad;
+    e.evidence = nullEvidence(stat, null, replicas);
+    e.evidence.peak_ratio = peak.ratio;
+    e.evidence.freq_hz = fit.freq_hz;
+    out.effects.push_back(e);
+    found = true;
+  }
+  return found;
+}
+
+}  // namespace gyrod::processing::model_check_detail
