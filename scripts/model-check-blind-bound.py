@@ -28,14 +28,14 @@ rows = []
 # steps: two-sided, 7 dyadic scales known-form; blind x positions (n_blocks/W effective: 100..600)
 for npos in (100, 600):
     r = z(1e-3 / (2 * 7 * npos)) / z(0.01 / (2 * 7))
-    rows.append(("bias_steps N_pos=%d" % npos, 3.6, 9.75, r))  # check: session 7
+    rows.append(("bias_steps N_pos=%d" % npos, 3.6, 9.75, r))  # check: 50 % size of the model-standardised step scan, measured at 82207bd
 # sinusoid: chi2(2); known 1 %; blind over 15000 bins at 1e-4
 kn = lam50(-2 * math.log(0.01)); bl = lam50(-2 * math.log(1e-4 / 15000))
 rows.append(("sinusoid N=15000", 0.025, 0.080, math.sqrt(bl / kn)))
 # temperature: N=1, two-sided, 1e-4 vs 1e-2
 rows.append(("temperature N=1", 4.5, 11.3, z(1e-4 / 2) / z(0.01 / 2)))
 # Gauss-Markov: one-sided score (mean ~ power ~ size^2); blind over ~6 effective T at 1e-3
-for name, kf, ck in (("GM T=dur/300", 0.71, 1.41), ("GM T=dur/60", 1.1, 3.08)):  # check: session 7, gated joint null
+for name, kf, ck in (("GM T=dur/300", 0.71, 1.41), ("GM T=dur/60", 1.1, 3.08)):  # check: gated joint-fit null, measured at 1ea3817
     rows.append((name + " N_T=6", kf, ck, math.sqrt(z(1e-3 / 6) / z(0.01))))
 for name, kf, ck, r in rows:
     print("%-24s known %.3g  bound %.3g (x%.2f)  check %.3g  check/bound %.2f" % (name, kf, kf * r, r, ck, ck / (kf * r)))
