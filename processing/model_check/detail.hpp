@@ -1,5 +1,5 @@
 #pragma once
-// Internal parts of the model check (processing/model_check*.cpp), shared between its
+// Internal parts of the model check (processing/model_check/*.cpp), shared between its
 // files and the tests. Not a stable interface.
 #include <cstddef>
 #include <span>

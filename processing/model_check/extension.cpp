@@ -54,7 +54,7 @@ AllanNull extendedAllanNull(const ExtensionInputs& in, bool any_model_effect, co
     added.resize(c.n);
     for (std::size_t i = 0; i < c.n; ++i) added[i] = in.removal->k * (*in.temp_detrended)[i];
   }
-  // The same replicas bootstrap the parameters' intervals (model_check_intervals.hpp).
+  // The same replicas bootstrap the parameters' intervals (intervals.hpp).
   const ReplicaSeriesHook measure = [&intervals](std::size_t i, std::span<const double> x) {
     intervals.measureReplica(i, x);
   };

@@ -1,6 +1,6 @@
 // The model check of one axis: base fit → replicas → statistics against their nulls →
 // named causes → extended model → replicas again → gain. See model_check.hpp and
-// docs/model-check.md; the stages are in model_check_pipeline.hpp.
+// docs/model-check.md; the stages are in pipeline.hpp.
 #include "processing/model_check/model_check.hpp"
 
 #include <algorithm>

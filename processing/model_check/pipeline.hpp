@@ -3,10 +3,10 @@
 // Each detector tests the measured series against the replicas' null of its statistic, names
 // its effect in the result and removes it from the working series. Not a stable interface.
 //
-// Files: model_check_series.cpp (what every series is measured by), model_check_replicas.cpp
-// (replicas, their thread pool, the Allan band), model_check_timing.cpp, _outliers.cpp,
-// _sinusoids.cpp, _steps.cpp (temperature against steps), _gauss_markov.cpp, and
-// model_check_extension.cpp (the extended model, what it leaves unexplained, the gain).
+// Files: series.cpp (what every series is measured by), replicas.cpp
+// (replicas, their thread pool, the Allan band), timing.cpp, outliers.cpp,
+// sinusoids.cpp, steps.cpp (temperature against steps), gauss_markov.cpp, and
+// extension.cpp (the extended model, what it leaves unexplained, the gain).
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -27,7 +27,7 @@ namespace gyrod::processing::model_check_detail {
 inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 inline constexpr std::size_t kOutlierHalfWindow = 10;
 
-// ---- the acquisition chain (model_check_chain.cpp) --------------------------------------
+// ---- the acquisition chain (chain.cpp) --------------------------------------
 
 struct ChainModel {
   std::optional<int> dlpf_cfg, fs_sel;
@@ -109,7 +109,7 @@ double temperatureSlope(const std::vector<double>& y, const std::vector<double>&
 double gaussMarkovStatistic(const GaussMarkovCurveFit& fit);
 // Block means of x with their least-squares line removed.
 std::vector<double> lowPassedResidual(std::span<const double> x, const Context& c);
-// The step scan's per-scale measures of y (model_check_steps.cpp) into s.step_scale_*.
+// The step scan's per-scale measures of y (steps.cpp) into s.step_scale_*.
 void measureStepScales(const std::vector<double>& y, const Context& c, SeriesStats& s);
 
 // ---- nulls and what the result reports of a statistic ----------------------------------

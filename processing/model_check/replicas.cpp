@@ -26,7 +26,7 @@ std::uint64_t replicaSeed(std::uint64_t seed, std::uint64_t round, std::uint64_t
 // One replica of axis x of `model` (terms as the output shows them at long τ), n samples,
 // through the acquisition chain of c, plus `added` (same length, or empty), detrended as the
 // measured series is. The chain's white noise is drawn at the output rate with the chain's
-// autocovariance (model_check_chain.cpp); the rounding adds white noise of its own, which
+// autocovariance (chain.cpp); the rounding adds white noise of its own, which
 // the white term already holds, so that much is taken out of it.
 std::vector<double> simulateReplica(const SimulationModel& model, const Context& c, std::uint64_t seed,
                                     std::span<const double> added) {

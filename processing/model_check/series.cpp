@@ -40,7 +40,7 @@ Context makeContext(const AxisModelCheckInput& in, std::span<const double> xd, s
   c.block = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(in.rate_hz)));
   if (c.n / c.block > kMaxBlocks) c.block = (c.n + kMaxBlocks - 1) / kMaxBlocks;
   c.blocks = c.n / c.block;
-  // Haar scales of the step scan (model_check_steps.cpp): 2, 4, … blocks, up to 1/16 of the record.
+  // Haar scales of the step scan (steps.cpp): 2, 4, … blocks, up to 1/16 of the record.
   for (std::size_t w = 2; 16 * w <= c.blocks; w *= 2) c.scales.push_back(w);
 
   const std::size_t nfft = fftLength(c.n);

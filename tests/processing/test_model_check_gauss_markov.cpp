@@ -73,9 +73,9 @@ bool namesGaussMarkov(const std::vector<double>& x, std::uint64_t seed, std::str
 }  // namespace
 
 TEST(ModelCheckGaussMarkov, FindsAProcessBetweenTheOldAndNewHalfDetectionSizes) {
-  // Six seeds: the five-term null named 2 of them (measured before the change), the joint
-  // null 5 (session 9, on the tree then: 4, and 4 with the joint null guarded by the
-  // five-term null at 100 α). The same six records without the process must stay clean.
+  // Six seeds: the five-term null alone names 2 of them (measured at c285c08), the joint null
+  // 4 guarded by the five-term null at 100 α (4c35414). The same six records without the
+  // process must stay clean.
   const double sigma = sigmaForPeak(kDuration / 300.0, 1.6);
   std::size_t found = 0, false_found = 0;
   std::string log;
@@ -92,7 +92,8 @@ TEST(ModelCheckGaussMarkov, CleanRecordsWithoutDlpfTheJointNullNamedStayMostlyCl
   // DLPF, as `model_check_dlpf_fdr --cfg none`) on which the joint-fit null alone named a
   // process (T 0.06–3.8 s), each with a rate random walk the five-term fit put at 0. With the
   // five-term null as a guard at 100 α, three are clean; the fourth (seed 1259 axis 1, statistic
-  // 5.7 above both thresholds) is still named (measured, docs/model-check.md, session 9).
+  // 5.7 above both thresholds) is still named (docs/model-check.md "The Gauss–Markov null",
+  // measured at 4c35414).
   // The power side: FindsAProcessBetweenTheOldAndNewHalfDetectionSizes above.
   const std::vector<std::pair<std::uint64_t, std::size_t>> axes{{1212, 1}, {1224, 2}, {1259, 1}, {1262, 0}};
   std::size_t named = 0;
