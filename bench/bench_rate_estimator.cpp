@@ -11,8 +11,8 @@
 #include <random>
 #include <vector>
 
-#include "processing/paper/filter_chain.hpp"
 #include "processing/motion/rate_estimator.hpp"
+#include "processing/paper/filter_chain.hpp"
 
 namespace {
 

@@ -28,12 +28,12 @@
 #include <string>
 #include <vector>
 
-#include "processing/model_check/known_form_detectors.hpp"
-#include "processing/model_check/model_check.hpp"
-#include "processing/model_check/detail.hpp"
-#include "processing/simulation/noise_simulator.hpp"
 #include "processing/base/noise_terms.hpp"
 #include "processing/base/portable_random.hpp"
+#include "processing/model_check/detail.hpp"
+#include "processing/model_check/known_form_detectors.hpp"
+#include "processing/model_check/model_check.hpp"
+#include "processing/simulation/noise_simulator.hpp"
 
 using namespace gyrod;
 using namespace gyrod::processing;

@@ -20,8 +20,8 @@
 #include <string>
 #include <vector>
 
-#include "processing/simulation/noise_simulator.hpp"
 #include "processing/base/portable_random.hpp"
+#include "processing/simulation/noise_simulator.hpp"
 
 using namespace gyrod::processing;
 

@@ -27,11 +27,11 @@
 #include <string>
 #include <vector>
 
-#include "processing/paper/filter_chain.hpp"
 #include "processing/allan/noise_fit.hpp"
-#include "processing/motion/rate_estimator.hpp"
 #include "processing/allan/rolling_allan.hpp"
+#include "processing/motion/rate_estimator.hpp"
 #include "processing/motion/still_period_check.hpp"
+#include "processing/paper/filter_chain.hpp"
 
 namespace gyrod::daemon {
 

@@ -58,9 +58,9 @@
 #include <string_view>
 
 #include "formats/recording_csv.hpp"
+#include "processing/motion/still_detector.hpp"
 #include "processing/paper/kalman.hpp"
 #include "processing/simulation/noise_simulator.hpp"
-#include "processing/motion/still_detector.hpp"
 
 namespace gyrod::recording {
 

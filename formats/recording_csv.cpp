@@ -29,16 +29,17 @@
 #include "formats/csv_fields.hpp"
 #include "formats/decimal_number.hpp"
 #include "formats/quoted_value.hpp"
+#include "formats/recording_slice.hpp"
 #include "processing/base/parallel_share.hpp"
 
 namespace gyrod::recording {
 namespace {
 
-constexpr std::array<std::string_view, 11> kKnownColumns = {"t",  "gx", "gy", "gz", "temp", "wx",
-                                                            "wy", "wz", "ax", "ay", "az"};
-// gyrod's columns a sample may leave empty (recording_format.hpp): read as NaN then.
-constexpr std::array<std::string_view, 8> kStreamColumns = {"time",    "gx_rate", "gy_rate", "gz_rate",
-                                                            "gx_bias", "gy_bias", "gz_bias", "still"};
+using slice_detail::isSkippable;
+using slice_detail::kKnownColumns;
+using slice_detail::kStreamColumns;
+using slice_detail::SliceParser;
+using slice_detail::SliceResult;
 
 std::vector<double>* streamColumn(Recording& rec, std::size_t index) {
   if (index == 0) return &rec.time;
@@ -55,27 +56,9 @@ std::vector<double>* streamColumn(Recording& rec, std::size_t index) {
   throw RecordingError(s.str());
 }
 
-bool isSkippable(std::string_view line) { return line.empty() || line.front() == '#'; }
-
 struct FileCloser {
   void operator()(std::FILE* f) const { std::fclose(f); }
 };
-
-// Splits `line` into at most fields.size() trimmed fields; returns the number of fields the
-// line has (which may be more than were stored).
-std::size_t splitInto(std::string_view line, std::span<std::string_view> fields) {
-  std::size_t count = 0;
-  std::size_t start = 0;
-  while (true) {
-    const auto comma = line.find(',', start);
-    if (count < fields.size())
-      fields[count] =
-          trimField(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
-    ++count;
-    if (comma == std::string_view::npos) return count;
-    start = comma + 1;
-  }
-}
 
 // A generous guess of the number of lines from the file's size and one line's length, so
 // that the columns are allocated once (capacity never touched costs no memory).
@@ -126,158 +109,6 @@ std::vector<ColumnRole> headerRoles(const std::string& path, std::size_t line_no
   rec.axes.resize(rec.axis_names.size());
   return roles;
 }
-
-// What a slice of the sample lines yields, numbered from the slice: its first line is 1 and
-// its first sample 0. Slices are parsed apart (on both cores) and appended in file order.
-struct SliceResult {
-  std::vector<std::vector<double>> columns;   // one per field of the header, when stored here
-  std::vector<std::vector<double>*> store;    // where the values go: `columns`, or the recording's
-  std::vector<Recording::LineRun> line_runs;  // runs within the slice
-  std::vector<std::size_t> sample_lines;      // each sample's line (only with ReadOptions::line_numbers)
-  std::vector<LostSamples> lost;              // GAP and DROPPED lines
-  std::size_t lines = 0;                      // lines read (up to and including an error's)
-  std::size_t samples = 0;
-  std::string error;  // the cause of the first bad line (the slice's last), empty when none
-
-  // Empty again, keeping the columns' memory for the next slice; the values go to `targets`
-  // (the recording's columns) when given, else to this slice's own columns.
-  void clear(std::size_t column_count, const std::vector<std::vector<double>*>* targets = nullptr) {
-    columns.resize(targets ? 0 : column_count);
-    store.clear();
-    for (std::size_t c = 0; c < column_count; ++c) {
-      if (targets) {
-        store.push_back((*targets)[c]);
-      } else {
-        columns[c].clear();
-        store.push_back(&columns[c]);
-      }
-    }
-    line_runs.clear();
-    sample_lines.clear();
-    lost.clear();
-    lines = samples = 0;
-    error.clear();
-  }
-};
-
-// The sample lines' rules, the same for every slice: field count, numbers, comments and
-// GAP/DROPPED records, the line length limit, one column for bare numbers.
-struct SliceParser {
-  std::vector<std::string> column_names;  // for messages ("value" for bare numbers)
-  std::vector<bool> may_be_empty;         // gyrod's stream columns: an empty field is NaN
-  bool bare_numbers = false;
-  bool line_numbers = false;
-  std::size_t max_bytes = kMaxLineBytes;
-
-  // Parses the lines of `text` (each ending in '\n' but maybe the last) into `out`,
-  // stopping at the first bad line.
-  void parse(std::string_view text, SliceResult& out) const {
-    std::array<std::string_view, kKnownColumns.size() + kStreamColumns.size()> fields;
-    std::size_t start = 0;
-    while (start < text.size()) {
-      if (const std::size_t next = parsePlainLine(text, start, out); next != 0) {
-        start = next;
-        continue;
-      }
-      const auto nl = text.find('\n', start);
-      const std::size_t end = nl == std::string_view::npos ? text.size() : nl;
-      const std::string_view raw = text.substr(start, end - start);
-      start = end + 1;
-      ++out.lines;
-      if (raw.size() > max_bytes) {
-        out.error = lineTooLongCause(max_bytes);
-        return;
-      }
-      const std::string_view line = trimField(raw);
-      if (isSkippable(line)) {
-        if (auto lost = parseLostSamplesLine(line)) {
-          lost->line = out.lines;
-          lost->before_sample = out.samples;
-          out.lost.push_back(std::move(*lost));
-        }
-        continue;
-      }
-      if (bare_numbers && line.find(',') != std::string_view::npos) {
-        out.error = "more than one column in a file of bare numbers (add a header t,gx,gy,gz,temp)";
-        return;
-      }
-      if (!consume(line, fields, out)) return;
-    }
-  }
-
-  // The common line, in one pass: exactly one plain number per column (no sign '+', no
-  // spaces, nothing empty), separated by single commas, ending in '\n' or the text's end,
-  // within the length limit. Each field is then exactly what from_chars read up to the
-  // comma, which is what the general path below would parse from it: the same values (both
-  // read with decimalFromChars, std::from_chars' values, faster on plain decimals). The
-  // sample is stored and the start of the next line returned; 0 (nothing stored) for any
-  // other line, left to the general path with its messages.
-  std::size_t parsePlainLine(std::string_view text, std::size_t start, SliceResult& out) const {
-    // Not zeroed: a line sets every value it stores, and zeroing 19 doubles a line cost as much
-    // as the rest of this function.
-    std::array<double, kKnownColumns.size() + kStreamColumns.size()> values;
-    const char* p = text.data() + start;
-    const char* const end = text.data() + text.size();
-    const std::size_t columns = column_names.size();
-    if (columns > values.size()) return 0;
-    for (std::size_t c = 0; c < columns; ++c) {
-      if (p == end || *p == '+') return 0;
-      const auto [after, ec] = decimalFromChars(p, end, values[c]);
-      if (ec != std::errc() || after == p || !std::isfinite(values[c])) return 0;
-      p = after;
-      if (c + 1 < columns) {
-        if (p == end || *p != ',') return 0;
-        ++p;
-      } else if (p != end && *p != '\n') {
-        return 0;
-      }
-    }
-    const auto line_end = static_cast<std::size_t>(p - text.data());
-    if (line_end - start > max_bytes) return 0;
-    ++out.lines;
-    for (std::size_t c = 0; c < columns; ++c) out.store[c]->push_back(values[c]);
-    recordSample(out);
-    return line_end + 1;  // past the '\n' (or the end of the text)
-  }
-
-  // The line and run bookkeeping of a sample just stored.
-  void recordSample(SliceResult& out) const {
-    if (line_numbers) out.sample_lines.push_back(out.lines);
-    if (out.line_runs.empty() ||
-        out.line_runs.back().first_line + (out.samples - out.line_runs.back().first_sample) != out.lines)
-      out.line_runs.push_back({out.samples, out.lines});
-    ++out.samples;
-  }
-
-  bool consume(std::string_view line, std::span<std::string_view> fields, SliceResult& out) const {
-    const std::size_t count = splitInto(line, fields);
-    if (count != column_names.size()) {
-      std::ostringstream s;
-      s << "expected " << column_names.size() << " field" << (column_names.size() == 1 ? "" : "s") << ", found "
-        << count;
-      out.error = s.str();
-      return false;
-    }
-    for (std::size_t c = 0; c < count; ++c) {
-      if (fields[c].empty() && may_be_empty[c]) {  // a value the sample did not have
-        out.store[c]->push_back(std::numeric_limits<double>::quiet_NaN());
-        continue;
-      }
-      const auto value = parseNumber(fields[c]);
-      if (!value) {
-        out.error = "column '" + column_names[c] + "': " + formats::quotedValue(fields[c]) + " is not a number";
-        return false;
-      }
-      if (!std::isfinite(*value)) {
-        out.error = "column '" + column_names[c] + "': non-finite value " + formats::quotedValue(fields[c]);
-        return false;
-      }
-      out.store[c]->push_back(*value);
-    }
-    recordSample(out);
-    return true;
-  }
-};
 
 // Below this many bytes a batch of lines is parsed on the calling thread alone.
 constexpr std::size_t kParallelSliceBytes = std::size_t{1} << 17;

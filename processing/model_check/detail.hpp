@@ -5,8 +5,8 @@
 #include <span>
 #include <vector>
 
-#include "processing/paper/ar_model.hpp"
 #include "processing/base/noise_terms.hpp"
+#include "processing/paper/ar_model.hpp"
 
 namespace gyrod::processing::model_check_detail {
 

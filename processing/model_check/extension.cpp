@@ -6,10 +6,10 @@
 #include <limits>
 #include <numbers>
 
-#include "processing/paper/ar_model.hpp"
 #include "processing/base/detrend.hpp"
 #include "processing/model_check/intervals.hpp"
 #include "processing/model_check/pipeline.hpp"
+#include "processing/paper/ar_model.hpp"
 
 namespace gyrod::processing::model_check_detail {
 namespace {

@@ -15,10 +15,10 @@
 #include <optional>
 #include <vector>
 
-#include "processing/model_check/model_check.hpp"
-#include "processing/simulation/noise_simulator.hpp"
 #include "processing/base/noise_terms.hpp"
 #include "processing/base/portable_random.hpp"
+#include "processing/model_check/model_check.hpp"
+#include "processing/simulation/noise_simulator.hpp"
 
 namespace gyrod::processing {
 

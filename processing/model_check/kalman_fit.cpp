@@ -8,8 +8,8 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "processing/paper/kalman.hpp"
 #include "processing/model_check/detail.hpp"
+#include "processing/paper/kalman.hpp"
 
 namespace gyrod::processing::model_check_detail {
 namespace {

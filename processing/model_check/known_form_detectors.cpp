@@ -7,8 +7,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "processing/model_check/model_check.hpp"
 #include "processing/model_check/detail.hpp"
+#include "processing/model_check/model_check.hpp"
 
 namespace gyrod::processing {
 namespace {

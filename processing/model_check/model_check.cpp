@@ -10,8 +10,8 @@
 #include <thread>
 
 #include "processing/base/detrend.hpp"
-#include "processing/paper/kalman.hpp"
 #include "processing/model_check/pipeline.hpp"
+#include "processing/paper/kalman.hpp"
 #include "processing/simulation/sensor_model.hpp"
 
 namespace gyrod::processing {

@@ -17,9 +17,9 @@
 #include <vector>
 
 #include "processing/allan/allan.hpp"
-#include "processing/model_check/model_check.hpp"
-#include "processing/model_check/detail.hpp"
 #include "processing/allan/noise_fit.hpp"
+#include "processing/model_check/detail.hpp"
+#include "processing/model_check/model_check.hpp"
 #include "processing/simulation/noise_simulator.hpp"
 
 namespace gyrod::processing::model_check_detail {

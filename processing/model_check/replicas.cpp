@@ -10,8 +10,8 @@
 #include <thread>
 
 #include "processing/base/detrend.hpp"
-#include "processing/model_check/pipeline.hpp"
 #include "processing/base/portable_random.hpp"
+#include "processing/model_check/pipeline.hpp"
 
 namespace gyrod::processing::model_check_detail {
 namespace {

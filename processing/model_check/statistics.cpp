@@ -10,8 +10,8 @@
 #include <unsupported/Eigen/FFT>
 
 #include "processing/base/distributions.hpp"
-#include "processing/model_check/model_check.hpp"
 #include "processing/model_check/detail.hpp"
+#include "processing/model_check/model_check.hpp"
 
 namespace gyrod::processing {
 

@@ -36,9 +36,9 @@
 #include <cstddef>
 #include <optional>
 
-#include "processing/simulation/motion_profile.hpp"
 #include "processing/base/noise_terms.hpp"
 #include "processing/motion/still_detector.hpp"
+#include "processing/simulation/motion_profile.hpp"
 
 namespace gyrod::processing {
 

@@ -46,8 +46,8 @@
 #include <cstddef>
 #include <vector>
 
-#include "processing/simulation/motion_profile.hpp"
 #include "processing/base/noise_terms.hpp"
+#include "processing/simulation/motion_profile.hpp"
 
 namespace gyrod::processing {
 

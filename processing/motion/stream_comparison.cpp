@@ -7,8 +7,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "processing/paper/axis_analysis.hpp"
 #include "processing/base/detrend.hpp"
+#include "processing/paper/axis_analysis.hpp"
 
 namespace gyrod::processing {
 namespace {

@@ -17,9 +17,9 @@
 #include <optional>
 #include <string_view>
 
+#include "processing/motion/rate_estimator.hpp"
 #include "processing/paper/filter_chain.hpp"
 #include "processing/simulation/noise_simulator.hpp"
-#include "processing/motion/rate_estimator.hpp"
 
 namespace gyrod::processing {
 

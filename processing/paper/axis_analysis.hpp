@@ -9,11 +9,11 @@
 #include <vector>
 
 #include "processing/allan/allan.hpp"
-#include "processing/paper/ar_model.hpp"
+#include "processing/allan/noise_fit.hpp"
 #include "processing/base/detrend.hpp"
+#include "processing/paper/ar_model.hpp"
 #include "processing/paper/filter_chain.hpp"
 #include "processing/paper/mean_filter.hpp"
-#include "processing/allan/noise_fit.hpp"
 #include "processing/paper/statistics_tests.hpp"
 
 namespace gyrod::processing {

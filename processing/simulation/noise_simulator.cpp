@@ -7,8 +7,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "processing/simulation/motion_profile.hpp"
 #include "processing/base/portable_math.hpp"
+#include "processing/simulation/motion_profile.hpp"
 
 namespace gyrod::processing {
 namespace {

@@ -18,9 +18,9 @@
 #include <string>
 #include <vector>
 
-#include "processing/simulation/motion_profile.hpp"
 #include "processing/base/noise_terms.hpp"
 #include "processing/base/portable_random.hpp"
+#include "processing/simulation/motion_profile.hpp"
 #include "processing/simulation/sensor_model.hpp"
 
 namespace gyrod::processing {

@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "processing/allan/allan.hpp"
-#include "processing/paper/axis_analysis.hpp"
 #include "processing/base/parallel_share.hpp"
+#include "processing/paper/axis_analysis.hpp"
 
 using namespace gyrod::processing;
 

@@ -8,9 +8,9 @@
 #include <stdexcept>
 #include <vector>
 
-#include "processing/model_check/known_form_detectors.hpp"
-#include "processing/model_check/detail.hpp"
 #include "processing/base/portable_random.hpp"
+#include "processing/model_check/detail.hpp"
+#include "processing/model_check/known_form_detectors.hpp"
 
 using namespace gyrod::processing;
 

@@ -15,10 +15,10 @@
 #include <utility>
 #include <vector>
 
+#include "processing/base/noise_terms.hpp"
 #include "processing/model_check/hidden_effect_generator.hpp"
 #include "processing/model_check/model_check.hpp"
 #include "processing/simulation/noise_simulator.hpp"
-#include "processing/base/noise_terms.hpp"
 
 using namespace gyrod::processing;
 

@@ -8,10 +8,10 @@
 #include <cmath>
 #include <vector>
 
-#include "processing/model_check/hidden_effect_generator.hpp"
-#include "processing/model_check/model_check.hpp"
-#include "processing/model_check/intervals.hpp"
 #include "processing/base/portable_random.hpp"
+#include "processing/model_check/hidden_effect_generator.hpp"
+#include "processing/model_check/intervals.hpp"
+#include "processing/model_check/model_check.hpp"
 
 using namespace gyrod::processing;
 

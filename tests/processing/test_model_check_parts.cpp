@@ -12,10 +12,10 @@
 
 #include "processing/allan/allan.hpp"
 #include "processing/base/distributions.hpp"
-#include "processing/model_check/model_check.hpp"
-#include "processing/model_check/detail.hpp"
-#include "processing/simulation/noise_simulator.hpp"
 #include "processing/base/portable_random.hpp"
+#include "processing/model_check/detail.hpp"
+#include "processing/model_check/model_check.hpp"
+#include "processing/simulation/noise_simulator.hpp"
 
 using namespace gyrod::processing;
 using namespace gyrod::processing::model_check_detail;

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "processing/base/noise_terms.hpp"
 #include "processing/model_check/model_check.hpp"
 #include "processing/simulation/noise_simulator.hpp"
-#include "processing/base/noise_terms.hpp"
 
 using namespace gyrod::processing;
 

@@ -18,8 +18,8 @@
 
 #include "fixed_threads.hpp"
 #include "processing/allan/allan.hpp"
-#include "processing/paper/axis_analysis.hpp"
 #include "processing/base/parallel_share.hpp"
+#include "processing/paper/axis_analysis.hpp"
 
 using namespace gyrod::processing;
 

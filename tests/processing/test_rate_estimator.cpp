@@ -15,11 +15,11 @@
 #include <vector>
 
 #include "processing/allan/allan.hpp"
+#include "processing/allan/noise_fit.hpp"
+#include "processing/motion/rate_estimator.hpp"
 #include "processing/paper/filter_chain.hpp"
 #include "processing/paper/kalman.hpp"
-#include "processing/allan/noise_fit.hpp"
 #include "processing/simulation/noise_simulator.hpp"
-#include "processing/motion/rate_estimator.hpp"
 
 // Counts every allocation in this test program, to show that update() makes none.
 namespace {

@@ -9,8 +9,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "processing/simulation/noise_simulator.hpp"
 #include "processing/motion/still_detector.hpp"
+#include "processing/simulation/noise_simulator.hpp"
 
 using namespace gyrod::processing;
 

@@ -14,9 +14,9 @@
 
 #include "formats/calibration.hpp"
 #include "formats/model_toml.hpp"
+#include "processing/motion/rate_estimator.hpp"
 #include "processing/simulation/motion_profile.hpp"
 #include "processing/simulation/noise_simulator.hpp"
-#include "processing/motion/rate_estimator.hpp"
 #include "tools/run_command.hpp"
 
 using namespace gyrod::recording;

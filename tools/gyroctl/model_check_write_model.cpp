@@ -17,10 +17,10 @@
 #include "formats/model_toml.hpp"
 #include "formats/output_file.hpp"
 #include "formats/recording_csv.hpp"
-#include "processing/simulation/noise_simulator.hpp"
 #include "processing/base/noise_terms.hpp"
-#include "processing/simulation/sensor_model.hpp"
 #include "processing/motion/warm_up_fit.hpp"
+#include "processing/simulation/noise_simulator.hpp"
+#include "processing/simulation/sensor_model.hpp"
 #include "tools/gyroctl/exit_codes.hpp"
 #include "tools/gyroctl/model_check_support.hpp"
 
