@@ -9,6 +9,6 @@ add_library(gyrod_daemon_config STATIC
   ${CMAKE_CURRENT_LIST_DIR}/recorder.cpp)
 target_include_directories(gyrod_daemon_config PUBLIC ${PROJECT_SOURCE_DIR})
 target_link_libraries(gyrod_daemon_config
-  PUBLIC spdlog::spdlog gyrod_processing gyrod_formats Threads::Threads
+  PUBLIC spdlog::spdlog gyrod_motion gyrod_formats Threads::Threads
   PRIVATE CLI11::CLI11)
 target_compile_definitions(gyrod_daemon_config PRIVATE GYROD_VERSION="${PROJECT_VERSION}")
