@@ -17,8 +17,10 @@ build=build-fuzz
 start=$(date +%s)
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+generator=()
+[ -f "$build/CMakeCache.txt" ] || ! command -v ninja >/dev/null || generator=(-G Ninja)
 mkdir -p "$build"
-nice -n 10 cmake -S . -B "$build" -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGYROD_FUZZ=ON \
+nice -n 10 cmake -S . -B "$build" "${generator[@]}" -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGYROD_FUZZ=ON \
   -DGYROD_BUILD_TESTS=OFF -DGYROD_BUILD_BENCHMARKS=OFF "${launcher[@]}" >"$build/configure.log" 2>&1 ||
   { cat "$build/configure.log" >&2; echo "fuzz: cmake configure failed" >&2; exit 2; }
 nice -n 10 cmake --build "$build" -j "${FUZZ_JOBS:-2}" --target gyrod_fuzzers
