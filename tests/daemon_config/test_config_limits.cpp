@@ -76,7 +76,8 @@ TEST(ConfigLimits, TheLargestConsumerIsNamed) {
 
 TEST(ConfigLimits, MemoryMbIsChecked) {
   EXPECT_EQ(parseConfig("[limits]\nmemory_mb = 4096\n", "x.toml").limits.memory_mb, 4096.0);
-  EXPECT_TRUE(contains(limitsErrorOf("[limits]\nmemory_mb = 0\n"), "x.toml:2: key 'limits.memory_mb': must be 16..1e9 MB"));
+  EXPECT_TRUE(
+      contains(limitsErrorOf("[limits]\nmemory_mb = 0\n"), "x.toml:2: key 'limits.memory_mb': must be 16..1e9 MB"));
   EXPECT_TRUE(contains(limitsErrorOf("[limits]\nmemory_mb = nan\n"), "key 'limits.memory_mb'"));
   EXPECT_TRUE(contains(limitsErrorOf("[limits]\nmemory = 1\n"), "unknown key 'memory' in [limits]"));
 }

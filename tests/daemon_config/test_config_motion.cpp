@@ -40,9 +40,10 @@ TEST(ConfigMockMotion, BadSpecNamesFileLineKeyAndProblem) {
             "x.toml:2: key 'mock.motion': motion: sine: freq must be finite and > 0, got -1 "
             "(got \"sine:axis=x,freq=-1,amp=20\")");
   EXPECT_NE(motionErrorOf("[mock]\nmotion = 30\n").find("x.toml:2: key 'mock.motion'"), std::string::npos);
-  EXPECT_EQ(motionErrorOf("[mock]\nsource = \"replay\"\nreplay_file = \"r.csv\"\nmotion = \"constant:axis=z,rate=1\"\n"),
-            "x.toml:4: key 'mock.motion': applies to source = \"simulator\" only (a replayed recording already "
-            "holds its motion) (got \"constant:axis=z,rate=1\")");
+  EXPECT_EQ(
+      motionErrorOf("[mock]\nsource = \"replay\"\nreplay_file = \"r.csv\"\nmotion = \"constant:axis=z,rate=1\"\n"),
+      "x.toml:4: key 'mock.motion': applies to source = \"simulator\" only (a replayed recording already "
+      "holds its motion) (got \"constant:axis=z,rate=1\")");
 }
 
 TEST(ConfigMockMotion, CsvSpecIsReadAndItsErrorsNameBothFiles) {

@@ -26,7 +26,7 @@ namespace fs = std::filesystem;
 namespace {
 
 std::string limitsMockConfig(const fs::path& dir, double speed, const std::string& record_extra = "",
-                       const std::string& extra = "") {
+                             const std::string& extra = "") {
   std::ostringstream c;
   c << "[device]\nbackend = \"mock\"\nrate_hz = 50\n"
     << "[bias]\nsource = \"config\"\nvalues = [0, 0, 0]\n"

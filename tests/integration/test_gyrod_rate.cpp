@@ -256,7 +256,8 @@ TEST(GyrodRate, SighupAppliesANewModelWithoutLosingTheStreamAndABadOneChangesNot
   for (const json& r : before) {
     ASSERT_TRUE(r.contains("rate")) << r.dump();  // raw − the configured bias, from the first sample
     EXPECT_FALSE(r.contains("still")) << r.dump();
-    for (int a = 0; a < 3; ++a) EXPECT_EQ(r["rate"][a].get<double>(), r["raw"][a].get<double>() - kMockBias[a]) << r.dump();
+    for (int a = 0; a < 3; ++a)
+      EXPECT_EQ(r["rate"][a].get<double>(), r["raw"][a].get<double>() - kMockBias[a]) << r.dump();
   }
 
   // A model file that does not parse: the running stream is kept.
