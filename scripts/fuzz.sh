@@ -5,7 +5,8 @@
 # targets, runs each on a copy of its seed corpus (the tree's corpus never grows), prints the
 # executions, exec/s and coverage per target, and exits non-zero on any crash, leak, timeout
 # or out-of-memory, leaving the input in build-fuzz/fuzz-artifacts/TARGET/.
-# Environment: FUZZ_JOBS (build jobs, default 2), FUZZ_TARGETS (space-separated subset).
+# Environment: FUZZ_JOBS (build jobs, default 2), FUZZ_PARALLEL (targets fuzzed at once, each on
+# one core; default the number of cores), FUZZ_TARGETS (space-separated subset).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-45}
@@ -16,8 +17,10 @@ build=build-fuzz
 start=$(date +%s)
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+generator=()
+[ -f "$build/CMakeCache.txt" ] || ! command -v ninja >/dev/null || generator=(-G Ninja)
 mkdir -p "$build"
-nice -n 10 cmake -S . -B "$build" -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGYROD_FUZZ=ON \
+nice -n 10 cmake -S . -B "$build" "${generator[@]}" -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGYROD_FUZZ=ON \
   -DGYROD_BUILD_TESTS=OFF -DGYROD_BUILD_BENCHMARKS=OFF "${launcher[@]}" >"$build/configure.log" 2>&1 ||
   { cat "$build/configure.log" >&2; echo "fuzz: cmake configure failed" >&2; exit 2; }
 nice -n 10 cmake --build "$build" -j "${FUZZ_JOBS:-2}" --target gyrod_fuzzers
@@ -32,22 +35,46 @@ run_dir=$build/fuzz-run
 artifacts=$build/fuzz-artifacts
 rm -rf "$run_dir"
 mkdir -p "$run_dir"
+for target in $targets; do
+  [[ -n ${max_len[$target]+x} ]] || { echo "fuzz: unknown target '$target'" >&2; exit 2; }
+done
+
+# One target's run; its exit status is in $run_dir/TARGET.status.
+fuzz_one() {
+  local target=$1 corpus=$run_dir/$1/corpus log=$run_dir/$1.log dict=()
+  mkdir -p "$corpus" "$artifacts/$target"
+  cp fuzz/corpus/"$target"/* "$corpus"/
+  [[ -f fuzz/$target.dict ]] && dict=(-dict="fuzz/$target.dict")
+  echo "fuzz: $target for ${seconds}s (log $log)"
+  # Leaks are found by ASan's LeakSanitizer at each input's end (-detect_leaks=1, the default).
+  local status=0
+  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 nice -n 10 "$build/bin/fuzz_$target" \
+    -max_total_time="$seconds" -max_len="${max_len[$target]}" -timeout=10 -rss_limit_mb=2048 \
+    -print_final_stats=1 -artifact_prefix="$artifacts/$target/" "${dict[@]}" "$corpus" </dev/null >"$log" 2>&1 ||
+    status=$?
+  echo "$status" >"$run_dir/$target.status"
+}
+
+# Each libFuzzer process uses one core: FUZZ_PARALLEL of them at a time.
+parallel=${FUZZ_PARALLEL:-$(nproc)}
+[[ $parallel =~ ^[1-9][0-9]*$ ]] || { echo "fuzz: FUZZ_PARALLEL must be a positive integer (got '$parallel')" >&2; exit 2; }
+running=0
+for target in $targets; do
+  if ((running >= parallel)); then
+    wait -n
+    running=$((running - 1))
+  fi
+  fuzz_one "$target" &
+  running=$((running + 1))
+done
+wait
+
 failed=()
 rows=()
 for target in $targets; do
-  [[ -n ${max_len[$target]+x} ]] || { echo "fuzz: unknown target '$target'" >&2; exit 2; }
-  corpus=$run_dir/$target/corpus
-  mkdir -p "$corpus" "$artifacts/$target"
-  cp fuzz/corpus/"$target"/* "$corpus"/
-  dict=()
-  [[ -f fuzz/$target.dict ]] && dict=(-dict="fuzz/$target.dict")
   log=$run_dir/$target.log
-  echo "fuzz: $target for ${seconds}s (log $log)"
   status=ok
-  # Leaks are found by ASan's LeakSanitizer at each input's end (-detect_leaks=1, the default).
-  if ! UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 nice -n 10 "$build/bin/fuzz_$target" \
-    -max_total_time="$seconds" -max_len="${max_len[$target]}" -timeout=10 -rss_limit_mb=2048 \
-    -print_final_stats=1 -artifact_prefix="$artifacts/$target/" "${dict[@]}" "$corpus" </dev/null >"$log" 2>&1; then
+  if [[ $(cat "$run_dir/$target.status" 2>/dev/null) != 0 ]]; then
     status=FAILED
     failed+=("$target")
     echo "fuzz: $target FAILED; the end of its log:" >&2

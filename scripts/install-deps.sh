@@ -3,7 +3,7 @@
 # "Dependencies"). Does nothing when all are present; needs root otherwise.
 set -euo pipefail
 packages=(
-  g++ cmake make pkg-config
+  g++ cmake make ninja-build pkg-config
   libeigen3-dev libboost-math-dev nlohmann-json3-dev libcli11-dev libtomlplusplus-dev
   libspdlog-dev libi2c-dev libgpiod-dev libsystemd-dev
   libgtest-dev libbenchmark-dev

@@ -11,7 +11,7 @@ using namespace gyrod::daemon;
 
 namespace {
 
-std::string errorOf(const std::string& text) {
+std::string accelErrorOf(const std::string& text) {
   try {
     parseConfig(text, "x.toml");
   } catch (const ConfigError& e) {
@@ -40,11 +40,11 @@ TEST(ConfigAccel, EveryRangeMapsToItsAfsSel) {
 }
 
 TEST(ConfigAccel, BadValuesNameFileLineKeyAndValue) {
-  EXPECT_EQ(errorOf("[device]\naccel_range_g = 3\n"),
+  EXPECT_EQ(accelErrorOf("[device]\naccel_range_g = 3\n"),
             "x.toml:2: key 'device.accel_range_g': must be 2, 4, 8 or 16 (got 3)");
-  EXPECT_EQ(errorOf("[device]\nrate_hz = 50\naccel_range_g = 32\n"),
+  EXPECT_EQ(accelErrorOf("[device]\nrate_hz = 50\naccel_range_g = 32\n"),
             "x.toml:3: key 'device.accel_range_g': must be 2, 4, 8 or 16 (got 32)");
-  const std::string not_bool = errorOf("[device]\naccel = 1\n");
+  const std::string not_bool = accelErrorOf("[device]\naccel = 1\n");
   EXPECT_EQ(not_bool.rfind("x.toml:2: key 'device.accel'", 0), 0u) << not_bool;
   EXPECT_EQ(exitCodeForConfigError(), 78);
 }

@@ -13,7 +13,7 @@ using namespace gyrod::daemon;
 
 namespace {
 
-std::string errorOf(const std::string& text) {
+std::string motionErrorOf(const std::string& text) {
   try {
     parseConfig(text, "x.toml");
   } catch (const ConfigError& e) {
@@ -33,16 +33,17 @@ TEST(ConfigMockMotion, ProfileTextIsKeptAsWritten) {
 }
 
 TEST(ConfigMockMotion, BadSpecNamesFileLineKeyAndProblem) {
-  EXPECT_EQ(errorOf("[mock]\nseed = 3\nmotion = \"step:axis=z,at=5,rat=10\"\n"),
+  EXPECT_EQ(motionErrorOf("[mock]\nseed = 3\nmotion = \"step:axis=z,at=5,rat=10\"\n"),
             "x.toml:3: key 'mock.motion': motion: step: unknown key 'rat' (keys: axis, at, rate) "
             "(got \"step:axis=z,at=5,rat=10\")");
-  EXPECT_EQ(errorOf("[mock]\nmotion = \"sine:axis=x,freq=-1,amp=20\"\n"),
+  EXPECT_EQ(motionErrorOf("[mock]\nmotion = \"sine:axis=x,freq=-1,amp=20\"\n"),
             "x.toml:2: key 'mock.motion': motion: sine: freq must be finite and > 0, got -1 "
             "(got \"sine:axis=x,freq=-1,amp=20\")");
-  EXPECT_NE(errorOf("[mock]\nmotion = 30\n").find("x.toml:2: key 'mock.motion'"), std::string::npos);
-  EXPECT_EQ(errorOf("[mock]\nsource = \"replay\"\nreplay_file = \"r.csv\"\nmotion = \"constant:axis=z,rate=1\"\n"),
-            "x.toml:4: key 'mock.motion': applies to source = \"simulator\" only (a replayed recording already "
-            "holds its motion) (got \"constant:axis=z,rate=1\")");
+  EXPECT_NE(motionErrorOf("[mock]\nmotion = 30\n").find("x.toml:2: key 'mock.motion'"), std::string::npos);
+  EXPECT_EQ(
+      motionErrorOf("[mock]\nsource = \"replay\"\nreplay_file = \"r.csv\"\nmotion = \"constant:axis=z,rate=1\"\n"),
+      "x.toml:4: key 'mock.motion': applies to source = \"simulator\" only (a replayed recording already "
+      "holds its motion) (got \"constant:axis=z,rate=1\")");
 }
 
 TEST(ConfigMockMotion, CsvSpecIsReadAndItsErrorsNameBothFiles) {
@@ -52,9 +53,9 @@ TEST(ConfigMockMotion, CsvSpecIsReadAndItsErrorsNameBothFiles) {
   std::ofstream(good) << "t,wz\n0,0\n10,30\n";
   std::ofstream(bad) << "t,wz\n0,0\n1,fast\n";
   EXPECT_EQ(parseConfig("[mock]\nmotion = \"" + good + "\"\n", "x.toml").mock.motion, good);
-  const std::string err = errorOf("[mock]\n\nmotion = \"" + bad + "\"\n");
+  const std::string err = motionErrorOf("[mock]\n\nmotion = \"" + bad + "\"\n");
   EXPECT_EQ(err.rfind("x.toml:3: key 'mock.motion': " + bad + ":3: column 'wz': 'fast' is not a number", 0), 0u) << err;
-  EXPECT_NE(errorOf("[mock]\nmotion = \"" + (dir / "none.csv").string() + "\"\n").find("none.csv: cannot open"),
+  EXPECT_NE(motionErrorOf("[mock]\nmotion = \"" + (dir / "none.csv").string() + "\"\n").find("none.csv: cannot open"),
             std::string::npos);
   std::filesystem::remove_all(dir);
 }
@@ -69,15 +70,15 @@ TEST(ConfigMockWarmUp, WarmUpAndCouplingAreReadAndChecked) {
             (std::vector<double>{0.01, 0.01, 0.01}));
   EXPECT_TRUE(GyrodConfig{}.mock.warm_up.empty());
   EXPECT_TRUE(GyrodConfig{}.mock.temperature_coefficient_dps_per_c.empty());
-  EXPECT_EQ(errorOf("[mock]\nwarm_up = \"15\"\n"),
+  EXPECT_EQ(motionErrorOf("[mock]\nwarm_up = \"15\"\n"),
             "x.toml:2: key 'mock.warm_up': warm-up: expected DELTA_C,TAU_S (e.g. 15,300), got '15' (got \"15\")");
   EXPECT_EQ(
-      errorOf("[mock]\n\nwarm_up = \"15,-1\"\n"),
+      motionErrorOf("[mock]\n\nwarm_up = \"15,-1\"\n"),
       "x.toml:3: key 'mock.warm_up': warm-up: the time constant TAU_S must be > 0 s, got '15,-1' (got \"15,-1\")");
-  EXPECT_NE(errorOf("[mock]\ntemperature_coefficient_dps_per_c = [1, 2]\n")
+  EXPECT_NE(motionErrorOf("[mock]\ntemperature_coefficient_dps_per_c = [1, 2]\n")
                 .find("x.toml:2: key 'mock.temperature_coefficient_dps_per_c'"),
             std::string::npos);
-  EXPECT_NE(errorOf("[mock]\nsource = \"replay\"\nreplay_file = \"r.csv\"\nwarm_up = \"15,300\"\n")
+  EXPECT_NE(motionErrorOf("[mock]\nsource = \"replay\"\nreplay_file = \"r.csv\"\nwarm_up = \"15,300\"\n")
                 .find("applies to source = \"simulator\" only"),
             std::string::npos);
 }

@@ -23,20 +23,20 @@ namespace fs = std::filesystem;
 
 namespace {
 
-class TempDir {
+class RecorderTempDir {
  public:
-  TempDir() {
+  RecorderTempDir() {
     char tmpl[] = "/tmp/gyrod-recorder-test-XXXXXX";
     path_ = mkdtemp(tmpl);
   }
-  ~TempDir() { fs::remove_all(path_); }
+  ~RecorderTempDir() { fs::remove_all(path_); }
   std::string path(const std::string& name = "") const { return (fs::path(path_) / name).string(); }
 
  private:
   std::string path_;
 };
 
-std::string readText(const std::string& path) {
+std::string recorderReadText(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::ostringstream s;
   s << in.rdbuf();
@@ -61,7 +61,7 @@ RecorderOptions options(const std::string& path) {
 }  // namespace
 
 TEST(Recorder, SamplesReadBackBitExactThroughTheRecordingReader) {
-  TempDir d;
+  RecorderTempDir d;
   std::mt19937_64 rng(7);
   std::normal_distribution<double> noise(0.0, 1.0);
   struct Row {
@@ -98,7 +98,7 @@ TEST(Recorder, SamplesReadBackBitExactThroughTheRecordingReader) {
     EXPECT_EQ(rec.temp[i], rows[i].temp) << i;
   }
   EXPECT_TRUE(std::signbit(rec.axes[1].back()));  // -0 survives
-  const auto text = readText(names[0]);
+  const auto text = recorderReadText(names[0]);
   EXPECT_NE(text.find("# device mock, rate_hz 50\n"), std::string::npos);
   // The column line first (numpy's genfromtxt(names=True) takes the first line), then the comments.
   EXPECT_EQ(linesOf(text)[0], "t,gx,gy,gz,temp");
@@ -106,7 +106,7 @@ TEST(Recorder, SamplesReadBackBitExactThroughTheRecordingReader) {
 }
 
 TEST(Recorder, GapsAreCommentLinesInStreamOrder) {
-  TempDir d;
+  RecorderTempDir d;
   std::string file;
   {
     Recorder rec(options(d.path("gyro.csv")));
@@ -118,7 +118,7 @@ TEST(Recorder, GapsAreCommentLinesInStreamOrder) {
     rec.pushGap(7, 0.14, 1, "weird reason\nwith newline, comma");
     rec.stop();
   }
-  const auto lines = linesOf(readText(file));
+  const auto lines = linesOf(recorderReadText(file));
   std::vector<std::string> tail(lines.end() - 5, lines.end());
   EXPECT_EQ(tail,
             (std::vector<std::string>{"0,1,2,3,25", "0.02,1,2,3,25", "# GAP seq=2 t=0.04 count=4 reason=fifo_overflow",
@@ -128,7 +128,7 @@ TEST(Recorder, GapsAreCommentLinesInStreamOrder) {
 }
 
 TEST(Recorder, NonFiniteSamplesAreKeptAsCommentsSoTheFileStaysReadable) {
-  TempDir d;
+  RecorderTempDir d;
   std::string file;
   {
     Recorder rec(options(d.path("gyro.csv")));
@@ -137,12 +137,12 @@ TEST(Recorder, NonFiniteSamplesAreKeptAsCommentsSoTheFileStaysReadable) {
     rec.pushSample(0.02, std::nan(""), 2, 3, 25);
     rec.pushSample(0.04, 1, 2, 3, 25);
   }
-  EXPECT_NE(readText(file).find("\n# NONFINITE 0.02,nan,2,3,25\n"), std::string::npos);
+  EXPECT_NE(recorderReadText(file).find("\n# NONFINITE 0.02,nan,2,3,25\n"), std::string::npos);
   EXPECT_EQ(readRecordingCsv(file).t, (std::vector<double>{0.0, 0.04}));
 }
 
 TEST(Recorder, RingFullDropsAreCountedAndMarkedWhereTheyHappened) {
-  TempDir d;
+  RecorderTempDir d;
   auto o = options(d.path("gyro.csv"));
   o.ring_capacity = 16;
   std::string file;
@@ -164,7 +164,7 @@ TEST(Recorder, RingFullDropsAreCountedAndMarkedWhereTheyHappened) {
     EXPECT_EQ(rec.stats().dropped, 6u);
     EXPECT_EQ(rec.stats().written, 32u);
   }
-  const auto lines = linesOf(readText(file));
+  const auto lines = linesOf(recorderReadText(file));
   const auto at = [&](const std::string& l) { return std::find(lines.begin(), lines.end(), l) - lines.begin(); };
   const auto drop4 = at("# DROPPED count=4 reason=ring_full");
   ASSERT_LT(drop4, static_cast<long>(lines.size()));
@@ -175,7 +175,7 @@ TEST(Recorder, RingFullDropsAreCountedAndMarkedWhereTheyHappened) {
 }
 
 TEST(Recorder, GapsAndDropsReadBackAsLostSampleRecords) {
-  TempDir d;
+  RecorderTempDir d;
   auto o = options(d.path("gyro.csv"));
   o.ring_capacity = 16;
   std::string file;
@@ -205,7 +205,7 @@ TEST(Recorder, GapsAndDropsReadBackAsLostSampleRecords) {
 
 TEST(Recorder, NoLineCrossesAPageBoundaryOfTheFile) {
   // The property that makes kill -9 safe: each write() stays inside one page.
-  TempDir d;
+  RecorderTempDir d;
   std::string file;
   {
     Recorder rec(options(d.path("gyro.csv")));
@@ -217,7 +217,7 @@ TEST(Recorder, NoLineCrossesAPageBoundaryOfTheFile) {
       if (i % 300 == 0) rec.flush();
     }
   }
-  const auto text = readText(file);
+  const auto text = recorderReadText(file);
   const auto page = static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
   ASSERT_GT(text.size(), 10 * page);
   for (std::size_t boundary = page; boundary <= text.size(); boundary += page)
@@ -227,7 +227,7 @@ TEST(Recorder, NoLineCrossesAPageBoundaryOfTheFile) {
 }
 
 TEST(Recorder, RotatesBySizeAndEveryFileStandsAlone) {
-  TempDir d;
+  RecorderTempDir d;
   auto o = options(d.path("gyro.csv"));
   o.rotate_bytes = 3000;
   const int n = 1000;
@@ -250,7 +250,7 @@ TEST(Recorder, RotatesBySizeAndEveryFileStandsAlone) {
     const auto r = readRecordingCsv(files[k]);  // each file has its own header
     gx.insert(gx.end(), r.axes[0].begin(), r.axes[0].end());
     if (k > 0) {
-      EXPECT_NE(readText(files[k]).find("# continues " + fs::path(files[k - 1]).filename().string() + "\n"),
+      EXPECT_NE(recorderReadText(files[k]).find("# continues " + fs::path(files[k - 1]).filename().string() + "\n"),
                 std::string::npos);
     }
   }
@@ -260,7 +260,7 @@ TEST(Recorder, RotatesBySizeAndEveryFileStandsAlone) {
 }
 
 TEST(Recorder, KeepsOnlyTheNewestFilesAndLeavesOtherFilesAlone) {
-  TempDir d;
+  RecorderTempDir d;
   std::ofstream(d.path("gyro.csv")) << "not ours\n";
   std::ofstream(d.path("gyro-notes.csv")) << "not ours\n";
   std::ofstream(d.path("other-20200101T000000Z-000000.csv")) << "not ours\n";
@@ -295,7 +295,7 @@ TEST(Recorder, KeepsOnlyTheNewestFilesAndLeavesOtherFilesAlone) {
 }
 
 TEST(Recorder, RotatesByTime) {
-  TempDir d;
+  RecorderTempDir d;
   auto o = options(d.path("gyro.csv"));
   o.rotate_after_s = 0.001;
   Recorder rec(o);
@@ -330,7 +330,7 @@ TEST(Recorder, FileNames) {
 }
 
 TEST(Recorder, CannotCreateTheFileIsAnErrorNamingThePath) {
-  TempDir d;
+  RecorderTempDir d;
   const auto path = d.path("missing-dir/gyro.csv");
   try {
     Recorder rec(options(path));
@@ -394,7 +394,7 @@ namespace {
 TEST(RecorderCrash, KillNineLeavesWholeLinesAndEverythingFlushedBeforeIt) {
   // Kill at different moments: after 3, 6 and 9 reported flushes.
   for (int flushes_before_kill : {3, 6, 9}) {
-    TempDir d;
+    RecorderTempDir d;
     int fds[2];
     ASSERT_EQ(::pipe(fds), 0);
     std::fflush(stdout);  // the child must not inherit (and later print) buffered output
@@ -426,7 +426,7 @@ TEST(RecorderCrash, KillNineLeavesWholeLinesAndEverythingFlushedBeforeIt) {
     std::vector<std::string> files;
     for (const auto& e : fs::directory_iterator(d.path())) files.push_back(e.path().string());
     ASSERT_EQ(files.size(), 1u);
-    const auto text = readText(files[0]);
+    const auto text = recorderReadText(files[0]);
     EXPECT_EQ(text.back(), '\n') << "torn last line";
     const auto rec = readRecordingCsv(files[0]);  // throws on a torn or malformed line
     ASSERT_GE(rec.size(), last_reported) << "lost records the recorder reported written";
@@ -467,14 +467,14 @@ RecorderOptions gyrodOptions(const std::string& path) {
 }  // namespace
 
 TEST(RecorderColumns, TheRateStreamAndTheWallClockAreRecordedAndReadBack) {
-  TempDir d;
+  RecorderTempDir d;
   std::string file;
   {
     Recorder rec(gyrodOptions(d.path("gyro.csv")));
     file = rec.currentFile();
     for (int i = 0; i < 20; ++i) ASSERT_TRUE(rec.pushSample(gyrodSample(i, false)));
   }
-  const auto lines = linesOf(readText(file));
+  const auto lines = linesOf(recorderReadText(file));
   EXPECT_EQ(lines[0], "t,gx,gy,gz,temp,time,gx_rate,gy_rate,gz_rate,gx_bias,gy_bias,gz_bias,still");
   EXPECT_EQ(lines[2], "0,0,-0.3333333333333333,0.5,25,1795000000.000000,,,,,,,");
   const auto rec = readRecordingCsv(file);
@@ -500,7 +500,7 @@ TEST(RecorderColumns, TheRateStreamAndTheWallClockAreRecordedAndReadBack) {
 }
 
 TEST(RecorderColumns, TheFirstSampleDecidesTheAccelColumns) {
-  TempDir d;
+  RecorderTempDir d;
   std::string file;
   {
     Recorder rec(gyrodOptions(d.path("gyro.csv")));
@@ -508,10 +508,10 @@ TEST(RecorderColumns, TheFirstSampleDecidesTheAccelColumns) {
     // A gap before any sample waits for the column line, which must stay the first line.
     rec.pushGap(0, 0.0, 2, "fifo_overflow");
     rec.flush();
-    EXPECT_EQ(readText(file), "");
+    EXPECT_EQ(recorderReadText(file), "");
     for (int i = 2; i < 10; ++i) ASSERT_TRUE(rec.pushSample(gyrodSample(i, true)));
   }
-  const auto lines = linesOf(readText(file));
+  const auto lines = linesOf(recorderReadText(file));
   EXPECT_EQ(lines[0], "t,gx,gy,gz,temp,time,ax,ay,az,gx_rate,gy_rate,gz_rate,gx_bias,gy_bias,gz_bias,still");
   EXPECT_EQ(lines[2], "# GAP seq=0 t=0 count=2 reason=fifo_overflow");
   EXPECT_EQ(lines[3], "0.04,0.02,-0.2,0.5,25.002,1795000000.040000,0.002,-0.002,1,,,,,,,");
@@ -528,7 +528,7 @@ TEST(RecorderColumns, TheFirstSampleDecidesTheAccelColumns) {
 }
 
 TEST(RecorderColumns, AFileWithoutSamplesStillHasItsHeader) {
-  TempDir d;
+  RecorderTempDir d;
   std::string file;
   {
     auto o = gyrodOptions(d.path("gyro.csv"));
@@ -536,7 +536,7 @@ TEST(RecorderColumns, AFileWithoutSamplesStillHasItsHeader) {
     Recorder rec(o);
     file = rec.currentFile();
   }
-  const auto lines = linesOf(readText(file));
+  const auto lines = linesOf(recorderReadText(file));
   ASSERT_EQ(lines.size(), 3u);
   EXPECT_EQ(lines[0], "t,gx,gy,gz,temp,time,gx_rate,gy_rate,gz_rate,gx_bias,gy_bias,gz_bias,still");
   EXPECT_EQ(lines[2], "# device mock");

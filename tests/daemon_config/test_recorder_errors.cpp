@@ -20,13 +20,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
-class TempDir {
+class ErrorsTempDir {
  public:
-  TempDir() {
+  ErrorsTempDir() {
     char tmpl[] = "/tmp/gyrod-recorder-errors-XXXXXX";
     path_ = mkdtemp(tmpl);
   }
-  ~TempDir() { fs::remove_all(path_); }
+  ~ErrorsTempDir() { fs::remove_all(path_); }
   std::string path(const std::string& name) const { return (fs::path(path_) / name).string(); }
 
  private:
@@ -58,7 +58,7 @@ class FileSizeLimit {
 }  // namespace
 
 TEST(RecorderWriteErrors, LossesAreCountedAndAnnouncedWhenWritingWorksAgain) {
-  TempDir d;
+  ErrorsTempDir d;
   RecorderOptions o;
   o.path = d.path("gyro.csv");
   o.flush_interval_s = 3600.0;  // only flush() and stop() write
@@ -103,7 +103,7 @@ TEST(RecorderWriteErrors, LossesAreCountedAndAnnouncedWhenWritingWorksAgain) {
 }
 
 TEST(RecorderWriteErrors, AFileThatCannotBeCreatedLosesRecordsWithTheCause) {
-  TempDir d;
+  ErrorsTempDir d;
   RecorderOptions o;
   o.path = d.path("sub/gyro.csv");
   fs::create_directory(d.path("sub"));
@@ -120,7 +120,7 @@ TEST(RecorderWriteErrors, AFileThatCannotBeCreatedLosesRecordsWithTheCause) {
 
 // A real full disk where the test may mount a 64 KiB tmpfs (root); skipped elsewhere.
 TEST(RecorderWriteErrors, AFullDiskIsADroppedLineWithReasonDiskFullOnceThereIsRoomAgain) {
-  TempDir d;
+  ErrorsTempDir d;
   const fs::path tiny = d.path("tiny");
   fs::create_directories(tiny);
   if (::mount("tmpfs", tiny.c_str(), "tmpfs", 0, "size=64k") != 0) GTEST_SKIP() << "cannot mount a tmpfs here";

@@ -56,7 +56,7 @@ TEST(LinuxI2cBus, ANonAdapterIsRefusedBecauseI2cFuncsFails) {
   ::close(fd);
   // qemu-user does not pass I2C_FUNCS to the kernel: it answers ENOSYS itself, where the
   // kernel answers ENOTTY. That the file is refused, and named, is still checked there.
-  const bool emulated = test::underEmulator();
+  const bool emulated = gyrod::test::underEmulator();
   for (const std::string& p : {std::string("/dev/null"), std::string(path)}) {
     const I2cBusError e = catchError<I2cBusError>([&] { LinuxI2cBus bus(p); });
     EXPECT_EQ(e.error(), emulated ? ENOSYS : ENOTTY) << p;
@@ -64,7 +64,7 @@ TEST(LinuxI2cBus, ANonAdapterIsRefusedBecauseI2cFuncsFails) {
     EXPECT_TRUE(contains(e.what(), p)) << e.what();
   }
   ::unlink(path);
-  if (test::underEmulator()) {
+  if (gyrod::test::underEmulator()) {
     GTEST_SKIP() << "emulator gap: qemu-user answers I2C_FUNCS with ENOSYS, not the kernel's ENOTTY; "
                     "the ENOTTY case is checked only on a native run";
   }

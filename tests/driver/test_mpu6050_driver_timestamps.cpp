@@ -12,7 +12,7 @@
 namespace gyrod::driver::test {
 namespace {
 
-SinusoidSource movingSource() {
+SinusoidSource movingTimestampSource() {
   return SinusoidSource(
       {SinusoidAxis{5.0, 100.0, 0.37, 0.0}, SinusoidAxis{-3.0, 80.0, 0.23, 1.0}, SinusoidAxis{1.0, 60.0, 0.61, 2.0}},
       25.0);
@@ -37,7 +37,7 @@ std::vector<double> timeErrors(const DriverRig& rig, std::size_t skip) {
 
 TEST(Mpu6050DriverTimestamps, ChipClockErrorOfSeveralPercentIsMeasured) {
   for (double ppm : {30'000.0, -25'000.0, 70'000.0}) {
-    SinusoidSource source = movingSource();
+    SinusoidSource source = movingTimestampSource();
     RigOptions o;
     o.mock.clock_error_ppm = ppm;
     DriverRig rig(source, o);
@@ -56,7 +56,7 @@ TEST(Mpu6050DriverTimestamps, InterruptLatencyJitterIsSmoothedNotFollowed) {
   // eases with β = 0.1, so its error has s.d. ≈ 57.7·√(β/(2−β)) ≈ 13 µs; a model that
   // jumped to each edge would show the full 57.7 µs. Accept < 29 µs (half the latency s.d.).
   for (std::uint64_t seed : {1u, 2u, 3u}) {
-    SinusoidSource source = movingSource();
+    SinusoidSource source = movingTimestampSource();
     RigOptions o;
     o.mock.clock_error_ppm = 15'000.0;
     o.edge_latency_ns = 200'000;
@@ -87,7 +87,7 @@ TEST(Mpu6050DriverTimestamps, InterruptLatencyJitterIsSmoothedNotFollowed) {
 }
 
 TEST(Mpu6050DriverTimestamps, ImplausibleEdgesAreRejectedAndDoNotMoveTheTimestamps) {
-  SinusoidSource source = movingSource();
+  SinusoidSource source = movingTimestampSource();
   RigOptions o;
   o.edge_latency_ns = 1;  // route edges through the wrapper (latency 0..1 ns)
   DriverRig rig(source, o);
@@ -104,7 +104,7 @@ TEST(Mpu6050DriverTimestamps, ImplausibleEdgesAreRejectedAndDoNotMoveTheTimestam
 TEST(Mpu6050DriverTimestamps, PollingModeTimestampsWithinAPeriodAndGapsWithinOne) {
   // Without edges the newest sample is 0..P old at each poll: timestamps are good to a
   // fraction of a period and a gap's count may be off by one (docs/driver.md).
-  SinusoidSource source = movingSource();
+  SinusoidSource source = movingTimestampSource();
   RigOptions o;
   o.driver = withPolling(o.driver);
   o.mock.clock_error_ppm = 20'000.0;
@@ -133,7 +133,7 @@ TEST(Mpu6050DriverTimestamps, PollingModeTimestampsWithinAPeriodAndGapsWithinOne
 // The wall clock of a sample is its t plus the clock's realtime offset, read once per burst
 // (driver/clock.hpp): on the virtual clock, a fixed offset, so wall − t is that offset exactly.
 TEST(Mpu6050DriverTimestamps, WallClockIsTheSameEdgeOnTheRealtimeClock) {
-  SinusoidSource source = movingSource();
+  SinusoidSource source = movingTimestampSource();
   DriverRig rig(source);
   constexpr std::int64_t kOffset = 1'795'000'000'000'000'000;
   rig.clock.setRealtimeOffsetNs(kOffset);

@@ -21,21 +21,21 @@ namespace fs = std::filesystem;
 
 namespace {
 
-class TempFile {
+class HostileTempFile {
  public:
-  explicit TempFile(const std::string& text) {
+  explicit HostileTempFile(const std::string& text) {
     path_ = (fs::temp_directory_path() / ("gyrod-hostile-test-" + std::to_string(::getpid()) + ".csv")).string();
     std::ofstream(path_, std::ios::binary) << text;
   }
-  ~TempFile() { std::remove(path_.c_str()); }
+  ~HostileTempFile() { std::remove(path_.c_str()); }
   const std::string& path() const { return path_; }
 
  private:
   std::string path_;
 };
 
-std::string errorOf(const std::string& text, std::string* path = nullptr) {
-  TempFile f(text);
+std::string hostileErrorOf(const std::string& text, std::string* path = nullptr) {
+  HostileTempFile f(text);
   if (path) *path = f.path();
   try {
     (void)readRecordingCsv(f.path());
@@ -99,28 +99,28 @@ TEST(BoundedLineReader, LastLineWithoutNewlineAndNulBytes) {
 TEST(RecordingHostileInput, ALineLongerThanTheLimitIsRefusedWithItsLine) {
   std::string path;
   const std::string long_line = "0.04," + std::string(kMaxLineBytes, '1') + "\n";
-  const auto e = errorOf("t,gx\n0,1\n0.02,2\n" + long_line + "0.06,3\n", &path);
+  const auto e = hostileErrorOf("t,gx\n0,1\n0.02,2\n" + long_line + "0.06,3\n", &path);
   EXPECT_EQ(e, path + ":4: line longer than 65536 bytes (the limit for one line)");
   // Exactly the limit is still a line (here refused for its value, not its length).
-  const auto at_limit = errorOf("t,gx\n0," + std::string(kMaxLineBytes - 2, '1') + "\n", &path);
+  const auto at_limit = hostileErrorOf("t,gx\n0," + std::string(kMaxLineBytes - 2, '1') + "\n", &path);
   EXPECT_EQ(at_limit.rfind(path + ":2: column 'gx': non-finite value '111", 0), 0u) << at_limit.substr(0, 200);
   EXPECT_NE(at_limit.find("…' (65534 bytes)"), std::string::npos) << at_limit.substr(0, 200);
 }
 
 TEST(RecordingHostileInput, BadValuesAreEscapedAndCut) {
   std::string path;
-  std::string e = errorOf("t,gx\n0,1\n0.02,\x1b]0;pwned\x07\n", &path);
+  std::string e = hostileErrorOf("t,gx\n0,1\n0.02,\x1b]0;pwned\x07\n", &path);
   EXPECT_EQ(e, path + ":3: column 'gx': '\\x1B]0;pwned\\x07' is not a number");
-  e = errorOf("t,gx\n0,1\u202E2\n", &path);
+  e = hostileErrorOf("t,gx\n0,1\u202E2\n", &path);
   EXPECT_EQ(e, path + ":2: column 'gx': '1\\u{202E}2' is not a number");
   const char with_nul[] = "t,gx\n0,1\0 trailing hidden\n";
-  e = errorOf(std::string(with_nul, sizeof with_nul - 1), &path);
+  e = hostileErrorOf(std::string(with_nul, sizeof with_nul - 1), &path);
   EXPECT_EQ(e, path + ":2: column 'gx': '1\\x00 trailing hidden' is not a number");
   const std::string huge_number = "1" + std::string(20'000, '0');
-  e = errorOf("t,gx\n0," + huge_number + "\n", &path);
+  e = hostileErrorOf("t,gx\n0," + huge_number + "\n", &path);
   EXPECT_EQ(e, path + ":2: column 'gx': non-finite value '" + huge_number.substr(0, kQuotedValueMaxChars) +
                    "…' (20001 bytes)");
-  e = errorOf("t,g\x1b[2J\n", &path);
+  e = hostileErrorOf("t,g\x1b[2J\n", &path);
   EXPECT_EQ(e, path + ":1: unknown column 'g\\x1B[2J' (expected any of t,gx,gy,gz,temp,wx,wy,wz,ax,ay,az)");
 }
 
@@ -142,7 +142,7 @@ TEST(RecordingHostileInput, ADirectoryIsNotAnEmptyFile) {
 
 // The motion CSV of `simulate --motion` is bounded like a recording.
 TEST(RecordingHostileInput, AMotionCsvLineLongerThanTheLimitIsRefusedWithItsLine) {
-  TempFile f("t,wz\n0,1\n1," + std::string(kMaxLineBytes + 10, '2') + "\n2,3\n");
+  HostileTempFile f("t,wz\n0,1\n1," + std::string(kMaxLineBytes + 10, '2') + "\n2,3\n");
   std::string message;
   try {
     (void)readMotionCsv(f.path());
@@ -150,6 +150,6 @@ TEST(RecordingHostileInput, AMotionCsvLineLongerThanTheLimitIsRefusedWithItsLine
     message = e.what();
   }
   EXPECT_EQ(message, f.path() + ":3: line longer than 65536 bytes (the limit for one line)");
-  TempFile g("t,wz\n0,1\n1,2");  // no newline at the end: still read
+  HostileTempFile g("t,wz\n0,1\n1,2");  // no newline at the end: still read
   EXPECT_EQ(readMotionCsv(g.path()).rateAt(1.0)[2], 2.0);
 }

@@ -11,7 +11,7 @@ using namespace gyrod::formats;
 
 namespace {
 
-std::string errorOf(const std::string& text) {
+std::string kalibrErrorOf(const std::string& text) {
   try {
     parseKalibrImuYaml(text, "imu.yaml");
   } catch (const std::runtime_error& e) {
@@ -60,8 +60,8 @@ TEST(KalibrYaml, ATermNotEstimatedIsACommentWithItsReason) {
 }
 
 TEST(KalibrYaml, BadLinesNameFileLineAndValue) {
-  EXPECT_EQ(errorOf("update_rate: 100\ngyroscope_noise_density: fast\n"),
+  EXPECT_EQ(kalibrErrorOf("update_rate: 100\ngyroscope_noise_density: fast\n"),
             "imu.yaml:2: gyroscope_noise_density: 'fast' is not a number");
-  EXPECT_EQ(errorOf("# c\nno colon here\n"), "imu.yaml:2: 'no colon here' is not 'key: value'");
-  EXPECT_EQ(errorOf("gyro_noise: 1\n"), "imu.yaml:1: unknown key 'gyro_noise'");
+  EXPECT_EQ(kalibrErrorOf("# c\nno colon here\n"), "imu.yaml:2: 'no colon here' is not 'key: value'");
+  EXPECT_EQ(kalibrErrorOf("gyro_noise: 1\n"), "imu.yaml:1: unknown key 'gyro_noise'");
 }

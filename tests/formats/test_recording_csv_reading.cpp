@@ -26,13 +26,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
-class TempFile {
+class ReadingTempFile {
  public:
-  explicit TempFile(const std::string& text) {
+  explicit ReadingTempFile(const std::string& text) {
     path_ = (fs::temp_directory_path() / ("gyrod-reading-test-" + std::to_string(::getpid()) + ".csv")).string();
     std::ofstream(path_, std::ios::binary) << text;
   }
-  ~TempFile() { std::remove(path_.c_str()); }
+  ~ReadingTempFile() { std::remove(path_.c_str()); }
   const std::string& path() const { return path_; }
 
  private:
@@ -68,7 +68,7 @@ Written longFile() {
 TEST(RecordingReading, SamplesAndLinesSurviveChunkBoundaries) {
   const Written w = longFile();
   ASSERT_GT(w.text.size(), 3u << 20);
-  TempFile f(w.text);
+  ReadingTempFile f(w.text);
   const Recording rec = readRecordingCsv(f.path());
   ASSERT_EQ(rec.size(), w.gy.size());
   EXPECT_EQ(*rec.axis("gy"), w.gy);
@@ -86,7 +86,7 @@ TEST(RecordingReading, TheLineLimitHoldsAcrossAChunkBoundary) {
   Written w = longFile();
   const std::size_t lines_before = w.lines.back();
   w.text += "1," + std::string(kMaxLineBytes, '2') + "\n0,1,2\n";
-  TempFile f(w.text);
+  ReadingTempFile f(w.text);
   try {
     (void)readRecordingCsv(f.path());
     FAIL() << "accepted a line longer than the limit";
@@ -112,7 +112,7 @@ TEST(RecordingReading, TheFirstBadLineIsNamedWhereverItFalls) {
   };
   for (std::size_t sample : {std::size_t{0}, std::size_t{9'000}, std::size_t{11'000}, std::size_t{21'000},
                              std::size_t{40'000}, std::size_t{59'999}}) {
-    TempFile f(withBadSample(w.text, sample));
+    ReadingTempFile f(withBadSample(w.text, sample));
     try {
       (void)readRecordingCsv(f.path());
       FAIL() << "accepted a bad value at sample " << sample;
@@ -122,7 +122,7 @@ TEST(RecordingReading, TheFirstBadLineIsNamedWhereverItFalls) {
     }
   }
   // Two bad lines a few kB apart (one chunk, most likely in both of its slices): the first.
-  TempFile two(withBadSample(withBadSample(w.text, 30'000), 25'000));
+  ReadingTempFile two(withBadSample(withBadSample(w.text, 30'000), 25'000));
   try {
     (void)readRecordingCsv(two.path());
     FAIL() << "accepted two bad values";
@@ -159,7 +159,7 @@ TEST(RecordingReading, ABadLineAtASliceOrBatchEdgeIsNamed) {
       text.replace(at, text.find('\n', at) - at, "0,1,x");
       const auto line =
           static_cast<std::size_t>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n')) + 1;
-      TempFile f(text);
+      ReadingTempFile f(text);
       try {
         (void)readRecordingCsv(f.path());
         FAIL() << "accepted a bad value at line " << line;
@@ -177,7 +177,7 @@ TEST(RecordingReading, OneCoreAndTwoCoresReadTheSame) {
   RecordingLine gap;
   w.text += formatGapLine(gap, 60'000, 1200.0, 3, "fifo_overflow");
   w.text += "1200.06,0.5,0.25\n";
-  TempFile f(w.text);
+  ReadingTempFile f(w.text);
   std::vector<Recording> read;
   for (const std::size_t threads : {std::size_t{1}, std::size_t{2}}) {
     const FixedThreads fixed(threads);
@@ -212,7 +212,7 @@ TEST(RecordingReading, GapRecordsKeepTheirPlaceInLongFiles) {
     ++line;
     ++samples;
   }
-  TempFile f(text);
+  ReadingTempFile f(text);
   const Recording rec = readRecordingCsv(f.path());
   EXPECT_EQ(rec.size(), samples);
   EXPECT_EQ(rec.lost, expected);
@@ -223,7 +223,7 @@ TEST(RecordingReading, ProgressIsReportedEveryMillionLines) {
   const std::size_t count = kProgressLines * 2 + 10;
   text.reserve(count * 2);
   for (std::size_t i = 0; i < count; ++i) text += "1\n";
-  TempFile f(text);
+  ReadingTempFile f(text);
   std::vector<std::size_t> reported_lines;
   std::vector<std::uint64_t> reported_bytes;
   ReadOptions options;
@@ -274,7 +274,7 @@ TEST(RecordingReading, PlainAndDecoratedLinesGiveTheSameValues) {
   ASSERT_GT(plain.str().size(), 3u << 20);
   std::vector<Recording> read;
   for (const std::string& text : {plain.str(), mixed.str()}) {
-    TempFile f(text);
+    ReadingTempFile f(text);
     read.push_back(readRecordingCsv(f.path()));
   }
   ASSERT_EQ(read[0].size(), count);
@@ -300,7 +300,7 @@ TEST(RecordingReading, ABadValueAmongPlainLinesIsNamed) {
   std::string text = "t,gx\n";
   for (int i = 0; i < 1000; ++i) text += std::to_string(i) + ".5,0.25\n";
   text += "1000.5,0.2x5\n";
-  TempFile f(text);
+  ReadingTempFile f(text);
   try {
     readRecordingCsv(f.path());
     FAIL() << "no error";

@@ -22,12 +22,12 @@ using namespace std::chrono_literals;
 
 namespace {
 
-const char* kBias = "-3.34, 1.09, -0.5";
+const char* kBiasText = "-3.34, 1.09, -0.5";
 
 std::string mockConfig(const std::filesystem::path& dir, double speed, const std::string& extra = "") {
   std::ostringstream c;
   c << "[device]\nbackend = \"mock\"\nrate_hz = 50\n"
-    << "[bias]\nsource = \"config\"\nvalues = [" << kBias << "]\n"
+    << "[bias]\nsource = \"config\"\nvalues = [" << kBiasText << "]\n"
     << "[filter]\nmean_window = 20\nmean_threshold_dps = 0.3\n"
     << "[filter.kalman]\na = 0.9\nq = 0.0001\nr = 0.01\n"
     << "[socket]\npath = \"" << (dir / "gyrod.sock").string() << "\"\n"

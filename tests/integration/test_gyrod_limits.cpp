@@ -25,8 +25,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string mockConfig(const fs::path& dir, double speed, const std::string& record_extra = "",
-                       const std::string& extra = "") {
+std::string limitsMockConfig(const fs::path& dir, double speed, const std::string& record_extra = "",
+                             const std::string& extra = "") {
   std::ostringstream c;
   c << "[device]\nbackend = \"mock\"\nrate_hz = 50\n"
     << "[bias]\nsource = \"config\"\nvalues = [0, 0, 0]\n"
@@ -140,7 +140,7 @@ TEST(GyrodLimits, AFailedRecordingWriteIsInStatusTheRecordingAndTheShutdownLine)
   ScratchDir d;
   // 16 KiB per file: the first file is full after ~270 samples (0.3 s at 20x); a new file
   // every 0.6 s of real time carries the DROPPED line of what the full one lost.
-  const auto cfg = d.write("gyrod.toml", mockConfig(d.path(), 20.0, "rotate_minutes = 0.01\nkeep = 0\n"));
+  const auto cfg = d.write("gyrod.toml", limitsMockConfig(d.path(), 20.0, "rotate_minutes = 0.01\nkeep = 0\n"));
   GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt", limitFileSize);
   LineClient c((d.path() / "gyrod.sock").string());
   ASSERT_TRUE(c.connected());
@@ -187,7 +187,7 @@ TEST(GyrodLimits, AFailedRecordingWriteIsInStatusTheRecordingAndTheShutdownLine)
 
 TEST(GyrodLimits, TheRecorderKeepsUpWithTheMockAtFiftyTimesRealTime) {
   ScratchDir d;
-  const auto cfg = d.write("gyrod.toml", mockConfig(d.path(), 1.0, "", ""));
+  const auto cfg = d.write("gyrod.toml", limitsMockConfig(d.path(), 1.0, "", ""));
   std::string text = readWholeFile(cfg);
   text.replace(text.find("flush_interval_s = 0.1"), 22, "flush_interval_s = 1  ");
   d.write("gyrod.toml", text);
@@ -219,7 +219,7 @@ TEST(GyrodLimits, TheRecorderKeepsUpWithTheMockAtFiftyTimesRealTime) {
 TEST(GyrodLimits, RecordIntoAFolderWritesInsideIt) {
   ScratchDir d;
   fs::create_directory(d.path() / "recordings");
-  const auto cfg = d.write("gyrod.toml", mockConfig(d.path(), 20.0));
+  const auto cfg = d.write("gyrod.toml", limitsMockConfig(d.path(), 20.0));
   for (const std::string flag : {"recordings", "recordings/"}) {
     GyrodProcess gyrod({"--config", cfg.string(), "--record", (d.path() / flag).string()}, d.path() / "log.txt");
     LineClient c((d.path() / "gyrod.sock").string());

@@ -26,13 +26,13 @@ using namespace std::chrono_literals;
 
 namespace {
 
-constexpr double kMotionStartS = 4.0;
+constexpr double kTurnStartS = 4.0;
 // With accel the still detector says "moving" until its accel window (250 samples, 5 s) is full
 // (docs/motion.md), so the rest before the turn must last longer to be seen.
 constexpr double kMotionStartWithAccelS = 9.0;
-double motionStartS(bool accel) { return accel ? kMotionStartWithAccelS : kMotionStartS; }
-constexpr double kMotionRateDps = 30.0;
-constexpr std::array<double, 3> kBias = {-3.34, 1.09, -0.5};  // the default mock model's
+double motionStartS(bool accel) { return accel ? kMotionStartWithAccelS : kTurnStartS; }
+constexpr double kTurnRateDps = 30.0;
+constexpr std::array<double, 3> kMockBias = {-3.34, 1.09, -0.5};  // the default mock model's
 constexpr double kModelBiasStdDps = 0.02;
 
 // The default mock model's terms and biases (daemon/device_backend.cpp), as a sensor model
@@ -45,7 +45,7 @@ std::string sensorModel() {
   for (int a = 0; a < 3; ++a) {
     const char* axis = a == 0 ? "x" : a == 1 ? "y" : "z";
     m << "[" << axis << "]\nquantization_urad = 0.1663\narw_deg_per_sqrt_h = 0.95164\n"
-      << "bias_instability_deg_per_h = 0.60565\nrrw_deg_per_h_sqrt_h = 0.07759\nbias_dps = " << kBias[a] << "\n"
+      << "bias_instability_deg_per_h = 0.60565\nrrw_deg_per_h_sqrt_h = 0.07759\nbias_dps = " << kMockBias[a] << "\n"
       << "[" << axis << ".calibration]\nbias_std_dps = " << kModelBiasStdDps << "\ntemperature_reference_c = 30.0\n";
   }
   return m.str();
@@ -63,14 +63,14 @@ std::string rateConfig(const std::filesystem::path& dir, const std::filesystem::
     << "[filter.kalman]\na = 0.9\nq = 0.0001\nr = 0.01\n"
     << "[socket]\npath = \"" << (dir / "gyrod.sock").string() << "\"\n"
     << "[record]\npath = \"" << (dir / "rec.csv").string() << "\"\nflush_interval_s = 0.1\n"
-    << "[mock]\nspeed = 50\nseed = 9\nmotion = \"constant:axis=z,rate=" << kMotionRateDps
+    << "[mock]\nspeed = 50\nseed = 9\nmotion = \"constant:axis=z,rate=" << kTurnRateDps
     << ",start=" << motionStartS(accel) << "\"\n"
     << extra;
   return c.str();
 }
 
 // Reads RATE lines until `count` arrived (GAP lines would be a failure here: none are injected).
-std::vector<json> readRates(LineClient& c, std::size_t count) {
+std::vector<json> readRateLines(LineClient& c, std::size_t count) {
   std::vector<json> rates;
   while (rates.size() < count) {
     const auto line = c.readLine(20s);
@@ -210,11 +210,11 @@ void expectRateFollowsTheMotionAndIsTheOfflineRateStream(bool accel) {
     // bias error (5 of its σ) and one quantum (1/131 °/s).
     const double n = static_cast<double>(rate_turning[a].size());
     const double tolerance = 5.0 * stdOf(rate_still[a]) / std::sqrt(n) + 5.0 * kModelBiasStdDps + 1.0 / 131.0;
-    const double truth = a == 2 ? kMotionRateDps : 0.0;
+    const double truth = a == 2 ? kTurnRateDps : 0.0;
     EXPECT_NEAR(meanOf(rate_turning[a]), truth, tolerance) << "axis " << a;
   }
   // The paper's filter, a low-pass of DC gain well below 1 (docs/motion.md), shrinks the turn.
-  EXPECT_LT(meanOf(kalman_turning[2]), 0.6 * kMotionRateDps);
+  EXPECT_LT(meanOf(kalman_turning[2]), 0.6 * kTurnRateDps);
 }
 
 }  // namespace
@@ -250,13 +250,14 @@ TEST(GyrodRate, SighupAppliesANewModelWithoutLosingTheStreamAndABadOneChangesNot
   ASSERT_TRUE(w.connected()) << readWholeFile(d.path() / "log.txt");
   ASSERT_TRUE(w.readLine());  // VERSION
   ASSERT_TRUE(w.send("{\"cmd\":\"watch\"}\n"));
-  const auto before = readRates(w, 100);
+  const auto before = readRateLines(w, 100);
   ASSERT_EQ(before.size(), 100u);
   EXPECT_EQ(statusRateModel(d.path() / "gyrod.sock"), "bias");
   for (const json& r : before) {
     ASSERT_TRUE(r.contains("rate")) << r.dump();  // raw − the configured bias, from the first sample
     EXPECT_FALSE(r.contains("still")) << r.dump();
-    for (int a = 0; a < 3; ++a) EXPECT_EQ(r["rate"][a].get<double>(), r["raw"][a].get<double>() - kBias[a]) << r.dump();
+    for (int a = 0; a < 3; ++a)
+      EXPECT_EQ(r["rate"][a].get<double>(), r["raw"][a].get<double>() - kMockBias[a]) << r.dump();
   }
 
   // A model file that does not parse: the running stream is kept.
@@ -265,7 +266,7 @@ TEST(GyrodRate, SighupAppliesANewModelWithoutLosingTheStreamAndABadOneChangesNot
   with_broken.insert(with_broken.find("[filter]\n") + 9, "model = \"" + broken.string() + "\"\n");
   d.write("gyrod.toml", with_broken);
   gyrod.signal(SIGHUP);
-  (void)readRates(w, 50);
+  (void)readRateLines(w, 50);
   EXPECT_EQ(statusRateModel(d.path() / "gyrod.sock"), "bias");
   EXPECT_NE(readWholeFile(d.path() / "log.txt").find("keeping the running filter"), std::string::npos);
 
@@ -273,7 +274,7 @@ TEST(GyrodRate, SighupAppliesANewModelWithoutLosingTheStreamAndABadOneChangesNot
   gyrod.signal(SIGHUP);
   std::vector<json> after;
   for (int tries = 0; tries < 20 && (after.empty() || !after.back().contains("still")); ++tries) {
-    auto more = readRates(w, 50);
+    auto more = readRateLines(w, 50);
     after.insert(after.end(), more.begin(), more.end());
   }
   ASSERT_FALSE(after.empty());

@@ -15,7 +15,7 @@ namespace {
 
 const std::filesystem::path kSourceDir = std::filesystem::path(GYROD_TEST_DATA_DIR).parent_path().parent_path();
 
-std::string mockConfig(const std::filesystem::path& dir) {
+std::string pythonMockConfig(const std::filesystem::path& dir) {
   std::ostringstream c;
   c << "[device]\nbackend = \"mock\"\nrate_hz = 50\n"
     << "[bias]\nsource = \"config\"\nvalues = [-3.34, 1.09, -0.5]\n"
@@ -30,7 +30,7 @@ TEST(PythonClient, WatchesStatusAndAllanAgainstGyrodOnTheMock) {
   const std::filesystem::path python = "/usr/bin/python3";
   if (!std::filesystem::exists(python)) GTEST_SKIP() << "no " << python;
   ScratchDir d;
-  const auto cfg = d.write("gyrod.toml", mockConfig(d.path()));
+  const auto cfg = d.write("gyrod.toml", pythonMockConfig(d.path()));
   const auto sock = (d.path() / "gyrod.sock").string();
   GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt");
   {

@@ -19,7 +19,7 @@ using namespace gyrod::processing;
 
 namespace {
 
-std::string describe(const AxisModelCheck& r) {
+std::string describeChain(const AxisModelCheck& r) {
   std::string s;
   for (const DetectedEffect& e : r.effects)
     s += std::string(modelEffectName(e.effect)) + " (statistic " + std::to_string(e.evidence.statistic) +
@@ -185,7 +185,7 @@ TEST(ModelCheckChain, CleanDataThroughEveryDlpfSettingHasNoEffect) {
       o.threads = 2;
       const AxisModelCheck r = checkAxisModel({g.axes[a], g.rate_hz, g.temp, g.t, {cfg, 0}}, o);
       EXPECT_TRUE(r.effects.empty()) << "DLPF_CFG " << cfg << " at " << rate << " Hz, axis " << a << ": "
-                                     << describe(r);
+                                     << describeChain(r);
       EXPECT_EQ(r.chain.dlpf_cfg, cfg);
     }
   }

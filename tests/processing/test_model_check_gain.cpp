@@ -17,8 +17,8 @@ using namespace gyrod::processing;
 
 namespace {
 
-constexpr double kDuration = 600.0;
-constexpr double kRate = 50.0;
+constexpr double kGainDuration = 600.0;
+constexpr double kGainRate = 50.0;
 
 ModelCheckOptions options(std::uint64_t seed) {
   ModelCheckOptions o;
@@ -27,7 +27,7 @@ ModelCheckOptions options(std::uint64_t seed) {
   return o;
 }
 
-std::string describe(const AxisModelCheck& r) {
+std::string describeGain(const AxisModelCheck& r) {
   std::string s;
   for (const DetectedEffect& e : r.effects)
     s += std::string(modelEffectName(e.effect)) + (e.explained ? "" : " (not explained)") + "; ";
@@ -52,14 +52,14 @@ bool has(const AxisModelCheck& r, ModelEffect e) {
 // extension accepted, every effect explained, nothing unexplained.
 void expectGain(const AxisModelCheck& r, const std::string& what) {
   const ModelCheckGain& g = r.gain;
-  EXPECT_TRUE(r.verdict.judged) << what << ": " << describe(r);
-  EXPECT_TRUE(r.verdict.accepted) << what << ": " << describe(r);
-  EXPECT_LE(g.innovation_var_extended_held_out, g.innovation_var_base_held_out) << what << ": " << describe(r);
-  EXPECT_LE(g.innovation_var_extended, g.innovation_var_base) << what << ": " << describe(r);
-  EXPECT_LE(g.adev_log_error_extended, 1.5 * g.adev_log_error_base + 0.002) << what << ": " << describe(r);
-  EXPECT_GE(g.in_band_extended, g.in_band_base - 0.2) << what << ": " << describe(r);
-  EXPECT_FALSE(has(r, ModelEffect::Unexplained)) << what << ": " << describe(r);
-  for (const DetectedEffect& e : r.effects) EXPECT_TRUE(e.explained) << what << ": " << describe(r);
+  EXPECT_TRUE(r.verdict.judged) << what << ": " << describeGain(r);
+  EXPECT_TRUE(r.verdict.accepted) << what << ": " << describeGain(r);
+  EXPECT_LE(g.innovation_var_extended_held_out, g.innovation_var_base_held_out) << what << ": " << describeGain(r);
+  EXPECT_LE(g.innovation_var_extended, g.innovation_var_base) << what << ": " << describeGain(r);
+  EXPECT_LE(g.adev_log_error_extended, 1.5 * g.adev_log_error_base + 0.002) << what << ": " << describeGain(r);
+  EXPECT_GE(g.in_band_extended, g.in_band_base - 0.2) << what << ": " << describeGain(r);
+  EXPECT_FALSE(has(r, ModelEffect::Unexplained)) << what << ": " << describeGain(r);
+  for (const DetectedEffect& e : r.effects) EXPECT_TRUE(e.explained) << what << ": " << describeGain(r);
 }
 
 AxisModelCheck checkHiddenAxis(const GeneratedRecording& g, std::size_t axis, std::uint64_t seed) {
@@ -75,9 +75,9 @@ TEST(ModelCheckGain, FiftySpikesAreFoundAndTheExtensionGains) {
   for (std::uint64_t seed = 1; seed <= 6; ++seed) {
     HiddenEffectGenerator gen(seed);
     gen.outlier_count_lo = gen.outlier_count_hi = 50;
-    const GeneratedRecording g = gen.generate(kDuration, kRate, {ModelEffect::Outliers});
+    const GeneratedRecording g = gen.generate(kGainDuration, kGainRate, {ModelEffect::Outliers});
     const AxisModelCheck r = checkHiddenAxis(g, g.hidden[0].axis, seed);
-    ASSERT_TRUE(has(r, ModelEffect::Outliers)) << "seed " << seed << ": " << describe(r);
+    ASSERT_TRUE(has(r, ModelEffect::Outliers)) << "seed " << seed << ": " << describeGain(r);
     for (const DetectedEffect& e : r.effects)
       if (e.effect == ModelEffect::Outliers) {
         EXPECT_EQ(e.count, 50u) << "seed " << seed;
@@ -93,7 +93,7 @@ TEST(ModelCheckGain, RemovingOutliersLeavesTheBaseModelsAllanCurve) {
   for (std::uint64_t seed : {2u, 5u}) {
     HiddenEffectGenerator gen(seed);
     gen.outlier_count_lo = gen.outlier_count_hi = 50;
-    const GeneratedRecording g = gen.generate(kDuration, kRate, {ModelEffect::Outliers});
+    const GeneratedRecording g = gen.generate(kGainDuration, kGainRate, {ModelEffect::Outliers});
     const AxisModelCheck r = checkHiddenAxis(g, g.hidden[0].axis, seed);
     ASSERT_EQ(r.allan_base.tau_s.size(), r.allan_extended.tau_s.size());
     for (std::size_t j = 0; j < r.allan_base.tau_s.size(); ++j)
@@ -118,10 +118,10 @@ TEST(ModelCheckGain, EachHiddenEffectGainsOutOfSample) {
     gen.gm_tau_hi_fraction = 1.0 / 300.0;
     gen.gm_peak_lo = 2.5;
     gen.gm_peak_hi = 3.5;
-    const GeneratedRecording g = gen.generate(kDuration, kRate, {c.effect});
+    const GeneratedRecording g = gen.generate(kGainDuration, kGainRate, {c.effect});
     const AxisModelCheck r = checkHiddenAxis(g, g.hidden[0].axis, c.seed);
     const std::string what(modelEffectName(c.effect));
-    ASSERT_TRUE(has(r, c.effect)) << what << ": " << describe(r);
+    ASSERT_TRUE(has(r, c.effect)) << what << ": " << describeGain(r);
     expectGain(r, what);
   }
 }
@@ -137,7 +137,7 @@ TEST(ModelCheckGain, TwoEffectsAtOnceGainOutOfSample) {
     HiddenEffectGenerator gen(c.seed);
     gen.step_size_lo = 20.0;
     gen.step_size_hi = 30.0;
-    const GeneratedRecording g = gen.generate(kDuration, kRate, {c.a, c.b});
+    const GeneratedRecording g = gen.generate(kGainDuration, kGainRate, {c.a, c.b});
     for (std::size_t axis = 0; axis < 3; ++axis) {
       std::vector<ModelEffect> hidden;
       for (const HiddenEffect& h : g.hidden)
@@ -146,7 +146,7 @@ TEST(ModelCheckGain, TwoEffectsAtOnceGainOutOfSample) {
       const AxisModelCheck r = checkHiddenAxis(g, axis, c.seed);
       const std::string what = std::string(modelEffectName(c.a)) + " + " + std::string(modelEffectName(c.b)) +
                                ", axis " + std::to_string(axis);
-      for (ModelEffect e : hidden) EXPECT_TRUE(has(r, e)) << what << ": " << describe(r);
+      for (ModelEffect e : hidden) EXPECT_TRUE(has(r, e)) << what << ": " << describeGain(r);
       expectGain(r, what);
     }
   }
@@ -158,7 +158,7 @@ TEST(ModelCheckGain, AnExtensionThatDoesNotGainIsSeenNotExplained) {
   // must not be accepted as an explanation unless it gains; either way the axis is
   // `unexplained` (tests/processing/test_model_check.cpp has the resonance itself).
   HiddenEffectGenerator gen(3);
-  const GeneratedRecording g = gen.generate(kDuration, kRate, {});
+  const GeneratedRecording g = gen.generate(kGainDuration, kGainRate, {});
   std::vector<double> x = g.axes[0];
   double a1 = 0.0, a2 = 0.0;
   NormalGenerator n(9);
@@ -169,10 +169,10 @@ TEST(ModelCheckGain, AnExtensionThatDoesNotGainIsSeenNotExplained) {
     v += r;
   }
   const AxisModelCheck r = checkAxisModel({x, g.rate_hz, g.temp, g.t, {}}, options(3));
-  EXPECT_TRUE(has(r, ModelEffect::Unexplained)) << describe(r);
+  EXPECT_TRUE(has(r, ModelEffect::Unexplained)) << describeGain(r);
   for (const DetectedEffect& e : r.effects)
     if (!e.explained) {
-      EXPECT_FALSE(r.verdict.accepted) << describe(r);
+      EXPECT_FALSE(r.verdict.accepted) << describeGain(r);
     }
   if (r.verdict.judged && !r.verdict.accepted) {
     const ExtensionVerdict& v = r.verdict;

@@ -24,8 +24,8 @@ using namespace gyrod::processing;
 
 namespace {
 
-constexpr double kRate = 50.0;
-constexpr double kDuration = 600.0;
+constexpr double kGaussMarkovRate = 50.0;
+constexpr double kGaussMarkovDuration = 600.0;
 
 NoiseTerms baseTerms() {
   NoiseTerms t;
@@ -47,11 +47,11 @@ double sigmaForPeak(double tau, double ratio) {
 
 std::vector<double> record(std::uint64_t seed, double sigma) {
   SimulationModel m;
-  m.rate_hz = kRate;
+  m.rate_hz = kGaussMarkovRate;
   m.axes[0].terms = baseTerms();
-  m.axes[0].extra.gauss_markov_tau_s = kDuration / 300.0;
+  m.axes[0].extra.gauss_markov_tau_s = kGaussMarkovDuration / 300.0;
   m.axes[0].extra.gauss_markov_sigma_dps = sigma;
-  NoiseSimulator sim(m, kDuration, seed);
+  NoiseSimulator sim(m, kGaussMarkovDuration, seed);
   std::vector<double> x(sim.sampleCount());
   for (double& v : x) v = std::round(sim.next().rate_dps[0] * 131.0) / 131.0;
   return x;
@@ -62,7 +62,7 @@ bool namesGaussMarkov(const std::vector<double>& x, std::uint64_t seed, std::str
   o.replicas = 40;
   o.seed = seed;
   o.threads = 2;
-  const AxisModelCheck r = checkAxisModel({x, kRate, {}, {}, {}}, o);
+  const AxisModelCheck r = checkAxisModel({x, kGaussMarkovRate, {}, {}, {}}, o);
   for (const CheckStatistic& s : r.statistics)
     if (s.name == "gauss_markov_sqrt_chi2_gain")
       log += "  statistic " + std::to_string(s.value) + ", threshold " + std::to_string(s.threshold) + "\n";
@@ -76,7 +76,7 @@ TEST(ModelCheckGaussMarkov, FindsAProcessBetweenTheOldAndNewHalfDetectionSizes) 
   // Six seeds: the five-term null alone names 2 of them (measured at c285c08), the joint null
   // 4 guarded by the five-term null at 100 α (4c35414). The same six records without the
   // process must stay clean.
-  const double sigma = sigmaForPeak(kDuration / 300.0, 1.6);
+  const double sigma = sigmaForPeak(kGaussMarkovDuration / 300.0, 1.6);
   std::size_t found = 0, false_found = 0;
   std::string log;
   for (std::uint64_t s = 0; s < 6; ++s) {
@@ -101,7 +101,7 @@ TEST(ModelCheckGaussMarkov, CleanRecordsWithoutDlpfTheJointNullNamedStayMostlyCl
   for (const auto& [seed, axis] : axes) {
     HiddenEffectGenerator gen(seed);
     gen.dlpf_cfg = std::nullopt;
-    const GeneratedRecording g = gen.generate(kDuration, kRate, {});
+    const GeneratedRecording g = gen.generate(kGaussMarkovDuration, kGaussMarkovRate, {});
     ModelCheckOptions o;
     o.seed = seed;
     o.replicas = 40;

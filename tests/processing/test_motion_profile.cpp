@@ -18,7 +18,7 @@ using namespace gyrod::processing;
 
 namespace {
 
-std::string messageOf(auto&& make) {
+std::string profileMessageOf(auto&& make) {
   try {
     make();
   } catch (const std::invalid_argument& e) {
@@ -101,28 +101,28 @@ TEST(MotionProfile, SumAddsAndSequenceRunsEachOnItsOwnClock) {
 }
 
 TEST(MotionProfile, BadParametersNameTheParameterAndValue) {
-  std::string msg = messageOf([] { MotionProfile::sine(0, -1.0, 20.0); });
+  std::string msg = profileMessageOf([] { MotionProfile::sine(0, -1.0, 20.0); });
   EXPECT_NE(msg.find("sine.frequency_hz"), std::string::npos) << msg;
   EXPECT_NE(msg.find("-1"), std::string::npos) << msg;
-  msg = messageOf([] { MotionProfile::sine(0, 1.0, -2.0); });
+  msg = profileMessageOf([] { MotionProfile::sine(0, 1.0, -2.0); });
   EXPECT_NE(msg.find("sine.amplitude_dps"), std::string::npos) << msg;
-  msg = messageOf([] { MotionProfile::turns(0, 0.0, 90.0, 1.0); });
+  msg = profileMessageOf([] { MotionProfile::turns(0, 0.0, 90.0, 1.0); });
   EXPECT_NE(msg.find("turns.count"), std::string::npos) << msg;
-  msg = messageOf([] { MotionProfile::turns(0, 3.0, 0.0, 1.0); });
+  msg = profileMessageOf([] { MotionProfile::turns(0, 3.0, 0.0, 1.0); });
   EXPECT_NE(msg.find("turns.rate_dps"), std::string::npos) << msg;
-  msg = messageOf([] { MotionProfile::step(3, 0.0, 1.0); });
+  msg = profileMessageOf([] { MotionProfile::step(3, 0.0, 1.0); });
   EXPECT_NE(msg.find("step.axis"), std::string::npos) << msg;
-  msg = messageOf([] { MotionProfile::constant(0, std::nan(""), 0.0); });
+  msg = profileMessageOf([] { MotionProfile::constant(0, std::nan(""), 0.0); });
   EXPECT_NE(msg.find("constant.rate_dps"), std::string::npos) << msg;
-  msg = messageOf([] { MotionProfile::table({{0.0, {}}, {0.0, {}}}); });
+  msg = profileMessageOf([] { MotionProfile::table({{0.0, {}}, {0.0, {}}}); });
   EXPECT_NE(msg.find("table point 1: t"), std::string::npos) << msg;
-  msg = messageOf([] { MotionProfile::table({}); });
+  msg = profileMessageOf([] { MotionProfile::table({}); });
   EXPECT_NE(msg.find("table"), std::string::npos) << msg;
-  msg = messageOf([] {
+  msg = profileMessageOf([] {
     MotionProfile::sequence({{MotionProfile{}, MotionProfile::kForever}, {MotionProfile{}, 1.0}});
   });
   EXPECT_NE(msg.find("sequence segment 0"), std::string::npos) << msg;
-  msg = messageOf([] { MotionProfile::sequence({{MotionProfile{}, -1.0}}); });
+  msg = profileMessageOf([] { MotionProfile::sequence({{MotionProfile{}, -1.0}}); });
   EXPECT_NE(msg.find("sequence segment 0: duration_s"), std::string::npos) << msg;
 }
 

@@ -17,7 +17,7 @@ using namespace gyrod::processing;
 
 namespace {
 
-SimulationModel pureModel(double rate_hz = 100.0) {
+SimulationModel pureAllanModel(double rate_hz = 100.0) {
   SimulationModel m;
   m.rate_hz = rate_hz;
   return m;
@@ -155,7 +155,7 @@ TEST(NoiseSimulatorAllan, EachTermAloneLiesInsideItsConfidenceIntervals) {
   options.confidence = 1.0 - 1e-6;
   for (const Case& c : cases) {
     for (std::uint64_t seed : {1ULL, 2ULL, 3ULL}) {
-      SimulationModel m = pureModel(1.0 / tau0);
+      SimulationModel m = pureAllanModel(1.0 / tau0);
       m.axes[0].terms.set(c.term, c.value);
       const std::vector<double> x = simulateAxis(m, c.samples, seed);
       const std::vector<std::size_t> ms = octaveClusterSizes(x.size());
@@ -209,7 +209,7 @@ TEST(NoiseSimulatorAllan, AllFiveTermsTogetherFitBackWithinTheirUncertainty) {
   // of its reported 1-σ uncertainty (over 20 seeds the z-scores had standard deviation
   // ≈ 1.1, largest |z| 3.9, the rate ramp where it trades off against K at the curve's end).
   const NoiseTerms truth = fiveTermModel();
-  SimulationModel m = pureModel(100.0);
+  SimulationModel m = pureAllanModel(100.0);
   m.axes[0].terms = truth;
   for (std::uint64_t seed = 1; seed <= 6; ++seed) {
     const std::vector<double> x = simulateAxis(m, 200000, seed);
@@ -234,7 +234,7 @@ TEST(NoiseSimulatorAllan, BiasInstabilityIsFlatAtFactorTimesB) {
   // σ/(0.6643·B) is reported; the exact curve itself is flat within ±1.5 % (FlickerBank).
   const double b = 2.0, tau0 = 0.1, duration = 1000.0;
   const double target = bCoefficient(b);
-  SimulationModel m = pureModel(1.0 / tau0);
+  SimulationModel m = pureAllanModel(1.0 / tau0);
   m.axes[0].terms.bias_instability_deg_per_h = b;
   const std::size_t n = static_cast<std::size_t>(duration / tau0);
   std::vector<std::size_t> ms;
@@ -327,7 +327,7 @@ TEST(NoiseSimulatorAllan, DlpfShapesShortTausAsItsTransferFunctionPredicts) {
     EXPECT_NEAR(decimatedWhiteAllanVariance(n2, c.cfg, c.rate, 4, false), n2 * fs / 4.0, 1e-9 * n2 * fs);
     EXPECT_NEAR(decimatedWhiteAllanVariance(n2, c.cfg, c.rate, 1), decimatedWhiteAllanVarianceAtTau0(n2, c.cfg, c.rate),
                 1e-9 * n2 * c.rate);
-    SimulationModel m = pureModel(c.rate);
+    SimulationModel m = pureAllanModel(c.rate);
     m.dlpf_cfg = c.cfg;
     m.axes[0].terms.arw_deg_per_sqrt_h = n_paper;
     const std::vector<std::size_t> ms = {1, 2, 4, 16, 64};
@@ -360,7 +360,7 @@ TEST(NoiseSimulatorAllan, QuantisationStepAddsDeltaSquaredOverTwelveAtTau0) {
   // then ≈ uniform on ±Δ/2 and independent of the signal, so the Allan variance at τ0 rises
   // by Var(e) = Δ²/12 and, being white, by Δ²/(12·m) at m. 20 seeds, 5 standard errors.
   const double delta = 1.0 / 16.4, rate = 100.0;
-  SimulationModel m = pureModel(rate);
+  SimulationModel m = pureAllanModel(rate);
   m.axes[0].terms.arw_deg_per_sqrt_h = 3.0 * delta / std::sqrt(rate) * 60.0;  // σ = N·√rate
   SimulationModel q = m;
   q.fs_sel = 3;

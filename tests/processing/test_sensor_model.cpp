@@ -15,7 +15,7 @@
 using namespace gyrod::processing;
 
 namespace {
-constexpr double kPi = std::numbers::pi;
+constexpr double kPiSensor = std::numbers::pi;
 }
 
 TEST(DlpfSetting, MatchesRegisterMapTable) {
@@ -39,7 +39,7 @@ TEST(DigitalLowPassFilter, MeasuredGainAndPhaseOfSinusoidEqualFrequencyResponse)
   // settle, then recover amplitude and phase of the output by correlating over a whole
   // number of periods. Both must match H(f) that the filter claims to implement.
   std::mt19937_64 rng(20240611);
-  std::uniform_real_distribution<double> phase_dist(0.0, 2.0 * kPi);
+  std::uniform_real_distribution<double> phase_dist(0.0, 2.0 * kPiSensor);
   for (int cfg : {0, 1, 2, 3, 4, 5, 6}) {
     const DlpfSetting& s = dlpfSetting(cfg);
     const double fs = s.internal_rate_hz;
@@ -53,10 +53,10 @@ TEST(DigitalLowPassFilter, MeasuredGainAndPhaseOfSinusoidEqualFrequencyResponse)
       const std::size_t settle = 4 * n;  // slowest pole (cfg 6) decays by e^-200 in 4 s
       for (std::size_t i = 0; i < settle + n; ++i) {
         const double t = static_cast<double>(i) / fs;
-        const double y = filter.update(amplitude * std::sin(2.0 * kPi * f * t + phase));
+        const double y = filter.update(amplitude * std::sin(2.0 * kPiSensor * f * t + phase));
         if (i >= settle) {
-          sum_sin += y * std::sin(2.0 * kPi * f * t + phase);
-          sum_cos += y * std::cos(2.0 * kPi * f * t + phase);
+          sum_sin += y * std::sin(2.0 * kPiSensor * f * t + phase);
+          sum_cos += y * std::cos(2.0 * kPiSensor * f * t + phase);
         }
       }
       const std::complex<double> measured(2.0 * sum_sin / (amplitude * n), 2.0 * sum_cos / (amplitude * n));
@@ -112,7 +112,7 @@ TEST(DigitalLowPassFilter, ImpulseResponseIsTheInverseTransformOfH) {
     const double h_n = filter.update(n == 0 ? 1.0 : 0.0);
     std::complex<double> sum = 0.0;
     for (int k = 0; k < n_fft; ++k)
-      sum += filter.frequencyResponse(k * fs / n_fft) * std::polar(1.0, 2.0 * kPi * k * n / n_fft);
+      sum += filter.frequencyResponse(k * fs / n_fft) * std::polar(1.0, 2.0 * kPiSensor * k * n / n_fft);
     EXPECT_NEAR(h_n, sum.real() / n_fft, 1e-12) << "n " << n;
   }
 }
@@ -121,7 +121,7 @@ TEST(DigitalLowPassFilter, GroupDelayAtDcIsMinusPhaseSlope) {
   for (int cfg = 0; cfg <= 6; ++cfg) {
     const DigitalLowPassFilter filter(cfg);
     const double df = 1e-3;  // Hz
-    const double slope = std::arg(filter.frequencyResponse(df)) / (2.0 * kPi * df);
+    const double slope = std::arg(filter.frequencyResponse(df)) / (2.0 * kPiSensor * df);
     EXPECT_NEAR(filter.groupDelayAtDc(), -slope, 1e-9) << "cfg " << cfg;
   }
 }

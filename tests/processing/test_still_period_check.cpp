@@ -16,10 +16,10 @@ using namespace gyrod::processing;
 
 namespace {
 
-constexpr double kRateHz = 50.0;
+constexpr double kStillRateHz = 50.0;
 constexpr std::size_t kSamples = 500;  // 10 s, bias.still_seconds' default
 // The paper's angle random walk, 0.95 °/√h, as the standard deviation of a 50 Hz sample.
-const double kSigmaDps = 0.95 / 60.0 * std::sqrt(kRateHz);
+const double kSigmaDps = 0.95 / 60.0 * std::sqrt(kStillRateHz);
 
 struct Window {
   std::array<std::vector<double>, 3> axes;
@@ -47,8 +47,8 @@ Window atRest(unsigned seed, double phi = 0.0) {
 TEST(StillPeriodCheck, NoiseAtRestPassesOverManySeeds) {
   int moved = 0;
   for (unsigned seed = 1; seed <= 200; ++seed) {
-    moved += checkStillPeriod(atRest(seed).spans(), kRateHz).moved ? 1 : 0;
-    moved += checkStillPeriod(atRest(1000 + seed, 0.5).spans(), kRateHz).moved ? 1 : 0;  // low-pass correlated
+    moved += checkStillPeriod(atRest(seed).spans(), kStillRateHz).moved ? 1 : 0;
+    moved += checkStillPeriod(atRest(1000 + seed, 0.5).spans(), kStillRateHz).moved ? 1 : 0;  // low-pass correlated
   }
   EXPECT_EQ(moved, 0);
 }
@@ -56,7 +56,7 @@ TEST(StillPeriodCheck, NoiseAtRestPassesOverManySeeds) {
 TEST(StillPeriodCheck, ATurnOfOneDegreePerSecondForOneSecondIsMotionOnItsAxis) {
   Window w = atRest(7);
   for (std::size_t k = 250; k < 300; ++k) w.axes[2][k] += 1.0;  // 1 °/s about z from 5 s to 6 s
-  const StillPeriodVerdict v = checkStillPeriod(w.spans(), kRateHz);
+  const StillPeriodVerdict v = checkStillPeriod(w.spans(), kStillRateHz);
   EXPECT_TRUE(v.moved);
   EXPECT_EQ(v.axis, 2u);
   EXPECT_GT(v.adev_dps, 2.0 * v.allowed_dps);  // 2.7 times with this seed
@@ -65,29 +65,29 @@ TEST(StillPeriodCheck, ATurnOfOneDegreePerSecondForOneSecondIsMotionOnItsAxis) {
 TEST(StillPeriodCheck, ASwayAndAStepAreMotion) {
   Window sway = atRest(8);
   for (std::size_t k = 0; k < kSamples; ++k)
-    sway.axes[0][k] += 0.5 * std::sin(2.0 * M_PI * 0.5 * static_cast<double>(k) / kRateHz);  // 0.5 Hz, 0.5 °/s
-  EXPECT_TRUE(checkStillPeriod(sway.spans(), kRateHz).moved);
-  EXPECT_EQ(checkStillPeriod(sway.spans(), kRateHz).axis, 0u);
+    sway.axes[0][k] += 0.5 * std::sin(2.0 * M_PI * 0.5 * static_cast<double>(k) / kStillRateHz);  // 0.5 Hz, 0.5 °/s
+  EXPECT_TRUE(checkStillPeriod(sway.spans(), kStillRateHz).moved);
+  EXPECT_EQ(checkStillPeriod(sway.spans(), kStillRateHz).axis, 0u);
 
   Window step = atRest(9);
   for (std::size_t k = 400; k < kSamples; ++k) step.axes[1][k] += 1.0;  // the board starts turning at 8 s
-  EXPECT_TRUE(checkStillPeriod(step.spans(), kRateHz).moved);
-  EXPECT_EQ(checkStillPeriod(step.spans(), kRateHz).axis, 1u);
+  EXPECT_TRUE(checkStillPeriod(step.spans(), kStillRateHz).moved);
+  EXPECT_EQ(checkStillPeriod(step.spans(), kStillRateHz).axis, 1u);
 }
 
 TEST(StillPeriodCheck, ARotationConstantOverTheWholeWindowLooksLikeABias) {
   Window w = atRest(10);
   for (double& v : w.axes[2]) v += 30.0;
-  EXPECT_FALSE(checkStillPeriod(w.spans(), kRateHz).moved);
+  EXPECT_FALSE(checkStillPeriod(w.spans(), kStillRateHz).moved);
 }
 
 TEST(StillPeriodCheck, RefusesBadInputAndSaysNothingOnTooFewSamples) {
   Window w = atRest(11);
   EXPECT_THROW(checkStillPeriod(w.spans(), 0.0), std::invalid_argument);
   std::array<std::span<const double>, 3> uneven = {w.axes[0], w.axes[1], std::span<const double>(w.axes[2]).first(10)};
-  EXPECT_THROW(checkStillPeriod(uneven, kRateHz), std::invalid_argument);
+  EXPECT_THROW(checkStillPeriod(uneven, kStillRateHz), std::invalid_argument);
   std::array<std::span<const double>, 3> few = {std::span<const double>(w.axes[0]).first(5),
                                                 std::span<const double>(w.axes[1]).first(5),
                                                 std::span<const double>(w.axes[2]).first(5)};
-  EXPECT_FALSE(checkStillPeriod(few, kRateHz).moved);
+  EXPECT_FALSE(checkStillPeriod(few, kStillRateHz).moved);
 }

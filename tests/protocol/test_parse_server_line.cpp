@@ -13,7 +13,7 @@ using namespace gyrod::protocol;
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kParsedNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Same bits: NaN equals NaN, and -0.0 differs from 0.0.
 bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0 || (std::isnan(a) && std::isnan(b)); }
@@ -66,11 +66,11 @@ TEST(ParseServerLine, RateRoundTripsBitForBit) {
 TEST(ParseServerLine, OmittedRateFieldsComeBackAsNaN) {
   RateSample s;
   s.seq = 12;
-  s.t_s = kNaN;  // omitted
+  s.t_s = kParsedNaN;  // omitted
   s.temp_c = 31.5;
   s.raw_dps = {1.0, 2.0, 3.0};
-  s.mean_dps = {kNaN, 0.0, 0.0};  // the whole array is omitted
-  s.kalman_dps = {kNaN, kNaN, kNaN};
+  s.mean_dps = {kParsedNaN, 0.0, 0.0};  // the whole array is omitted
+  s.kalman_dps = {kParsedNaN, kParsedNaN, kParsedNaN};
   const RateSample back = parsed<RateSample>(rateLine(s));
   EXPECT_TRUE(std::isnan(back.t_s));
   EXPECT_EQ(back.temp_c, 31.5);
@@ -115,11 +115,11 @@ TEST(ParseServerLine, AllanRoundTripsCurvesAndNoiseTerms) {
       a.curves[axis][2].adev_dps.push_back(0.001 * (axis + 1) / std::sqrt(tau / 0.02));
     }
   gyrod::processing::NoiseTerms t;
-  t.quantization_urad = kNaN;
+  t.quantization_urad = kParsedNaN;
   t.arw_deg_per_sqrt_h = 0.42;
   t.bias_instability_deg_per_h = 1.5;
-  t.rrw_deg_per_h_sqrt_h = kNaN;
-  t.rate_ramp_deg_per_h2 = kNaN;
+  t.rrw_deg_per_h_sqrt_h = kParsedNaN;
+  t.rate_ramp_deg_per_h2 = kParsedNaN;
   a.curves[1][2].noise = t;
 
   const AllanReport back = parsed<AllanReport>(allanLine(a));

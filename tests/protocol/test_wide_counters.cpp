@@ -19,7 +19,7 @@ using namespace gyrod::protocol;
 namespace {
 
 template <class T>
-T parsed(const std::string& line) {
+T parsedWide(const std::string& line) {
   const ServerMessage m = parseServerLine(line.substr(0, line.size() - 1));  // without its '\n'
   const T* value = std::get_if<T>(&m);
   if (value == nullptr) throw std::runtime_error("parsed to another class: " + line);
@@ -44,7 +44,7 @@ TEST(WideCounters, EveryDriverCounterPast2To32ComesBackFromStatus) {
   s.clients_total = k2To32 + 2;
   s.lines_dropped = 7 * k2To32;
 
-  const StatusReply back = parsed<StatusReply>(statusLine(d, s));
+  const StatusReply back = parsedWide<StatusReply>(statusLine(d, s));
   EXPECT_EQ(back.daemon.device_counters, d.device_counters);
   EXPECT_EQ(back.daemon.samples, d.samples);
   EXPECT_EQ(back.daemon.gaps, d.gaps);
@@ -62,13 +62,13 @@ TEST(WideCounters, RateAndGapSequenceNumbersPast2To32ComeBack) {
   r.raw_dps = r.mean_dps = r.kalman_dps = {1.0, -2.0, 0.5};
   std::array<char, kMaxRateLineBytes> rate_buffer{};
   const std::size_t rate_size = formatRateLine(r, rate_buffer);
-  const RateSample rate_back = parsed<RateSample>(std::string(rate_buffer.data(), rate_size));
+  const RateSample rate_back = parsedWide<RateSample>(std::string(rate_buffer.data(), rate_size));
   EXPECT_EQ(rate_back.seq, r.seq);
   EXPECT_EQ(rate_back.t_s, r.t_s);
 
   std::array<char, kMaxGapLineBytes> gap_buffer{};
   const std::size_t gap_size = formatGapLine({k2To32 + 11, 2 * k2To32, "fifo_overflow"}, gap_buffer);
-  const GapNotice gap_back = parsed<GapNotice>(std::string(gap_buffer.data(), gap_size));
+  const GapNotice gap_back = parsedWide<GapNotice>(std::string(gap_buffer.data(), gap_size));
   EXPECT_EQ(gap_back.first_missing_seq, k2To32 + 11);
   EXPECT_EQ(gap_back.count, 2 * k2To32);
 }

@@ -76,7 +76,7 @@ json timingOf(const CommandResult& r) {
   return doc.value("timing", json::object());
 }
 
-std::size_t lines(const std::string& s) { return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n')); }
+std::size_t countLines(const std::string& s) { return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n')); }
 
 }  // namespace
 
@@ -162,7 +162,7 @@ TEST(GyroctlTiming, JitterIsCountedWithItsLargestDeviation) {
                                                 "by more than 10 %"),
             std::string::npos)
       << r.err;
-  EXPECT_EQ(lines(r.err), 2u) << r.err;
+  EXPECT_EQ(countLines(r.err), 2u) << r.err;
 
   const auto strict = runGyroctl(
       "filter " + f.string() + " --rate 10 -o " + (d.path() / "o.csv").string() + " --strict-timing", d.path());
@@ -173,7 +173,7 @@ TEST(GyroctlTiming, JitterIsCountedWithItsLargestDeviation) {
             0u)
       << strict.err;
   EXPECT_NE(strict.err.find("by more than 10 %"), std::string::npos) << strict.err;
-  EXPECT_EQ(lines(strict.err), 1u) << strict.err;
+  EXPECT_EQ(countLines(strict.err), 1u) << strict.err;
 }
 
 TEST(GyroctlTiming, GapAndDroppedRecordsAreReported) {
