@@ -1,4 +1,4 @@
-# Build time (docs/testing.md, "CI"): most of a TU's compile time here is the third-party headers
+# Build time (docs/testing.md, "CI time"): most of a TU's compile time here is the third-party headers
 # (GoogleTest, nlohmann-json, CLI11, spdlog, toml++, Eigen) parsed again in every file.
 #
 # GYROD_PCH: each heavy target precompiles the headers most of its files include, once per target
