@@ -108,6 +108,7 @@ HiddenEffect HiddenEffectGenerator::drawEffect(ModelEffect e, double duration_s,
       h.count = integer(1, 5);
       for (std::size_t j = 0; j < h.count; ++j) h.lost += integer(1, 50);
       break;
+    case ModelEffect::NarrowbandLine:
     case ModelEffect::Unexplained: break;
   }
   return h;

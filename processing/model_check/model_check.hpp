@@ -38,6 +38,7 @@ enum class ModelEffect {
   BiasSteps,        // bias_steps {count, times_s}
   Outliers,         // outliers {count}
   SampleGaps,       // sample_gaps {count, lost}
+  NarrowbandLine,   // narrowband_line {centre_hz, width_hz, rms_dps}: a line whose frequency wanders
   Unexplained,      // unexplained {where: tau range or frequency}
 };
 std::string_view modelEffectName(ModelEffect e);
@@ -105,14 +106,17 @@ struct DetectedEffect {
   std::size_t lost = 0;                       // sample_gaps: samples missing in the gaps
   double outlier_median_amplitude_dps = 0.0;  // outliers: median |excursion|
   double where_lo = 0.0, where_hi = 0.0;      // unexplained: τ range [s] (Allan)
+  double centre_hz = 0.0, width_hz = 0.0;     // narrowband_line (simulation/narrowband_line.hpp)
+  double rms_dps = 0.0;                       // narrowband_line: its standard deviation
   EffectEvidence evidence;                    // statistic, value, threshold
   // 95 % intervals of the parameters above (only those of `effect` are stated).
-  ParameterInterval k_interval;                    // temperature_bias
-  ParameterInterval amp_interval;                  // sinusoid
-  ParameterInterval tau_interval, sigma_interval;  // gauss_markov
-  std::vector<ParameterInterval> size_intervals;   // bias_steps, one per step
-  ParameterInterval count_interval;                // outliers
-  ParameterInterval outlier_amplitude_interval;    // outliers (of the median excursion)
+  ParameterInterval k_interval;                                     // temperature_bias
+  ParameterInterval amp_interval;                                   // sinusoid
+  ParameterInterval tau_interval, sigma_interval;                   // gauss_markov
+  std::vector<ParameterInterval> size_intervals;                    // bias_steps, one per step
+  ParameterInterval count_interval;                                 // outliers
+  ParameterInterval outlier_amplitude_interval;                     // outliers (of the median excursion)
+  ParameterInterval centre_interval, width_interval, rms_interval;  // narrowband_line
   // false: seen (its statistic fired) but not explained: the extended model with it did not
   // gain out of sample (AxisModelCheck::verdict says which measures).
   bool explained = true;

@@ -326,6 +326,7 @@ std::string_view modelEffectName(ModelEffect e) {
     case ModelEffect::BiasSteps: return "bias_steps";
     case ModelEffect::Outliers: return "outliers";
     case ModelEffect::SampleGaps: return "sample_gaps";
+    case ModelEffect::NarrowbandLine: return "narrowband_line";
     case ModelEffect::Unexplained: return "unexplained";
   }
   throw std::invalid_argument("unknown model effect");

@@ -21,6 +21,7 @@
 #include "processing/base/noise_terms.hpp"
 #include "processing/base/portable_random.hpp"
 #include "processing/simulation/motion_profile.hpp"
+#include "processing/simulation/narrowband_line.hpp"
 #include "processing/simulation/sensor_model.hpp"
 
 namespace gyrod::processing {
@@ -61,9 +62,11 @@ struct AxisExtraEffects {
   // get ±outlier_amplitude_dps added (sign at random).
   std::size_t outlier_count = 0;
   double outlier_amplitude_dps = 0.0;
+  // Lines whose frequency wanders (narrowband_line.hpp), each its own resonance.
+  std::vector<NarrowbandLine> narrowband_lines;
   bool empty() const {
     return temperature_coefficient_dps_per_c == 0.0 && sinusoids.empty() && gauss_markov_sigma_dps == 0.0 &&
-           bias_steps.empty() && outlier_count == 0;
+           bias_steps.empty() && outlier_count == 0 && narrowband_lines.empty();
   }
 };
 

@@ -96,6 +96,12 @@ json effectParams(const DetectedEffect& e) {
       addInterval(p, "median_amplitude_dps", e.outlier_amplitude_interval);
       return p;
     case ModelEffect::SampleGaps: return {{"count", e.count}, {"lost", e.lost}};
+    case ModelEffect::NarrowbandLine:
+      p = {{"centre_hz", e.centre_hz}, {"width_hz", e.width_hz}, {"rms_dps", e.rms_dps}};
+      addInterval(p, "centre_hz", e.centre_interval);
+      addInterval(p, "width_hz", e.width_interval);
+      addInterval(p, "rms_dps", e.rms_interval);
+      return p;
     case ModelEffect::Unexplained:
       return {{"where", "tau " + fmt("%.4g", e.where_lo) + " to " + fmt("%.4g", e.where_hi) + " s"},
               {"tau_lo_s", e.where_lo},
@@ -157,6 +163,10 @@ std::string evidenceText(const DetectedEffect& e) {
              std::to_string(e.count) + " samples beyond it, median excursion " +
              fmt("%.3g", e.outlier_median_amplitude_dps) + " deg/s";
     case ModelEffect::Sinusoid: return sinusoidEvidenceText(v);
+    case ModelEffect::NarrowbandLine:
+      return "a spectral peak " + fmt("%.4g", e.width_hz) + " Hz wide at " + fmt("%.4g", e.centre_hz) +
+             " Hz, wider than one periodogram bin (scan statistic " + fmt("%.3g", v.statistic) + "; " + nullText(v) +
+             "): the line's frequency wanders";
     case ModelEffect::TemperatureBias:
       return "low-passed residual against the detrended temperature: slope " + fmt("%.4g", v.statistic) + " deg/s/C, " +
              nullText(v) + " (two-sided on the distance); " + decisionText(v);

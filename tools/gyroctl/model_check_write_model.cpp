@@ -78,6 +78,7 @@ AxisNoiseModel extendedAxisModel(const AxisModelCheck& r, std::span<const double
         x.temperature_reference_c = temperature_reference_c;
         break;
       case ModelEffect::Sinusoid: x.sinusoids.push_back({e.freq_hz, e.amp_dps, e.phase_rad}); break;
+      case ModelEffect::NarrowbandLine: x.narrowband_lines.push_back({e.centre_hz, e.width_hz, e.rms_dps}); break;
       case ModelEffect::GaussMarkov:
         x.gauss_markov_tau_s = e.tau_s;
         x.gauss_markov_sigma_dps = e.sigma_dps;
