@@ -7,6 +7,7 @@
 
 #include "processing/base/noise_terms.hpp"
 #include "processing/paper/ar_model.hpp"
+#include "processing/simulation/narrowband_line.hpp"
 
 namespace gyrod::processing::model_check_detail {
 
@@ -108,7 +109,11 @@ struct InnovationStats {
   std::size_t rejected = 0;
   std::vector<std::size_t> rejected_samples;  // indices into z of the rejected samples
 };
+// `lines`: narrowband lines (simulation/narrowband_line.hpp), each two more states
+// [y_k, y_{k−1}] with y_k = a1·y_{k−1} + a2·y_{k−2} + e_k, measured with the rest.
+inline constexpr std::size_t kMaxInnovationLines = 6;
 InnovationStats kalmanInnovations(std::span<const double> z, std::span<const double> phi, double ar_noise_var,
-                                  double gm_decay, double gm_noise_var, bool robust);
+                                  double gm_decay, double gm_noise_var, bool robust,
+                                  std::span<const NarrowbandLineRecursion> lines = {});
 
 }  // namespace gyrod::processing::model_check_detail

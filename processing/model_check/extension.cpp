@@ -39,6 +39,7 @@ SimulationModel extendedSimulationModel(const ExtensionInputs& in, double rate, 
   }
   extra.outlier_count = in.outliers.count;
   extra.outlier_amplitude_dps = in.outliers.median_amplitude;
+  extra.narrowband_lines = in.removal->lines;
   return ext;
 }
 
@@ -147,9 +148,11 @@ InnovationFigures extendedInnovations(const ExtensionInputs& in, std::span<const
       }
     }
   }
-  const InnovationStats inn = kalmanInnovations(z, phi, noise_var, gm_decay, gm_q, in.outliers.count > 0);
-  return {inn.variance, ljungBoxTest(inn.innovations, o.ljung_box_lags, phi.size() + (gm_q > 0.0 ? 2 : 0)).p_value,
-          inn.rejected_samples};
+  std::vector<NarrowbandLineRecursion> lines;
+  for (const NarrowbandLine& l : in.removal->lines) lines.push_back(narrowbandLineRecursion(l, c.rate));
+  const InnovationStats inn = kalmanInnovations(z, phi, noise_var, gm_decay, gm_q, in.outliers.count > 0, lines);
+  const std::size_t fitted = phi.size() + (gm_q > 0.0 ? 2 : 0) + 3 * lines.size();
+  return {inn.variance, ljungBoxTest(inn.innovations, o.ljung_box_lags, fitted).p_value, inn.rejected_samples};
 }
 
 // The measured series minus the named deterministic effects, detrended.

@@ -26,7 +26,8 @@ struct HiddenEffect {
   ModelEffect effect = ModelEffect::Unexplained;
   std::size_t axis = 0;  // 0..2 (sample_gaps: all axes)
   double k_dps_per_c = 0.0;
-  double freq_hz = 0.0, amp_dps = 0.0;  // sinusoid; outliers: amp_dps the size of each spike
+  double freq_hz = 0.0, amp_dps = 0.0;                    // sinusoid; outliers: amp_dps the size of each spike
+  double centre_hz = 0.0, width_hz = 0.0, rms_dps = 0.0;  // narrowband line
   double tau_s = 0.0, sigma_dps = 0.0;
   std::vector<double> times_s, sizes_dps;  // bias steps
   std::size_t count = 0;                   // steps, outliers, gaps
@@ -42,9 +43,9 @@ struct GeneratedRecording {
 };
 
 // The effects a generator may hide (the catalogue; `unexplained` is not an effect one hides).
-inline constexpr std::array<ModelEffect, 6> kHideableEffects = {ModelEffect::TemperatureBias, ModelEffect::Sinusoid,
-                                                                ModelEffect::GaussMarkov,     ModelEffect::BiasSteps,
-                                                                ModelEffect::Outliers,        ModelEffect::SampleGaps};
+inline constexpr std::array<ModelEffect, 7> kHideableEffects = {
+    ModelEffect::TemperatureBias, ModelEffect::Sinusoid,   ModelEffect::GaussMarkov,   ModelEffect::BiasSteps,
+    ModelEffect::Outliers,        ModelEffect::SampleGaps, ModelEffect::NarrowbandLine};
 
 class HiddenEffectGenerator {
  public:
@@ -62,6 +63,10 @@ class HiddenEffectGenerator {
   // Number of hidden outliers (inclusive range) and their size in multiples of the white sd.
   std::size_t outlier_count_lo = 3, outlier_count_hi = 30;
   double outlier_size_lo = 10.0, outlier_size_hi = 30.0;
+  // A hidden narrowband line: centre uniform over 2 Hz .. 0.4 × rate, width uniform over
+  // line_width_lo..hi Hz, rms line_rms_lo..hi × the white noise's sd.
+  double line_width_lo = 0.1, line_width_hi = 0.5;
+  double line_rms_lo = 0.15, line_rms_hi = 0.5;
   // The chip's DLPF (DLPF_CFG 0..6) the recording is made through, as gyrod records it: the
   // analog noise at the internal rate, filtered, decimated to the rate (which must be
   // reachable), then quantised. None: the noise is made at the output rate (no DLPF).

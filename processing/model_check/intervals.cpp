@@ -171,7 +171,8 @@ namespace gyrod::processing::model_check_detail {
 
 EffectIntervals::EffectIntervals(const Removal& removal, const Context& c,
                                  const std::vector<double>& temperature_regressor, std::size_t replicas)
-    : removal_(removal), n_(c.n) {
+    : removal_(removal), n_(c.n), context_(c) {
+  if (!removal.lines.empty()) line_estimates_.assign(replicas, {});
   // A line first (the series are detrended; it keeps the estimates free of that), then the
   // effects in a fixed order: steps, each sinusoid's sine and cosine parts, temperature.
   std::vector<double> ones(n_, 1.0), line(n_);
@@ -195,7 +196,10 @@ EffectIntervals::EffectIntervals(const Removal& removal, const Context& c,
   }
   if (removal.temperature && temperature_regressor.size() == n_) regressors_.push_back(temperature_regressor);
   const std::size_t p = regressors_.size();
-  if (p == first_effect_column_) return;  // nothing linear named
+  if (p == first_effect_column_) {  // nothing linear named
+    regressors_.clear();
+    return;
+  }
   Eigen::MatrixXd gram(static_cast<Eigen::Index>(p), static_cast<Eigen::Index>(p));
   for (std::size_t a = 0; a < p; ++a)
     for (std::size_t b = a; b < p; ++b) {
@@ -226,8 +230,27 @@ std::vector<double> EffectIntervals::solve(std::span<const double> x) const {
 }
 
 void EffectIntervals::measureReplica(std::size_t index, std::span<const double> x) {
-  if (empty() || index >= estimates_.size()) return;
-  estimates_[index] = solve(x);
+  if (columns_ > 0 && index < estimates_.size()) estimates_[index] = solve(x);
+  if (index < line_estimates_.size()) measureLines(index, x);
+}
+
+void EffectIntervals::measureLines(std::size_t index, std::span<const double> x) {
+  const Context& c = context_;
+  const Periodogram p = hannPeriodogram(x);
+  const double df = c.rate / static_cast<double>(p.nfft);
+  std::vector<double> bg = blockMedianBackground(p.power, c.line_background_block);
+  for (double& v : bg) v *= 2.0 / (c.rate * p.window_power);
+  const std::vector<double> psd = onesidedPsd(p, c.rate);
+  std::vector<double>& est = line_estimates_[index];
+  for (const NarrowbandLine& l : removal_.lines) {
+    const auto centre = static_cast<std::size_t>(std::lround(l.centre_hz / df));
+    const auto width = std::max<std::size_t>(4, static_cast<std::size_t>(std::lround(l.width_hz / df)));
+    const NarrowbandFit fit = fitNarrowbandLine(psd, bg, df, c.rate, centre, width, c.k_lo, c.k_hi, 200);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    est.push_back(fit.fitted ? fit.centre_hz : nan);
+    est.push_back(fit.fitted ? fit.width_hz : nan);
+    est.push_back(fit.fitted ? fit.rms_dps : nan);
+  }
 }
 
 void EffectIntervals::measureGaussMarkov(const std::vector<SeriesStats>& reps, const Context& c) {
@@ -263,12 +286,12 @@ void EffectIntervals::state(AxisModelCheck& out, std::span<const double> cleaned
       case ModelEffect::BiasSteps:
         e.size_intervals.clear();
         for (std::size_t j = 0; j < e.sizes_dps.size(); ++j)
-          e.size_intervals.push_back(empty() || j >= step_columns
+          e.size_intervals.push_back(columns_ == 0 || j >= step_columns
                                          ? ParameterInterval{}
                                          : bootstrapInterval(e.sizes_dps[j], column(next_column + j)));
         break;
       case ModelEffect::Sinusoid:
-        for (std::size_t s = 0; s < removal_.sinusoids.size() && !empty(); ++s) {
+        for (std::size_t s = 0; s < removal_.sinusoids.size() && columns_ > 0; ++s) {
           if (std::fabs(removal_.sinusoids[s].freq_hz - e.freq_hz) > 1e-9 * e.freq_hz) continue;
           e.amp_interval =
               sinusoidAmplitudeInterval(e.amp_dps, column(sine_first + 2 * s), column(sine_first + 2 * s + 1));
@@ -276,7 +299,7 @@ void EffectIntervals::state(AxisModelCheck& out, std::span<const double> cleaned
         }
         break;
       case ModelEffect::TemperatureBias:
-        if (!empty() && removal_.temperature && temperature_column < columns_)
+        if (columns_ > 0 && removal_.temperature && temperature_column < columns_)
           e.k_interval = bootstrapInterval(e.k_dps_per_c, column(temperature_column));
         break;
       case ModelEffect::GaussMarkov:
@@ -286,6 +309,22 @@ void EffectIntervals::state(AxisModelCheck& out, std::span<const double> cleaned
           e.tau_interval.hi *= std::exp(gm_tau_grid_step_);
         }
         e.sigma_interval = logBootstrapInterval(e.sigma_dps, gm_sigma_);
+        break;
+      case ModelEffect::NarrowbandLine:
+        for (std::size_t j = 0; j < removal_.lines.size(); ++j) {
+          if (std::fabs(removal_.lines[j].centre_hz - e.centre_hz) > 1e-9 * e.centre_hz) continue;
+          std::vector<double> centre, width, rms;
+          for (const std::vector<double>& r : line_estimates_) {
+            if (r.size() != 3 * removal_.lines.size()) continue;
+            centre.push_back(r[3 * j]);
+            width.push_back(r[3 * j + 1]);
+            rms.push_back(r[3 * j + 2]);
+          }
+          e.centre_interval = bootstrapInterval(e.centre_hz, centre);
+          e.width_interval = logBootstrapInterval(e.width_hz, width);
+          e.rms_interval = logBootstrapInterval(e.rms_dps, rms);
+          break;
+        }
         break;
       case ModelEffect::Outliers: {
         e.count_interval = poissonInterval(e.count);

@@ -10,6 +10,8 @@
 // widened by one step of its fitting grid, which the replicas cannot show); the sinusoid's
 // amplitude from the Rice distribution of √(a² + b²) with the parts' pooled replica spread.
 // Outliers: an exact Poisson interval of the count, and the median excursion's normal one.
+// A narrowband line: its centre, width and rms refitted on each replica by the same Whittle
+// fit (narrowband.cpp); normal interval for the centre, log scale for width and rms.
 #include <cstddef>
 #include <span>
 #include <vector>
@@ -49,7 +51,7 @@ class EffectIntervals {
  public:
   EffectIntervals(const Removal& removal, const Context& c, const std::vector<double>& temperature_regressor,
                   std::size_t replicas);
-  bool empty() const { return columns_ == 0; }
+  bool empty() const { return columns_ == 0 && removal_.lines.empty(); }
   void measureReplica(std::size_t index, std::span<const double> x);
   // Replicas' Allan curves → the Gauss–Markov fit's T and σ on each.
   void measureGaussMarkov(const std::vector<SeriesStats>& reps, const Context& c);
@@ -64,6 +66,10 @@ class EffectIntervals {
   std::vector<std::vector<double>> regressors_;  // column-major, n each
   std::vector<double> gram_inverse_;             // columns_ × columns_
   std::vector<std::vector<double>> estimates_;   // per replica, the effect columns' estimates
+  // Narrowband lines, refitted on each replica: per replica, centre, width and rms per line.
+  void measureLines(std::size_t index, std::span<const double> x);
+  const Context& context_;
+  std::vector<std::vector<double>> line_estimates_;
   std::vector<double> gm_tau_, gm_sigma_;
   double gm_tau_grid_step_ = 0.0;  // the T grid's step, log scale
 };

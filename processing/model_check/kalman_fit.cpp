@@ -14,7 +14,7 @@
 namespace gyrod::processing::model_check_detail {
 namespace {
 
-constexpr std::size_t kMaxStates = kMaxArOrder + 1;
+constexpr std::size_t kMaxStates = kMaxArOrder + 1 + 2 * kMaxInnovationLines;
 using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxStates, kMaxStates>;
 using Vector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxStates, 1>;
 constexpr std::size_t kBurnIn = 100;
@@ -26,7 +26,8 @@ constexpr double kRejectSigmas = 5.0;
 }  // namespace
 
 InnovationStats kalmanInnovations(std::span<const double> z, std::span<const double> phi, double ar_noise_var,
-                                  double gm_decay, double gm_noise_var, bool robust) {
+                                  double gm_decay, double gm_noise_var, bool robust,
+                                  std::span<const NarrowbandLineRecursion> lines) {
   const std::size_t p = phi.size();
   const bool gm = gm_noise_var > 0.0;
   if (p == 0 || p > kMaxArOrder)
@@ -38,7 +39,10 @@ InnovationStats kalmanInnovations(std::span<const double> z, std::span<const dou
   if (z.size() <= kBurnIn + 10)
     throw std::invalid_argument("the Kalman innovations need more than " + std::to_string(kBurnIn + 10) +
                                 " samples, got " + std::to_string(z.size()));
-  const auto d = static_cast<Eigen::Index>(p + (gm ? 1 : 0));
+  if (lines.size() > kMaxInnovationLines)
+    throw std::invalid_argument("the Kalman innovations take at most " + std::to_string(kMaxInnovationLines) +
+                                " narrowband lines, got " + std::to_string(lines.size()));
+  const auto d = static_cast<Eigen::Index>(p + (gm ? 1 : 0) + 2 * lines.size());
   const auto pi = static_cast<Eigen::Index>(p);
 
   Matrix f = Matrix::Zero(d, d), q = Matrix::Zero(d, d), pm(d, d), pp(d, d);
@@ -52,6 +56,14 @@ InnovationStats kalmanInnovations(std::span<const double> z, std::span<const dou
   Vector h = Vector::Zero(d);
   h(0) = 1.0;
   if (gm) h(pi) = 1.0;
+  for (std::size_t j = 0; j < lines.size(); ++j) {
+    const auto at = static_cast<Eigen::Index>(p + (gm ? 1 : 0) + 2 * j);
+    f(at, at) = lines[j].a1;
+    f(at, at + 1) = lines[j].a2;
+    f(at + 1, at) = 1.0;
+    q(at, at) = lines[j].drive_var;
+    h(at) = 1.0;
+  }
 
   double var_z = 0.0;
   for (double v : z) var_z += v * v;

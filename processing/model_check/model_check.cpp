@@ -182,19 +182,21 @@ AxisModelCheck checkAxisModel(const AxisModelCheckInput& input, const ModelCheck
   const NullSummary outlier_null = summarizeNull(column(base_reps, &SeriesStats::outlier_max_z), o.false_alarm, false);
   const NullSummary spectral_null =
       summarizeNull(column(base_reps, &SeriesStats::spectral_log_ratio), o.false_alarm, false);
+  const NullSummary line_scan_null = summarizeNull(column(base_reps, &SeriesStats::line_scan), o.false_alarm, false);
 
   // The detectors, each removing what it names from xc (the measured series, cleaned).
   std::vector<double> xc = xd;
   Removal removal;
   const OutliersFound outliers = checkOutliers(xd, xc, outlier_null, o.replicas, out);
   bool deterministic_found = outliers.found;
-  deterministic_found = checkSinusoids(xc, c, spectral_null, o.replicas, removal, out) || deterministic_found;
+  deterministic_found =
+      checkSinusoids(xc, c, spectral_null, line_scan_null, o.replicas, removal, out) || deterministic_found;
   deterministic_found = checkTemperatureAndSteps(input, xc, c, temp, base_reps, o, removal, out) || deterministic_found;
   removeLinearTrend(xc, c.tau0);
   GaussMarkovFound gm = checkGaussMarkov(xc, c, deterministic_found, curve, base_reps, o, out);
   refitThroughChain(xc, c, deterministic_found, gm, out);
-  const bool outliers_alone =
-      outliers.found && removal.sinusoids.empty() && !removal.temperature && removal.step_samples.empty() && !gm.found;
+  const bool outliers_alone = outliers.found && removal.sinusoids.empty() && removal.lines.empty() &&
+                              !removal.temperature && removal.step_samples.empty() && !gm.found;
   if (outliers_alone) spikesAsWhiteNoise(xd, xc, c, gm, out);
   out.extended_fit = gm.clean_fit;
   out.extended_fit.value = gm.extended_terms;

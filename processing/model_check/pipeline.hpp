@@ -20,6 +20,7 @@
 #include "processing/allan/noise_fit.hpp"
 #include "processing/model_check/detail.hpp"
 #include "processing/model_check/model_check.hpp"
+#include "processing/simulation/narrowband_line.hpp"
 #include "processing/simulation/noise_simulator.hpp"
 
 namespace gyrod::processing::model_check_detail {
@@ -46,11 +47,13 @@ struct Context {
   double rate = 0.0, tau0 = 0.0;
   std::vector<std::size_t> ms;
   std::vector<double> taus, edf;
-  std::vector<double> t_grid;         // Gauss–Markov correlation times tried
-  std::size_t block = 1, blocks = 0;  // block length [samples], number of blocks
-  std::vector<double> temp_blocks;    // detrended block means of temperature (empty: none)
-  std::vector<std::size_t> scales;    // Haar scales [blocks]
-  std::size_t k_lo = 0, k_hi = 0;     // periodogram bins searched for a sinusoid
+  std::vector<double> t_grid;             // Gauss–Markov correlation times tried
+  std::size_t block = 1, blocks = 0;      // block length [samples], number of blocks
+  std::vector<double> temp_blocks;        // detrended block means of temperature (empty: none)
+  std::vector<std::size_t> scales;        // Haar scales [blocks]
+  std::size_t k_lo = 0, k_hi = 0;         // periodogram bins searched for a sinusoid or a line
+  std::vector<std::size_t> line_scales;   // widths [bins] of the narrowband scan (narrowband.cpp)
+  std::size_t line_background_block = 0;  // bins per median of its background
   std::vector<double> psd_edges;
   ChainModel chain;
 };
@@ -93,6 +96,7 @@ struct SeriesStats {
   double outlier_max_z = kNaN;
   double spectral_log_ratio = kNaN;
   std::size_t spectral_bin = 0;
+  double line_scan = kNaN;  // the narrowband scan's statistic (narrowband.cpp)
   double temp_slope = kNaN;
   // Per Haar scale of c.scales: the largest |D_W| of the low-passed residual and the mean of
   // D_W² over its positions (the replicas' pooled mean square standardises the scan).
@@ -148,6 +152,7 @@ double maxAbsZ(const std::vector<double>& log_adev, const std::vector<double>& m
 
 struct Removal {
   std::vector<SinusoidFit> sinusoids;
+  std::vector<NarrowbandLine> lines;  // shrunk out of the working series, not subtracted
   double k = 0.0;
   bool temperature = false;
   std::vector<std::size_t> step_samples;
@@ -173,9 +178,46 @@ struct OutliersFound {
 OutliersFound checkOutliers(std::span<const double> xd, std::vector<double>& xc, const NullSummary& null,
                             std::size_t replicas, AxisModelCheck& out);
 
-// Up to three narrow lines, each fitted and subtracted from xc; returns whether one was named.
-bool checkSinusoids(std::vector<double>& xc, const Context& c, const NullSummary& null, std::size_t replicas,
-                    Removal& removal, AxisModelCheck& out);
+// Lines in the spectrum, one at a time until neither the single-bin peak (`null`) nor the
+// narrowband scan (`scan_null`) fires: each fitted as a resonance (narrowband.cpp); one whose
+// width is not resolved is a fixed sinusoid, fitted and subtracted from xc; a wider one a
+// narrowband line, shrunk out of xc. Returns whether one was named.
+bool checkSinusoids(std::vector<double>& xc, const Context& c, const NullSummary& null, const NullSummary& scan_null,
+                    std::size_t replicas, Removal& removal, AxisModelCheck& out);
+
+// ---- narrowband lines (narrowband.cpp) --------------------------------------------------------
+
+// Widths [bins] of the scan: 4, 8, … up to 1 Hz and 1/16 of the bins.
+std::vector<std::size_t> lineScanScales(std::size_t bins, double df);
+// Bins per median block of the scan's background: four times its widest band, ≥ 256.
+std::size_t lineBackgroundBlock(double df);
+// The periodogram's local level from medians of blocks of `block` bins (÷ ln 2), log-linear
+// between block centres.
+std::vector<double> blockMedianBackground(const std::vector<double>& power, std::size_t block);
+// The largest band of excess power: for each width w of `scales`, the band of w bins whose
+// mean ratio to the background is largest, scored as −ln of its tail probability under no
+// line (a mean of w Hann periodogram bins ~ Gamma(w/κ, κ/w)); the best over widths.
+struct LineScan {
+  double statistic = 0.0;
+  std::size_t centre_bin = 0, width_bins = 0;
+};
+LineScan scanForLines(const std::vector<double>& power, const std::vector<double>& background, std::size_t k_lo,
+                      std::size_t k_hi, const std::vector<std::size_t>& scales);
+// The resonance (narrowband_line.hpp) plus a log-linear background, fitted by the Whittle
+// likelihood to the one-sided PSD near `centre_bin`.
+struct NarrowbandFit {
+  bool fitted = false;
+  bool resolved = false;  // wider than a fixed sinusoid's peak: a narrowband line
+  double centre_hz = 0.0, width_hz = 0.0, rms_dps = 0.0;
+  double background_psd = 0.0;  // the fitted background at the centre
+};
+NarrowbandFit fitNarrowbandLine(const std::vector<double>& psd, const std::vector<double>& background, double df,
+                                double rate, std::size_t centre_bin, std::size_t width_bins, std::size_t k_lo,
+                                std::size_t k_hi, int iterations = 400);
+// One-sided PSD [(°/s)²/Hz] of a Hann periodogram.
+std::vector<double> onesidedPsd(const Periodogram& p, double rate);
+// x with the line's power taken out: its spectrum times √(b/(b + S_line)), b the background.
+void shrinkNarrowbandLine(std::vector<double>& x, const NarrowbandLine& line, double background_psd, double rate);
 
 // The temperature channel detrended as the rate is, and its block means.
 struct TemperatureChannel {

@@ -1,4 +1,5 @@
-// The model check's sinusoid detector: narrow lines in the spectrum, each fitted and removed.
+// The model check's line detector: peaks in the spectrum, each fitted and removed — a fixed
+// sinusoid subtracted, a narrowband line (narrowband.cpp) shrunk out.
 #include <cmath>
 #include <numbers>
 
@@ -8,7 +9,8 @@
 namespace gyrod::processing::model_check_detail {
 namespace {
 
-constexpr std::size_t kMaxSinusoids = 3;
+// Lines named per axis (fixed sinusoids and narrowband lines together).
+constexpr std::size_t kMaxLines = 6;
 constexpr double kSameLineBins = 3.0;  // peaks closer than this (periodogram bins) are one line
 
 // The least-squares sinusoid at the frequency within ±1 bin of `bin` of largest amplitude.
@@ -28,19 +30,58 @@ DetectedEffect* sameLine(std::vector<DetectedEffect>& effects, double freq_hz, d
   return same_line;
 }
 
+// A line wider than a bin: named as a narrowband line, shrunk out of xc.
+void nameNarrowbandLine(std::vector<double>& xc, const NarrowbandFit& fit, const Context& c, double stat,
+                        const NullSummary& null, std::size_t replicas, Removal& removal, AxisModelCheck& out) {
+  const NarrowbandLine line{fit.centre_hz, fit.width_hz, fit.rms_dps};
+  shrinkNarrowbandLine(xc, line, fit.background_psd, c.rate);
+  removal.lines.push_back(line);
+  DetectedEffect e;
+  e.effect = ModelEffect::NarrowbandLine;
+  e.centre_hz = fit.centre_hz;
+  e.width_hz = fit.width_hz;
+  e.rms_dps = fit.rms_dps;
+  e.evidence = nullEvidence(stat, null, replicas);
+  e.evidence.freq_hz = fit.centre_hz;
+  out.effects.push_back(e);
+}
+
 }  // namespace
 
-bool checkSinusoids(std::vector<double>& xc, const Context& c, const NullSummary& null, std::size_t replicas,
-                    Removal& removal, AxisModelCheck& out) {
+bool checkSinusoids(std::vector<double>& xc, const Context& c, const NullSummary& null, const NullSummary& scan_null,
+                    std::size_t replicas, Removal& removal, AxisModelCheck& out) {
   const double rate = c.rate;
   bool found = false;
-  for (std::size_t s = 0; s < kMaxSinusoids; ++s) {
+  for (std::size_t s = 0; s < kMaxLines; ++s) {
     const Periodogram p = hannPeriodogram(xc);
     const SpectralPeak peak = largestSpectralPeak(p.power, spectralBackground(p.power), c.k_lo, c.k_hi);
     const double stat = std::log(peak.ratio);
-    if (s == 0) out.statistics.push_back(makeStatistic("spectral_peak_log_ratio", stat, null));
-    if (!null.fires(stat)) break;
+    const std::vector<double> wide_bg = blockMedianBackground(p.power, c.line_background_block);
+    const LineScan scan = scanForLines(p.power, wide_bg, c.k_lo, c.k_hi, c.line_scales);
+    if (s == 0) {
+      out.statistics.push_back(makeStatistic("spectral_peak_log_ratio", stat, null));
+      out.statistics.push_back(makeStatistic("narrowband_scan", scan.statistic, scan_null));
+    }
+    const bool peak_fires = null.fires(stat), scan_fires = !c.line_scales.empty() && scan_null.fires(scan.statistic);
+    if (!peak_fires && !scan_fires) break;
     const double df = rate / static_cast<double>(p.nfft);
+    // The line's shape decides its kind: fitted as a resonance where it fired, resolved wider
+    // than a bin it is a narrowband line.
+    {
+      const std::size_t centre = peak_fires ? peak.bin : scan.centre_bin;
+      const std::size_t width = peak_fires ? 4 : scan.width_bins;
+      const std::vector<double> psd = onesidedPsd(p, rate);
+      std::vector<double> bg_psd = wide_bg;
+      for (double& v : bg_psd) v *= 2.0 / (rate * p.window_power);
+      const NarrowbandFit fit = fitNarrowbandLine(psd, bg_psd, df, rate, centre, width, c.k_lo, c.k_hi);
+      if (fit.fitted && fit.resolved) {
+        nameNarrowbandLine(xc, fit, c, scan_fires ? scan.statistic : stat, scan_fires ? scan_null : null, replicas,
+                           removal, out);
+        found = true;
+        continue;
+      }
+      if (!peak_fires) break;  // the scan's band is a fixed sinusoid too weak for the peak test
+    }
     const SinusoidFit fit = fitLineNearBin(xc, rate, peak.bin, df);
     const double w = 2.0 * std::numbers::pi * fit.freq_hz / rate;
     for (std::size_t i = 0; i < xc.size(); ++i)

@@ -411,8 +411,12 @@ bool checkTemperatureAndSteps(const AxisModelCheckInput& input, std::vector<doub
     e.evidence = lowFrequencyEvidence(s_stat, lf.steps, o.replicas, ch);
     out.effects.push_back(e);
   }
-  const std::vector<double> d = deterministicPart(
-      {{}, removal.k, removal.temperature, removal.step_samples, removal.step_sizes}, xc.size(), c.rate, temp.smoothed);
+  Removal low_frequency;  // the temperature response and the steps: the lines are already out of xc
+  low_frequency.k = removal.k;
+  low_frequency.temperature = removal.temperature;
+  low_frequency.step_samples = removal.step_samples;
+  low_frequency.step_sizes = removal.step_sizes;
+  const std::vector<double> d = deterministicPart(low_frequency, xc.size(), c.rate, temp.smoothed);
   for (std::size_t i = 0; i < xc.size(); ++i) xc[i] -= d[i];
   return true;
 }
