@@ -114,7 +114,35 @@ void validateExtraEffects(const AxisExtraEffects& extra, const std::string& pref
     requireFinite(extra.bias_steps[i].size_dps, w + "size_dps");
   }
   requireNonNegative(extra.outlier_amplitude_dps, prefix + "extra.outlier_amplitude_dps");
+  // centre < rate/2 needs the rate: narrowbandLineRecursionOf checks it where the rate is known.
+  for (std::size_t i = 0; i < extra.narrowband_lines.size(); ++i) {
+    const std::string w = prefix + "extra.narrowband_line[" + std::to_string(i) + "].";
+    requirePositive(extra.narrowband_lines[i].centre_hz, w + "centre_hz");
+    requirePositive(extra.narrowband_lines[i].width_hz, w + "width_hz");
+    requireNonNegative(extra.narrowband_lines[i].rms_dps, w + "rms_dps");
+  }
 }
+
+namespace {
+
+// narrowbandLineRecursion with its message naming the line as the model's other keys are
+// named ("axis y: extra.narrowband_line[0].centre_hz must be in (0, rate/2 = 25), got 31.4").
+NarrowbandLineRecursion narrowbandLineRecursionOf(const NarrowbandLine& line, double rate_hz, const std::string& what) {
+  try {
+    return narrowbandLineRecursion(line, rate_hz);
+  } catch (const std::invalid_argument& e) {
+    std::string cause = e.what();
+    const std::string generic = "narrowband line: ";
+    if (cause.rfind(generic, 0) == 0) cause.erase(0, generic.size());
+    throw std::invalid_argument(what + cause);
+  }
+}
+
+std::string narrowbandLineName(std::size_t axis, std::size_t index) {
+  return axisPrefix(axis) + "extra.narrowband_line[" + std::to_string(index) + "].";
+}
+
+}  // namespace
 
 void validateSimulationModel(const SimulationModel& model) {
   requirePositive(model.rate_hz, "rate_hz");
@@ -127,6 +155,8 @@ void validateSimulationModel(const SimulationModel& model) {
     requireFinite(axis.bias_dps, prefix + "bias_dps");
     validateArComponent(axis.ar, prefix);
     validateExtraEffects(axis.extra, prefix);
+    for (std::size_t i = 0; i < axis.extra.narrowband_lines.size(); ++i)
+      narrowbandLineRecursionOf(axis.extra.narrowband_lines[i], model.rate_hz, narrowbandLineName(a, i));
   }
   const TemperatureModel& temp = model.temperature;
   requireFinite(temp.start_c, "temperature.start_c");
@@ -358,6 +388,23 @@ void NoiseSimulator::initExtras(std::uint64_t seed, double duration_s) {
       s.gm_innovation_std = e.gauss_markov_sigma_dps * std::sqrt(-portable::expm1(-2.0 * h));
       s.gm_value = e.gauss_markov_sigma_dps * extra_noise_->next();  // stationary start
     }
+    // Each line its own AR(2), started in its stationary distribution: (x_{−2}, x_{−1}) jointly
+    // Gaussian with variance v and lag-1 covariance v·a1/(1 − a2), so the first samples are as
+    // wide as the rest.
+    for (std::size_t i = 0; i < e.narrowband_lines.size(); ++i) {
+      const NarrowbandLineRecursion r =
+          narrowbandLineRecursionOf(e.narrowband_lines[i], model_.rate_hz, narrowbandLineName(a, i));
+      const double variance = r.drive_var * ar2StationaryVariancePerDrive(r.a1, r.a2);
+      const double lag1_correlation = r.a1 / (1.0 - r.a2);
+      NarrowbandLineState line;
+      line.a1 = r.a1;
+      line.a2 = r.a2;
+      line.drive_std = std::sqrt(r.drive_var);
+      line.before_previous = std::sqrt(variance) * extra_noise_->next();
+      line.previous = lag1_correlation * line.before_previous +
+                      std::sqrt(variance * (1.0 - lag1_correlation * lag1_correlation)) * extra_noise_->next();
+      s.lines.push_back(line);
+    }
     if (e.outlier_count > sample_count_)
       throw std::invalid_argument(axisPrefix(a) + "extra.outlier_count " + std::to_string(e.outlier_count) +
                                   " is more than the " + std::to_string(sample_count_) + " samples of " +
@@ -388,12 +435,32 @@ double NoiseSimulator::extraEffectAt(std::size_t a, std::uint64_t index) {
     v += s.gm_value;
     s.gm_value = s.gm_decay * s.gm_value + s.gm_innovation_std * extra_noise_->next();
   }
+  if (!s.lines.empty()) v += nextLinesSum(s);
   for (const BiasStepEffect& step : e.bias_steps)
     if (t >= step.time_s) v += step.size_dps;
   while (s.next_outlier < s.outlier_positions.size() && s.outlier_positions[s.next_outlier] < index) ++s.next_outlier;
   if (s.next_outlier < s.outlier_positions.size() && s.outlier_positions[s.next_outlier] == index)
     v += s.outlier_values[s.next_outlier];
   return v;
+}
+
+double NoiseSimulator::nextLinesSum(ExtraState& s) {
+  double sum = 0.0;
+  for (NarrowbandLineState& line : s.lines) {
+    const double x = line.a1 * line.previous + line.a2 * line.before_previous + line.drive_std * extra_noise_->next();
+    line.before_previous = line.previous;
+    line.previous = x;
+    sum += x;
+  }
+  return sum;
+}
+
+std::array<double, kSimulatedAxes> NoiseSimulator::nextNarrowbandLines() {
+  std::array<double, kSimulatedAxes> out{};
+  if (extras_.empty()) return out;
+  for (std::size_t a = 0; a < kSimulatedAxes; ++a)
+    if (!extras_[a].lines.empty()) out[a] = nextLinesSum(extras_[a]);
+  return out;
 }
 
 void NoiseSimulator::initAr(AxisState& axis, const ArComponent& ar) {

@@ -62,7 +62,9 @@ struct AxisExtraEffects {
   // get ±outlier_amplitude_dps added (sign at random).
   std::size_t outlier_count = 0;
   double outlier_amplitude_dps = 0.0;
-  // Lines whose frequency wanders (narrowband_line.hpp), each its own resonance.
+  // Lines whose frequency wanders (narrowband_line.hpp), each its own resonance, started in
+  // its stationary distribution (centre < rate/2 is checked where the rate is known:
+  // validateSimulationModel and the simulator's constructor).
   std::vector<NarrowbandLine> narrowband_lines;
   bool empty() const {
     return temperature_coefficient_dps_per_c == 0.0 && sinusoids.empty() && gauss_markov_sigma_dps == 0.0 &&
@@ -146,8 +148,9 @@ void validateSimulationModel(const SimulationModel& model);
 std::size_t sampleRateDivisor(int dlpf_cfg, double rate_hz);
 void validateArComponent(const ArComponent& ar, const std::string& what = "");
 // The extra effects of one axis: finite values, frequencies and a set Gauss–Markov's
-// correlation time > 0, amplitudes ≥ 0 (messages start with `what`). The outlier count
-// is checked against the recording length when the simulator is built.
+// correlation time > 0, amplitudes ≥ 0, a narrowband line's centre and width > 0 and rms ≥ 0
+// (messages start with `what`). The outlier count is checked against the recording length
+// when the simulator is built, a line's centre against rate/2 by validateSimulationModel.
 void validateExtraEffects(const AxisExtraEffects& extra, const std::string& what = "");
 
 // ---- bias instability (flicker) as a bank of Gauss–Markov processes ----------------
@@ -215,6 +218,12 @@ class NoiseSimulator {
   // these two on one instance, not both.
   SimulatedSample nextAnalog();
   std::array<double, kSimulatedAxes> nextOutputRateNoise();
+  // For the mock device, whose simulator runs at the internal rate and which does not take the
+  // output-rate terms: the narrowband lines alone (AxisExtraEffects::narrowband_lines, 0 on an
+  // axis without), advanced one sample per call at outputRateHz(). A line's centre and width
+  // are in Hz, so at the internal rate it is the same line, and the mock's DLPF acts on it as
+  // on the chip. Use instead of nextOutputRateNoise(), not with it.
+  std::array<double, kSimulatedAxes> nextNarrowbandLines();
 
   double outputRateHz() const { return model_.rate_hz; }
   double internalRateHz() const { return internal_rate_hz_; }
@@ -251,14 +260,20 @@ class NoiseSimulator {
   void initAr(AxisState& axis, const ArComponent& ar);
 
   // State of the extra effects of one axis (empty when the axis has none).
+  struct NarrowbandLineState {
+    double a1 = 0.0, a2 = 0.0, drive_std = 0.0;
+    double previous = 0.0, before_previous = 0.0;  // x_{k−1}, x_{k−2}
+  };
   struct ExtraState {
     double gm_decay = 0.0, gm_innovation_std = 0.0, gm_value = 0.0;
+    std::vector<NarrowbandLineState> lines;
     std::vector<std::uint64_t> outlier_positions;  // sorted output-sample indices
     std::vector<double> outlier_values;            // signed, same order
     std::size_t next_outlier = 0;
   };
   void initExtras(std::uint64_t seed, double duration_s);
   double extraEffectAt(std::size_t axis, std::uint64_t index);
+  double nextLinesSum(ExtraState& state);  // the axis's lines advanced one sample, summed
 
   SimulationModel model_;
   SplitMix64 seeder_;  // expands the seed into one xoshiro stream per term and axis
