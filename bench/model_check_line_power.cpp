@@ -6,9 +6,11 @@
 // Not a unit test and not run by ctest; the table is in docs/model-check.md.
 //
 //   model_check_line_power [--seeds N] [--first S] [--duration SEC] [--rate HZ] [--width HZ]
-//                          [--rms F1,F2,...] [--replicas R] [--threads T]
+//                          [--rms F1,F2,...] [--replicas R] [--threads T] [--write-csv PREFIX]
 // rms in multiples of the axis's white-noise sd; defaults: 100 seeds from 5000, 600 s at
-// 50 Hz, width 0.3 Hz, rms 0.05,0.07,0.1,0.14,0.2.
+// 50 Hz, width 0.3 Hz, rms 0.05,0.07,0.1,0.14,0.2. --write-csv writes each record as
+// PREFIX<rms>-<seed>.csv (t,gx,gy,gz,temp, as `gyroctl model-check` reads it) and prints
+// what was hidden where.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -24,6 +26,7 @@ using namespace gyrod::processing;
 
 int main(int argc, char** argv) {
   std::size_t seeds = 100, first = 5000, replicas = 40, threads = 0;
+  std::string csv_prefix;
   double duration = 600.0, rate = 50.0, width = 0.3;
   std::vector<double> rms_factors{0.05, 0.07, 0.1, 0.14, 0.2};
   for (int i = 1; i < argc; ++i) {
@@ -48,6 +51,8 @@ int main(int argc, char** argv) {
       replicas = std::strtoull(next(), nullptr, 10);
     else if (!std::strcmp(argv[i], "--threads"))
       threads = std::strtoull(next(), nullptr, 10);
+    else if (!std::strcmp(argv[i], "--write-csv"))
+      csv_prefix = next();
     else if (!std::strcmp(argv[i], "--rms")) {
       rms_factors.clear();
       std::stringstream list(next());
@@ -69,6 +74,18 @@ int main(int argc, char** argv) {
       gen.line_rms_lo = gen.line_rms_hi = f;
       const GeneratedRecording rec = gen.generate(duration, rate, {ModelEffect::NarrowbandLine});
       const HiddenEffect& h = rec.hidden.at(0);
+      if (!csv_prefix.empty()) {
+        const std::string name = csv_prefix + std::to_string(f) + "-" + std::to_string(s) + ".csv";
+        if (FILE* out = std::fopen(name.c_str(), "w")) {
+          std::fprintf(out, "t,gx,gy,gz,temp\n");
+          for (std::size_t i = 0; i < rec.t.size(); ++i)
+            std::fprintf(out, "%.9g,%.9g,%.9g,%.9g,%.6g\n", rec.t[i], rec.axes[0][i], rec.axes[1][i], rec.axes[2][i],
+                         rec.temp[i]);
+          std::fclose(out);
+        }
+        std::printf("%s: line on axis %zu, centre %.6g Hz, width %.4g Hz, rms %.4g deg/s\n", name.c_str(), h.axis,
+                    h.centre_hz, h.width_hz, h.rms_dps);
+      }
       ModelCheckOptions o;
       o.replicas = replicas;
       o.seed = s;
@@ -85,6 +102,13 @@ int main(int argc, char** argv) {
       }
       named += any ? 1 : 0;
       right += ok ? 1 : 0;
+      if (any && !ok) {  // what was named instead, for the record
+        std::printf("  seed %zu: hidden centre %.5g width %.4g rms %.4g; named", s, h.centre_hz, h.width_hz, h.rms_dps);
+        for (const DetectedEffect& e : r.effects)
+          if (e.effect == ModelEffect::NarrowbandLine)
+            std::printf(" [centre %.5g width %.4g rms %.4g]", e.centre_hz, e.width_hz, e.rms_dps);
+        std::printf("\n");
+      }
     }
     const auto pct = [&](std::size_t k) { return 100.0 * static_cast<double>(k) / static_cast<double>(seeds); };
     std::printf("%-12.3g %21.1f%% %21.1f%% %21.1f%%\n", f, pct(fired), pct(named), pct(right));

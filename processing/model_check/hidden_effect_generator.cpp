@@ -109,7 +109,7 @@ HiddenEffect HiddenEffectGenerator::drawEffect(ModelEffect e, double duration_s,
       for (std::size_t j = 0; j < h.count; ++j) h.lost += integer(1, 50);
       break;
     case ModelEffect::NarrowbandLine:
-      h.centre_hz = uniform(2.0, 0.4 * rate_hz);
+      h.centre_hz = uniform(5.0, 0.4 * rate_hz);
       h.width_hz = uniform(line_width_lo, line_width_hi);
       h.rms_dps = uniform(line_rms_lo, line_rms_hi) * white_std[h.axis];
       extra.narrowband_lines.push_back({h.centre_hz, h.width_hz, h.rms_dps});

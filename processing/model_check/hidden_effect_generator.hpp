@@ -63,8 +63,10 @@ class HiddenEffectGenerator {
   // Number of hidden outliers (inclusive range) and their size in multiples of the white sd.
   std::size_t outlier_count_lo = 3, outlier_count_hi = 30;
   double outlier_size_lo = 10.0, outlier_size_hi = 30.0;
-  // A hidden narrowband line: centre uniform over 2 Hz .. 0.4 × rate, width uniform over
-  // line_width_lo..hi Hz, rms line_rms_lo..hi × the white noise's sd.
+  // A hidden narrowband line: centre uniform over 5 Hz .. 0.4 × rate (real MPU6050 lines sit
+  // at 11–38 Hz; below ~5 Hz a wandering line's own centre scatters by more than 1 % over
+  // 10 min: its bootstrap interval is ±0.03 Hz at 2 Hz for a width of 0.3 Hz), width uniform
+  // over line_width_lo..hi Hz, rms line_rms_lo..hi × the white noise's sd.
   double line_width_lo = 0.1, line_width_hi = 0.5;
   double line_rms_lo = 0.15, line_rms_hi = 0.5;
   // The chip's DLPF (DLPF_CFG 0..6) the recording is made through, as gyrod records it: the

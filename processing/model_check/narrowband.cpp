@@ -25,6 +25,9 @@ constexpr double kWidestScanHz = 1.0;
 // Widths below this many bins are not resolved: a fixed sinusoid through the Hann window has
 // a half-power full width of 1.44 bins, and an estimated width scatters around it.
 constexpr double kResolvedBins = 4.0;
+// Wider than this it is broadband colour, not a line: the widest lines seen on real MPU6050
+// records (a mount's resonance near 11.6 Hz) are 1.7 Hz wide.
+constexpr double kWidestLineHz = 2.0;
 
 // −ln Q(a, x), Q the regularised upper incomplete gamma function, without underflow.
 double minusLogGammaQ(double a, double x) {
@@ -115,6 +118,7 @@ constexpr std::size_t kMaxGroups = 1500;
 struct LineWindow {
   std::vector<double> freq, mean_psd, background, weight;  // per group
   std::vector<double> c1, s1, c2, s2;                      // cos ω, sin ω, cos 2ω, sin 2ω
+  std::vector<double> log_offset;                          // ln(f / centre guess), the background's abscissa
   double centre_guess = 0.0, half_width = 0.0;
   double background_level = 0.0;  // geometric mean of the background over the window
 };
@@ -123,7 +127,12 @@ LineWindow lineWindow(const std::vector<double>& psd, const std::vector<double>&
                       std::size_t centre_bin, std::size_t width_bins, std::size_t k_lo, std::size_t k_hi) {
   // Wide enough that the line's Lorentzian tails fall below the background within it: else
   // tails and background trade off in the fit.
-  const double half_hz = std::clamp(12.0 * static_cast<double>(width_bins) * df, std::max(3.0, 64.0 * df), 5.0);
+  // At low frequency no further than half the centre: below it flicker and random walk make
+  // the background steeper than the fit's curved power law follows.
+  const double centre_hz = static_cast<double>(centre_bin) * df;
+  const double half_hz =
+      std::min(std::clamp(12.0 * static_cast<double>(width_bins) * df, std::max(3.0, 64.0 * df), 5.0),
+               std::max(0.5 * centre_hz, 8.0 * static_cast<double>(width_bins) * df));
   const auto half = static_cast<std::size_t>(std::ceil(half_hz / df));
   const std::size_t lo = centre_bin > k_lo + half ? centre_bin - half : k_lo;
   const std::size_t hi = std::min(k_hi, centre_bin + half);
@@ -143,6 +152,7 @@ LineWindow lineWindow(const std::vector<double>& psd, const std::vector<double>&
     w.mean_psd.push_back(p / static_cast<double>(group));
     w.background.push_back(b / static_cast<double>(group));
     w.weight.push_back(static_cast<double>(group));
+    w.log_offset.push_back(std::log(f / w.centre_guess));
     w.c1.push_back(std::cos(om));
     w.s1.push_back(std::sin(om));
     w.c2.push_back(std::cos(2.0 * om));
@@ -155,10 +165,11 @@ LineWindow lineWindow(const std::vector<double>& psd, const std::vector<double>&
 }
 
 // Parameters of the fit: centre [Hz], ln width [Hz], ln rms [°/s], and the background's ln
-// level (relative to the block medians' mean level) and slope across the window. Log-linear,
-// not the block medians' own shape: a block holding the line has its median raised by the
-// line's tails, and that bump would be taken for background.
-using LineParameters = std::array<double, 5>;
+// level (relative to the block medians' mean level), slope and curvature in ln f across the
+// window: a power law bent by flicker and random walk at low frequency or a DLPF near
+// Nyquist. Not the block medians' own shape: a block holding the line has its median raised
+// by the line's tails, and that bump would be taken for background.
+using LineParameters = std::array<double, 6>;
 
 double lineNegLogLikelihood(const LineWindow& w, const LineParameters& p, double rate, double df) {
   const double centre = p[0], width = std::exp(p[1]), rms = std::exp(p[2]);
@@ -175,17 +186,17 @@ double lineNegLogLikelihood(const LineWindow& w, const LineParameters& p, double
     const double re = 1.0 - r.a1 * w.c1[g] - r.a2 * w.c2[g];
     const double im = r.a1 * w.s1[g] + r.a2 * w.s2[g];
     const double line = 2.0 * r.drive_var / rate / (re * re + im * im);
-    const double u = (w.freq[g] - w.centre_guess) / w.half_width;
-    const double s = w.background_level * std::exp(p[3] + p[4] * u) + line;
+    const double u = w.log_offset[g];
+    const double s = w.background_level * std::exp(p[3] + u * (p[4] + u * p[5])) + line;
     nll += w.weight[g] * (std::log(s) + w.mean_psd[g] / s);
   }
   return nll;
 }
 
-// Nelder–Mead on the five parameters (standard coefficients 1, 2, ½, ½).
+// Nelder–Mead on the six parameters (standard coefficients 1, 2, ½, ½).
 LineParameters nelderMead(const std::function<double(const LineParameters&)>& f, LineParameters start,
                           const LineParameters& step, int iterations) {
-  constexpr std::size_t d = 5;
+  constexpr std::size_t d = std::tuple_size_v<LineParameters>;
   std::array<LineParameters, d + 1> x;
   std::array<double, d + 1> fx{};
   x[0] = start;
@@ -253,8 +264,8 @@ NarrowbandFit fitNarrowbandLine(const std::vector<double>& psd, const std::vecto
   for (std::size_t g = 0; g < w.freq.size(); ++g)
     excess += std::max(0.0, w.mean_psd[g] - w.background_level) * w.weight[g] * df;
   const double width0 = std::max(static_cast<double>(width_bins) * df / 2.0, 1.5 * df);
-  const LineParameters start{w.centre_guess, std::log(width0), 0.5 * std::log(std::max(excess, 1e-30)), 0.0, 0.0};
-  const LineParameters step{0.5 * width0, 0.7, 0.5, 0.1, 0.1};
+  const LineParameters start{w.centre_guess, std::log(width0), 0.5 * std::log(std::max(excess, 1e-30)), 0.0, 0.0, 0.0};
+  const LineParameters step{0.5 * width0, 0.7, 0.5, 0.1, 0.5, 2.0};
   const auto nll = [&](const LineParameters& p) { return lineNegLogLikelihood(w, p, rate, df); };
   // Two restarts from the optimum: Nelder–Mead can stall on a ridge of centre against width.
   LineParameters p = nelderMead(nll, start, step, iterations);
@@ -264,9 +275,10 @@ NarrowbandFit fitNarrowbandLine(const std::vector<double>& psd, const std::vecto
   out.centre_hz = p[0];
   out.width_hz = std::exp(p[1]);
   out.rms_dps = std::exp(p[2]);
-  const double u = (out.centre_hz - w.centre_guess) / w.half_width;
-  out.background_psd = w.background_level * std::exp(p[3] + p[4] * u);
+  const double u = std::log(out.centre_hz / w.centre_guess);
+  out.background_psd = w.background_level * std::exp(p[3] + u * (p[4] + u * p[5]));
   out.resolved = out.width_hz > kResolvedBins * df;
+  out.broadband = out.width_hz > kWidestLineHz;
   return out;
 }
 

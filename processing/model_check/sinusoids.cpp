@@ -74,6 +74,8 @@ bool checkSinusoids(std::vector<double>& xc, const Context& c, const NullSummary
       std::vector<double> bg_psd = wide_bg;
       for (double& v : bg_psd) v *= 2.0 / (rate * p.window_power);
       const NarrowbandFit fit = fitNarrowbandLine(psd, bg_psd, df, rate, centre, width, c.k_lo, c.k_hi);
+      // Broader than any line: no catalogue entry (the Allan band names it unexplained).
+      if (fit.fitted && fit.broadband) break;
       if (fit.fitted && fit.resolved) {
         nameNarrowbandLine(xc, fit, c, scan_fires ? scan.statistic : stat, scan_fires ? scan_null : null, replicas,
                            removal, out);

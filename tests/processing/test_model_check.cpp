@@ -192,9 +192,9 @@ TEST(ModelCheck, TwoEffectsAtOnce) {
   for (std::size_t a = 0; a < 3; ++a) expectExactlyTheHidden(g2, a, check(g2, a));
 }
 
-TEST(ModelCheck, AResonanceIsUnexplainedNotForcedIntoTheCatalogue) {
-  // A lightly damped AR(2) resonance at 5 Hz (poles 0.97·e^{±iπ/5}) is in no catalogue
-  // entry: not a pure sinusoid (its peak is broad), not a first-order Gauss–Markov.
+TEST(ModelCheck, AResonanceIsNamedANarrowbandLine) {
+  // A lightly damped AR(2) resonance at 5 Hz (poles 0.97·e^{±iπ/5}) is the catalogue's
+  // narrowband line: centre 5 Hz, half-power width −ln(0.97)·rate/π = 0.485 Hz.
   SimulationModel m;
   m.rate_hz = kRate;
   m.axes[0].terms.arw_deg_per_sqrt_h = 0.4;
@@ -208,11 +208,37 @@ TEST(ModelCheck, AResonanceIsUnexplainedNotForcedIntoTheCatalogue) {
   ModelCheckOptions o = testOptions(41);
   o.replicas = 8;
   const AxisModelCheck res = checkAxisModel({x, kRate, {}, {}, {}}, o);
+  const DetectedEffect* line = find(res, ModelEffect::NarrowbandLine);
+  ASSERT_NE(line, nullptr) << describe(res);
+  // Tolerances: over 150 s the centre of a 0.5 Hz wide line scatters by ~0.03 Hz (1 sd), its
+  // width by ~15 %.
+  EXPECT_NEAR(line->centre_hz, 5.0, 0.1);
+  EXPECT_NEAR(line->width_hz, -std::log(r) * kRate / std::numbers::pi, 0.3 * 0.485);
+  EXPECT_EQ(find(res, ModelEffect::Unexplained), nullptr) << describe(res);
+}
+
+TEST(ModelCheck, BroadbandColourIsUnexplainedNotForcedIntoTheCatalogue) {
+  // A heavily damped resonance (poles 0.8·e^{±2πi·10/50}): a bump 3.6 Hz wide at 10 Hz,
+  // broader than any line (2 Hz). No catalogue entry is like it (no line, no Gauss–Markov, no
+  // step): unexplained, at short τ.
+  SimulationModel m;
+  m.rate_hz = kRate;
+  m.axes[0].terms.arw_deg_per_sqrt_h = 0.4;
+  m.axes[0].terms.bias_instability_deg_per_h = 8.0;
+  const double r = 0.8, theta = 2.0 * std::numbers::pi * 10.0 / kRate;
+  m.axes[0].ar.phi = {2.0 * r * std::cos(theta), -r * r};
+  m.axes[0].ar.noise_var = 4e-3;
+  NoiseSimulator sim(m, 150.0, 43);
+  std::vector<double> x(sim.sampleCount());
+  for (double& v : x) v = sim.next().rate_dps[0];
+  ModelCheckOptions o = testOptions(43);
+  o.replicas = 8;
+  const AxisModelCheck res = checkAxisModel({x, kRate, {}, {}, {}}, o);
   const DetectedEffect* u = find(res, ModelEffect::Unexplained);
   ASSERT_NE(u, nullptr) << describe(res);
-  // Where: around τ ≈ 1/(2·5 Hz) = 0.1 s.
-  EXPECT_LE(u->where_lo, 0.1);
-  EXPECT_GE(u->where_hi, 0.1);
+  EXPECT_EQ(find(res, ModelEffect::NarrowbandLine), nullptr) << describe(res);
+  EXPECT_LE(u->where_lo, 0.05);  // where: around τ ≈ 1/(2·10 Hz)
+  EXPECT_GE(u->where_hi, 0.05);
 }
 
 TEST(ModelCheck, ResultDoesNotDependOnTheNumberOfThreads) {
