@@ -25,7 +25,7 @@ using namespace gyrod::processing;
 
 namespace {
 
-std::uint64_t bitsOf(double v) {
+std::uint64_t shareBitsOf(double v) {
   std::uint64_t b = 0;
   std::memcpy(&b, &v, sizeof b);
   return b;
@@ -65,7 +65,7 @@ TEST(ParallelShares, OverlappingAllanVariancesAreTheSameBitsForAnyThreadCount) {
     const std::vector<double> v = overlappingAllanVariances(x, ms);
     ASSERT_EQ(v.size(), reference.size());
     for (std::size_t k = 0; k < v.size(); ++k)
-      EXPECT_EQ(bitsOf(v[k]), bitsOf(reference[k])) << threads << " threads, m = " << ms[k];
+      EXPECT_EQ(shareBitsOf(v[k]), shareBitsOf(reference[k])) << threads << " threads, m = " << ms[k];
   }
 }
 
@@ -83,18 +83,18 @@ TEST(ParallelShares, TheWholeAxisAnalysisIsTheSameBitsForAnyThreadCount) {
     const AxisAnalysis a = analyzeAxis(x, options);
     ASSERT_EQ(a.allan.size(), reference.allan.size());
     for (std::size_t k = 0; k < a.allan.size(); ++k) {
-      EXPECT_EQ(bitsOf(a.allan[k].oadev), bitsOf(reference.allan[k].oadev)) << threads << " threads, k = " << k;
-      EXPECT_EQ(bitsOf(a.allan[k].adev), bitsOf(reference.allan[k].adev)) << threads << " threads, k = " << k;
+      EXPECT_EQ(shareBitsOf(a.allan[k].oadev), shareBitsOf(reference.allan[k].oadev)) << threads << " threads, k = " << k;
+      EXPECT_EQ(shareBitsOf(a.allan[k].adev), shareBitsOf(reference.allan[k].adev)) << threads << " threads, k = " << k;
       EXPECT_EQ(a.allan[k].noise_alpha, reference.allan[k].noise_alpha) << threads << " threads, k = " << k;
     }
     ASSERT_EQ(a.allan_after_kalman.size(), reference.allan_after_kalman.size());
     for (std::size_t k = 0; k < a.allan_after_kalman.size(); ++k)
-      EXPECT_EQ(bitsOf(a.allan_after_kalman[k].oadev), bitsOf(reference.allan_after_kalman[k].oadev))
+      EXPECT_EQ(shareBitsOf(a.allan_after_kalman[k].oadev), shareBitsOf(reference.allan_after_kalman[k].oadev))
           << threads << " threads, k = " << k;
-    EXPECT_EQ(bitsOf(a.noise.value.arw_deg_per_sqrt_h), bitsOf(reference.noise.value.arw_deg_per_sqrt_h));
-    EXPECT_EQ(bitsOf(a.noise_after_kalman.value.arw_deg_per_sqrt_h),
-              bitsOf(reference.noise_after_kalman.value.arw_deg_per_sqrt_h));
-    EXPECT_EQ(bitsOf(a.variance.kalman), bitsOf(reference.variance.kalman)) << threads << " threads";
+    EXPECT_EQ(shareBitsOf(a.noise.value.arw_deg_per_sqrt_h), shareBitsOf(reference.noise.value.arw_deg_per_sqrt_h));
+    EXPECT_EQ(shareBitsOf(a.noise_after_kalman.value.arw_deg_per_sqrt_h),
+              shareBitsOf(reference.noise_after_kalman.value.arw_deg_per_sqrt_h));
+    EXPECT_EQ(shareBitsOf(a.variance.kalman), shareBitsOf(reference.variance.kalman)) << threads << " threads";
   }
 }
 
@@ -136,8 +136,8 @@ TEST(ParallelShares, TheInPlaceTablesAlongsideWorkReadsTheSamplesBeforeTheyBecom
     double sum = 0.0;
     for (double v : x) sum += v;
     EXPECT_EQ(calls, 1) << threads << " threads";
-    EXPECT_EQ(bitsOf(sum_seen), bitsOf(sum)) << threads << " threads";
+    EXPECT_EQ(shareBitsOf(sum_seen), shareBitsOf(sum)) << threads << " threads";
     ASSERT_EQ(table.size(), reference.size());
-    for (std::size_t k = 0; k < table.size(); ++k) EXPECT_EQ(bitsOf(table[k].oadev), bitsOf(reference[k].oadev));
+    for (std::size_t k = 0; k < table.size(); ++k) EXPECT_EQ(shareBitsOf(table[k].oadev), shareBitsOf(reference[k].oadev));
   }
 }

@@ -32,6 +32,7 @@
 #include "processing/simulation/sensor_model.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
+#include "tools/gyroctl/model_check_edges.hpp"
 #include "tools/gyroctl/model_check_support.hpp"
 #include "tools/gyroctl/model_check_write_model.hpp"
 #include "tools/gyroctl/series_checks.hpp"
@@ -48,6 +49,7 @@ struct ModelCheckCliOptions {
   std::string axis = "all";
   bool json = false;
   bool strict_timing = false;
+  bool keep_edges = false;
   std::string report_dir;
   std::uint64_t seed = 1;
   std::size_t replicas = 40;
@@ -407,7 +409,9 @@ void writeReport(const std::string& dir_text, const ModelCheckCliOptions& opt, c
 int runModelCheck(const ModelCheckCliOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
   if (!opt.write_model.empty()) requireWritableTarget(opt.write_model, opt.file);
-  const LoadedInput in = loadInput(opt.file, opt.rate_hz, opt.axis);
+  LoadedInput in = loadInput(opt.file, opt.rate_hz, opt.axis);
+  const EdgeTrim edges = trimEdgeMotion(in, opt.keep_edges);
+  if (const std::string note = edgeTrimText(opt.file, edges); !note.empty()) std::fprintf(stderr, "%s\n", note.c_str());
   const auto& rec = in.recording;
   // The noise model is the gyro's: an accel column is read but not checked, which the user should not have to guess.
   if (std::any_of(rec.accel_g.begin(), rec.accel_g.end(), [](const auto& c) { return !c.empty(); }))
@@ -448,6 +452,7 @@ int runModelCheck(const ModelCheckCliOptions& opt) {
     doc["replicas"] = opt.replicas;
     doc["elapsed_s"] = seconds;
     doc["timing"] = timingJson(timing);
+    doc["edges"] = edgeTrimJson(edges);
     doc["acquisition_chain"] = chainJson(chain);
     doc["axes"] = json::object();
     for (const auto& [name, r] : results) doc["axes"][name] = axisJson(r);
@@ -484,6 +489,9 @@ void addModelCheckCommand(CLI::App& app, CommandRunner& run) {
   sub->add_option("--rate", opt->rate_hz, "sample rate [Hz] (default: from t, else 50)");
   sub->add_option("--axis", opt->axis, "gx, gy, gz or all")->default_val("all");
   sub->add_flag("--json", opt->json, "one JSON document on stdout");
+  sub->add_flag("--keep-edges", opt->keep_edges,
+                "keep motion found at the start or end of the recording (by default it is left out: the model is for a "
+                "gyro at rest)");
   sub->add_flag("--strict-timing", opt->strict_timing,
                 "gaps or irregular spacing in t, or GAP/DROPPED records, are an error instead of a warning");
   sub->add_option("--report", opt->report_dir, "write report.md with plots (gnuplot, when installed) into this folder");
