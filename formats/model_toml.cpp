@@ -68,6 +68,12 @@ class ModelReader {
     SensorModel sensor;
     SimulationModel& model = sensor.simulation;
     const toml::key* rate_key = nullptr;
+    // The rate bounds the narrowband lines' centres, which may be read before rate_hz itself.
+    if (const toml::node* rate = root.get("rate_hz"); rate && rate->is_number()) {
+      const double v = *rate->value<double>();
+      line_rate_hz_ = std::isfinite(v) && v > 0.0 ? v : 0.0;  // 0: rate_hz's own error comes first
+      line_rate_given_ = true;
+    }
     for (auto&& [key, node] : root) {
       const std::string k(key.str());
       if (k == "rate_hz") {
@@ -151,7 +157,8 @@ class ModelReader {
   //   temperature_coefficient_dps_per_c, temperature_reference_c, gauss_markov_tau_s,
   //   gauss_markov_sigma_dps, outlier_count, outlier_amplitude_dps,
   //   sinusoids = [{freq_hz = 1.0, amp_dps = 0.05, phase_rad = 0.0}, ...],
-  //   bias_steps = [{time_s = 60.0, size_dps = 0.02}, ...]
+  //   bias_steps = [{time_s = 60.0, size_dps = 0.02}, ...],
+  //   narrowband_lines = [{centre_hz = 31.4, width_hz = 0.3, rms_dps = 0.02}, ...]
   void readExtra(const toml::table& t, const std::string& axis, processing::AxisExtraEffects& e) const {
     const std::string where = axis + ".extra.";
     for (auto&& [key, node] : t) {
@@ -168,7 +175,7 @@ class ModelReader {
         e.outlier_amplitude_dps = nonNegative(node, key, where);
       else if (k == "outlier_count")
         e.outlier_count = static_cast<std::size_t>(integerIn(node, key, 0, 1000000000));
-      else if (k == "sinusoids" || k == "bias_steps") {
+      else if (k == "sinusoids" || k == "bias_steps" || k == "narrowband_lines") {
         if (!node.is_array())
           fail(key.source(), where + k + " must be an array of inline tables, got " + tomlTypeName(node));
         for (const toml::node& element : *node.as_array()) {
@@ -189,6 +196,8 @@ class ModelReader {
                      "unknown key '" + n + "' in " + where + "sinusoids (expected freq_hz, amp_dps, phase_rad)");
             }
             e.sinusoids.push_back(sin);
+          } else if (k == "narrowband_lines") {
+            e.narrowband_lines.push_back(readNarrowbandLine(*element.as_table(), key, where));
           } else {
             processing::BiasStepEffect step;
             for (auto&& [ek, ev] : *element.as_table()) {
@@ -207,7 +216,7 @@ class ModelReader {
         fail(key.source(), "unknown key '" + k + "' in [" + axis +
                                ".extra] (expected temperature_coefficient_dps_per_c, temperature_reference_c, "
                                "gauss_markov_tau_s, gauss_markov_sigma_dps, outlier_count, outlier_amplitude_dps, "
-                               "sinusoids, bias_steps)");
+                               "sinusoids, bias_steps, narrowband_lines)");
       }
     }
     try {
@@ -215,6 +224,36 @@ class ModelReader {
     } catch (const std::invalid_argument& ex) {
       doc_.failFile(ex.what());
     }
+  }
+
+  // One element of narrowband_lines: centre_hz and width_hz required, rms_dps 0 by default; the
+  // centre below the Nyquist frequency of the file's rate (the default 50 Hz when it gives none).
+  processing::NarrowbandLine readNarrowbandLine(const toml::table& t, const toml::key& array_key,
+                                                const std::string& where) const {
+    const std::string in = where + "narrowband_lines.";
+    processing::NarrowbandLine line;
+    for (auto&& [key, node] : t) {
+      const std::string n(key.str());
+      if (n == "centre_hz") {
+        line.centre_hz = positive(node, key, in);
+        if (line_rate_hz_ > 0.0 && !(line.centre_hz < line_rate_hz_ / 2.0))
+          fail(key.source(), in + "centre_hz must be < rate_hz/2 = " + formatNumber(line_rate_hz_ / 2.0) + ", got " +
+                                 formatNumber(line.centre_hz) +
+                                 (line_rate_given_ ? "" : " (rate_hz not given: default 50)"));
+      } else if (n == "width_hz") {
+        line.width_hz = positive(node, key, in);
+      } else if (n == "rms_dps") {
+        line.rms_dps = nonNegative(node, key, in);
+      } else {
+        fail(key.source(),
+             "unknown key '" + n + "' in " + where + "narrowband_lines (expected centre_hz, width_hz, rms_dps)");
+      }
+    }
+    for (const char* needed : {"centre_hz", "width_hz"})
+      if (!t.contains(needed))
+        fail(array_key.source(),
+             where + "narrowband_lines: each line needs centre_hz and width_hz (" + needed + " is missing)");
+    return line;
   }
 
   // [x.calibration]: every key optional (AxisCalibration's defaults).
@@ -340,6 +379,10 @@ class ModelReader {
 
  private:
   const formats::TomlDocument& doc_;
+  // The file's output rate as read() finds it first, for the lines' centres (the readers are
+  // const: this is the one thing read() learns before the tables that need it).
+  mutable double line_rate_hz_ = processing::SimulationModel{}.rate_hz;
+  mutable bool line_rate_given_ = false;
 };
 
 // In arrays values are written as %.17g, where -0.0 would be "-0", which TOML reads as the
@@ -484,6 +527,16 @@ std::string modelText(const processing::SimulationModel& model, const SensorMode
         out += buf;
       }
       out += "]\n";
+      if (!e.narrowband_lines.empty()) {
+        out += "narrowband_lines = [";
+        for (std::size_t i = 0; i < e.narrowband_lines.size(); ++i) {
+          std::snprintf(buf, sizeof buf, "%s{centre_hz = %.17g, width_hz = %.17g, rms_dps = %.17g}", i ? ", " : "",
+                        unsignedZero(e.narrowband_lines[i].centre_hz), unsignedZero(e.narrowband_lines[i].width_hz),
+                        unsignedZero(e.narrowband_lines[i].rms_dps));
+          out += buf;
+        }
+        out += "]\n";
+      }
     }
     if (sensor) appendCalibration(out, names[a], *sensor, a);
   }

@@ -28,6 +28,7 @@
 //   outlier_amplitude_dps = 1.0
 //   sinusoids = [{freq_hz = 1.08, amp_dps = 0.07, phase_rad = 0.0}]
 //   bias_steps = [{time_s = 600.0, size_dps = 0.02}]
+//   narrowband_lines = [{centre_hz = 31.4, width_hz = 0.3, rms_dps = 0.02}]  # centre < rate_hz/2
 //   [x.calibration]         # optional: the bias model of the `rate` stream (docs/calibration.md)
 //   bias_std_dps = 0.0004                    # 1σ of bias_dps (the bias at temperature_reference_c)
 //   temperature_coefficient_dps_per_c = 0.03

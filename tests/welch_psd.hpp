@@ -72,12 +72,12 @@ inline WelchSpectrum welchPsd(const std::vector<double>& x, double rate_hz, std:
 }
 
 // The peak of a spectrum near `around_hz` (searched within ±search_hz) and its half-power
-// points, each crossing interpolated linearly between bins. The peak level is the largest
-// three-bin mean, which halves the scatter of a single bin at the cost of a percent or two
-// of a peak several bins wide.
+// points, each crossing interpolated linearly between bins. The peak is the largest three-bin
+// mean, whose scatter is 1/√3 of a single bin's, at the cost of a percent or two of the
+// level of a peak several bins wide.
 struct SpectralPeak {
   double level = 0.0;
-  double max_bin_hz = 0.0;  // the bin of the largest value
+  double max_bin_hz = 0.0;  // the middle bin of the largest three-bin mean
   double lower_half_power_hz = 0.0, upper_half_power_hz = 0.0;
   double centreHz() const { return 0.5 * (lower_half_power_hz + upper_half_power_hz); }
   double widthHz() const { return upper_half_power_hz - lower_half_power_hz; }
@@ -92,8 +92,10 @@ inline SpectralPeak spectralPeakNear(const WelchSpectrum& s, double around_hz, d
   double best = -1.0;
   for (std::size_t k = lo; k <= hi; ++k) {
     const double three = (s.psd[k - 1] + s.psd[k] + s.psd[k + 1]) / 3.0;
-    if (three > best) best = three;
-    if (s.psd[k] > s.psd[top]) top = k;
+    if (three > best) {
+      best = three;
+      top = k;
+    }
   }
   SpectralPeak p;
   p.level = best;

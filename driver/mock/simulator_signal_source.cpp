@@ -1,5 +1,6 @@
 #include "driver/mock/simulator_signal_source.hpp"
 
+#include <array>
 #include <stdexcept>
 #include <utility>
 
@@ -30,7 +31,10 @@ SimulatorSignalSource::SimulatorSignalSource(const processing::SimulationModel& 
     : simulator_(motion.atRest() ? std::make_unique<processing::NoiseSimulator>(modelAtInternalRate(model, dlpf_cfg),
                                                                                 horizon_s, seed)
                                  : std::make_unique<processing::NoiseSimulator>(modelAtInternalRate(model, dlpf_cfg),
-                                                                                horizon_s, seed, std::move(motion))) {}
+                                                                                horizon_s, seed, std::move(motion))) {
+  for (const processing::AxisNoiseModel& axis : simulator_->model().axes)
+    has_lines_ = has_lines_ || !axis.extra.narrowband_lines.empty();
+}
 
 AnalogSample SimulatorSignalSource::nextTick(double /*t_s*/) {
   const processing::SimulatedSample s = simulator_->nextAnalog();
@@ -43,6 +47,13 @@ AnalogSample SimulatorSignalSource::nextTick(double /*t_s*/) {
   for (std::size_t axis = 0; axis < a.rate_dps.size(); ++axis)
     if (model.axes[axis].extra.temperature_coefficient_dps_per_c != 0.0)
       a.rate_dps[axis] += processing::temperatureCouplingDps(model.axes[axis].extra, model.temperature, s.t_s);
+  // The narrowband lines likewise, at the internal rate (their random numbers are the extras'
+  // own, so the rest of the stream is the same with them).
+  if (has_lines_) {
+    const std::array<double, processing::kSimulatedAxes> lines = simulator_->nextNarrowbandLines();
+    for (std::size_t axis = 0; axis < a.rate_dps.size(); ++axis)
+      if (!model.axes[axis].extra.narrowband_lines.empty()) a.rate_dps[axis] += lines[axis];
+  }
   a.temperature_c = s.temperature_c;
   a.accel_g = s.accel_g;
   return a;

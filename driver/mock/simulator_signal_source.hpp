@@ -10,7 +10,10 @@
 // tick), so the mock's accel tilts with the board; the mock adds its accel noise and bias.
 //
 // The temperature coupling k·(T(t) − T_ref) of the model's [x.extra] (the bias following a
-// warm-up) is added to the analog rate, so it passes the DLPF like the rest of the bias.
+// warm-up) is added to the analog rate, so it passes the DLPF like the rest of the bias. So are
+// the model's narrowband lines ([x.extra] narrowband_lines): a line is defined by its centre and
+// width in Hz, so the simulator plays it at the internal rate (NoiseSimulator::nextNarrowbandLines)
+// and the mock's DLPF attenuates it as the chip's would.
 //
 // Not included: the terms the simulator defines at the *output* rate — angle
 // quantization noise Q, the AR(p) component and the other extra effects — because the mock's output rate is set by
@@ -40,6 +43,7 @@ class SimulatorSignalSource final : public SignalSource {
 
  private:
   std::unique_ptr<processing::NoiseSimulator> simulator_;
+  bool has_lines_ = false;  // some axis has narrowband lines
 };
 
 }  // namespace gyrod::driver
