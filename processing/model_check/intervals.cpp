@@ -245,7 +245,8 @@ void EffectIntervals::measureLines(std::size_t index, std::span<const double> x)
   for (const NarrowbandLine& l : removal_.lines) {
     const auto centre = static_cast<std::size_t>(std::lround(l.centre_hz / df));
     const auto width = std::max<std::size_t>(4, static_cast<std::size_t>(std::lround(l.width_hz / df)));
-    const NarrowbandFit fit = fitNarrowbandLine(psd, bg, df, c.rate, centre, width, c.k_lo, c.k_hi, 200);
+    const NarrowbandFit fit =
+        fitNarrowbandLine(psd, bg, df, c.rate, centre, width, c.k_lo, c.k_hi, LineFitEffort::Refit);
     const double nan = std::numeric_limits<double>::quiet_NaN();
     est.push_back(fit.fitted ? fit.centre_hz : nan);
     est.push_back(fit.fitted ? fit.width_hz : nan);

@@ -124,7 +124,8 @@ struct LineWindow {
 };
 
 LineWindow lineWindow(const std::vector<double>& psd, const std::vector<double>& background, double df, double rate,
-                      std::size_t centre_bin, std::size_t width_bins, std::size_t k_lo, std::size_t k_hi) {
+                      std::size_t centre_bin, std::size_t width_bins, std::size_t k_lo, std::size_t k_hi,
+                      bool economical) {
   // Wide enough that the line's Lorentzian tails fall below the background within it: else
   // tails and background trade off in the fit.
   // At low frequency no further than half the centre: below it flicker and random walk make
@@ -136,7 +137,12 @@ LineWindow lineWindow(const std::vector<double>& psd, const std::vector<double>&
   const auto half = static_cast<std::size_t>(std::ceil(half_hz / df));
   const std::size_t lo = centre_bin > k_lo + half ? centre_bin - half : k_lo;
   const std::size_t hi = std::min(k_hi, centre_bin + half);
-  const std::size_t bins = hi - lo + 1, group = (bins + kMaxGroups - 1) / kMaxGroups;
+  // A refit near a known line needs only groups a quarter of its width (at least 200).
+  const std::size_t bins = hi - lo + 1;
+  const std::size_t max_groups =
+      economical ? std::clamp<std::size_t>(4 * bins / std::max<std::size_t>(1, width_bins), 200, kMaxGroups)
+                 : kMaxGroups;
+  const std::size_t group = (bins + max_groups - 1) / max_groups;
   LineWindow w;
   w.centre_guess = static_cast<double>(centre_bin) * df;
   w.half_width = static_cast<double>(half) * df;
@@ -255,8 +261,10 @@ LineParameters nelderMead(const std::function<double(const LineParameters&)>& f,
 
 NarrowbandFit fitNarrowbandLine(const std::vector<double>& psd, const std::vector<double>& background, double df,
                                 double rate, std::size_t centre_bin, std::size_t width_bins, std::size_t k_lo,
-                                std::size_t k_hi, int iterations) {
-  const LineWindow w = lineWindow(psd, background, df, rate, centre_bin, width_bins, k_lo, k_hi);
+                                std::size_t k_hi, LineFitEffort effort) {
+  const bool economical = effort == LineFitEffort::Refit;
+  const int iterations = economical ? 150 : 400;
+  const LineWindow w = lineWindow(psd, background, df, rate, centre_bin, width_bins, k_lo, k_hi, economical);
   NarrowbandFit out;
   if (w.freq.size() < 8) return out;
   // Start: the scan's centre and width, and the power above the background in the window.
@@ -269,7 +277,7 @@ NarrowbandFit fitNarrowbandLine(const std::vector<double>& psd, const std::vecto
   const auto nll = [&](const LineParameters& p) { return lineNegLogLikelihood(w, p, rate, df); };
   // Two restarts from the optimum: Nelder–Mead can stall on a ridge of centre against width.
   LineParameters p = nelderMead(nll, start, step, iterations);
-  p = nelderMead(nll, p, step, iterations);
+  if (!economical) p = nelderMead(nll, p, step, iterations);
   if (!std::isfinite(nll(p))) return out;
   out.fitted = true;
   out.centre_hz = p[0];

@@ -212,9 +212,13 @@ struct NarrowbandFit {
   double centre_hz = 0.0, width_hz = 0.0, rms_dps = 0.0;
   double background_psd = 0.0;  // the fitted background at the centre
 };
+// Search: from the scan's guess (up to 1500 groups, Nelder–Mead restarted once). Refit: near a
+// line already fitted, as on each replica for the intervals (groups of a quarter of its
+// width, one shorter run): the intervals' cost on a 1 h record.
+enum class LineFitEffort { Search, Refit };
 NarrowbandFit fitNarrowbandLine(const std::vector<double>& psd, const std::vector<double>& background, double df,
                                 double rate, std::size_t centre_bin, std::size_t width_bins, std::size_t k_lo,
-                                std::size_t k_hi, int iterations = 400);
+                                std::size_t k_hi, LineFitEffort effort = LineFitEffort::Search);
 // One-sided PSD [(°/s)²/Hz] of a Hann periodogram.
 std::vector<double> onesidedPsd(const Periodogram& p, double rate);
 // x with the line's power taken out: its spectrum times √(b/(b + S_line)), b the background.
