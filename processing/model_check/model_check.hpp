@@ -17,6 +17,7 @@
 // depend on the number of threads.
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -163,6 +164,34 @@ struct ExtensionVerdict {
   bool operator==(const ExtensionVerdict&) const = default;
 };
 
+// Whether the model the check ends with (the extended model when its extension is accepted,
+// else the base model) passes the two tests its own figures imply, and where it misses
+// (docs/model-check.md, "Misfit"): its Kalman innovations on the held-back half are white
+// (Ljung–Box p ≥ kMisfitWhitenessP) and the measured Allan curve lies inside the 90 % band of
+// its replicas at ≥ kMisfitInBand of the τ. A named effect does not make a model fit; an
+// empty `effects` does not either, unless both tests pass.
+inline constexpr double kMisfitWhitenessP = 0.01;
+inline constexpr double kMisfitInBand = 0.9;
+struct ModelMisfit {
+  bool whiteness_fails = false;       // held-out Ljung–Box p < kMisfitWhitenessP
+  bool band_fails = false;            // in-band share < kMisfitInBand
+  double ljung_box_p_held_out = 0.0;  // of the final model (a copy of ModelCheckGain's)
+  double in_band = 0.0;               // of the final model (a copy of ModelCheckGain's)
+  // Where the Allan curve leaves the final model's band (stated when band_fails): the first
+  // and last τ outside it, and measured/median at the τ outside farthest from the median
+  // (> 1 above it, < 1 below). NaN when not stated.
+  double tau_lo_s = std::numeric_limits<double>::quiet_NaN();
+  double tau_hi_s = std::numeric_limits<double>::quiet_NaN();
+  double adev_ratio = std::numeric_limits<double>::quiet_NaN();
+  // Where the final model's held-out innovations carry excess power (looked for when a test
+  // fails; innovationSpectralExcess): the band's edges and its mean power over the white
+  // level. NaN when not stated (no test fails, or no band stands out).
+  double freq_lo_hz = std::numeric_limits<double>::quiet_NaN();
+  double freq_hi_hz = std::numeric_limits<double>::quiet_NaN();
+  double power_ratio = std::numeric_limits<double>::quiet_NaN();
+  bool fails() const { return whiteness_fails || band_fails; }
+};
+
 struct ModelCheckOptions {
   std::size_t replicas = 40;  // per round; the thresholds use robust spread, not ranks
   std::uint64_t seed = 1;
@@ -213,6 +242,7 @@ struct AxisModelCheck {
   std::size_t replicas_simulated = 0;
   AcquisitionChain chain;  // the acquisition chain in the base model
   ExtensionVerdict verdict;
+  ModelMisfit misfit;  // of the model the check ends with
 };
 
 // Throws std::invalid_argument for a rate that is not finite and > 0, fewer than
@@ -280,6 +310,24 @@ struct SinusoidFit {
   double freq_hz = 0.0, amp_dps = 0.0, phase_rad = 0.0;
 };
 SinusoidFit fitSinusoidAt(std::span<const double> x, double rate_hz, double freq_hz);
+
+// Excess power in a series that should be white (the misfit's innovations): Welch's
+// average of Hann-windowed periodograms (segments of L samples, the largest power of two
+// ≤ n/16 within 64..1024, overlapping by half), each bin 1..L/2−1 divided by the white level
+// (the bins' median over the median of χ²(ν)/ν, ν the segments' equivalent degrees of
+// freedom). A bin stands out when it exceeds the (1 − family_alpha/(L/2−1)) quantile of
+// χ²(ν)/ν: Bonferroni over the bins, so white noise shows a band in about
+// `family_alpha` of series. The band stated is the run of adjacent bins standing out that
+// holds the largest ratio: its edges (bin centres ± half a bin) and its mean ratio.
+struct SpectralExcess {
+  bool found = false;
+  double freq_lo_hz = 0.0, freq_hi_hz = 0.0;
+  double power_ratio = 0.0;  // mean power of the band over the white level
+  double peak_ratio = 0.0;   // largest single bin's, anywhere
+  double threshold = 0.0;    // on a bin's ratio
+  std::size_t segment = 0;   // L
+};
+SpectralExcess innovationSpectralExcess(std::span<const double> x, double rate_hz, double family_alpha = 1e-3);
 
 // Robust z of each sample against its neighbours: (x_i − mean of the h neighbours on each
 // side) / (1.4826·MAD of those differences).

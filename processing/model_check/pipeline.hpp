@@ -220,6 +220,11 @@ struct ExtensionInputs {
   bool deterministic_found = false;
 };
 
+// The misfit of the final model from its held-out Ljung–Box p, its Allan band and in-band
+// share, and its innovations on the held-back half (misfit.cpp).
+ModelMisfit judgeMisfit(double ljung_box_p_held_out, const AllanBand& band, double in_band,
+                        std::span<const double> held_out_innovations, double rate_hz);
+
 // Replicas of the extended model: its Allan band, what it leaves unexplained, and the gain
 // (Allan band and Kalman innovations, base against extended).
 void checkExtendedModel(const ExtensionInputs& in, const Context& c, const ModelCheckOptions& o, AxisModelCheck& out);
