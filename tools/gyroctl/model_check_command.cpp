@@ -195,6 +195,44 @@ std::string paramsText(const DetectedEffect& e) {
   return s;
 }
 
+// ---- the misfit of the final model -------------------------------------------------------
+
+// The model the check ends with: the extended one when its extension was accepted.
+const char* finalModelName(const AxisModelCheck& r) {
+  return r.verdict.judged && r.verdict.accepted ? "extended" : "base";
+}
+
+json numberOrNull(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json misfitJson(const ModelMisfit& m) {
+  return {{"whiteness_fails", m.whiteness_fails},           {"band_fails", m.band_fails},
+          {"ljung_box_p_held_out", m.ljung_box_p_held_out}, {"in_band", m.in_band},
+          {"tau_lo_s", numberOrNull(m.tau_lo_s)},           {"tau_hi_s", numberOrNull(m.tau_hi_s)},
+          {"adev_ratio", numberOrNull(m.adev_ratio)},       {"freq_lo_hz", numberOrNull(m.freq_lo_hz)},
+          {"freq_hi_hz", numberOrNull(m.freq_hi_hz)},       {"power_ratio", numberOrNull(m.power_ratio)}};
+}
+
+// "held-out innovations not white (Ljung-Box p 3e-05 < 0.01), 80 % of the Allan curve in the
+// 90 % band; misfit at tau 0.02-0.16 s (up to 1.6 x the band's median) and 31.2-31.6 Hz (12 x white)".
+std::string misfitText(const ModelMisfit& m) {
+  std::string s = m.whiteness_fails
+                      ? "held-out innovations not white (Ljung-Box p " + fmt("%.3g", m.ljung_box_p_held_out) + " < " +
+                            fmt("%g", kMisfitWhitenessP) + ")"
+                      : "held-out innovations white (Ljung-Box p " + fmt("%.3g", m.ljung_box_p_held_out) + ")";
+  s += ", " + fmt("%.3g", 100.0 * m.in_band) + " % of the Allan curve in the 90 % band" +
+       (m.band_fails ? " (< " + fmt("%g", 100.0 * kMisfitInBand) + " %)" : "");
+  std::vector<std::string> where;
+  if (std::isfinite(m.tau_lo_s))
+    where.push_back("tau " + fmt("%.3g", m.tau_lo_s) + "-" + fmt("%.3g", m.tau_hi_s) + " s (" +
+                    (m.adev_ratio >= 1.0 ? "up to " : "down to ") + fmt("%.3g", m.adev_ratio) +
+                    " x the band's median)");
+  if (std::isfinite(m.freq_lo_hz))
+    where.push_back(fmt("%.4g", m.freq_lo_hz) + "-" + fmt("%.4g", m.freq_hi_hz) + " Hz (" + fmt("%.3g", m.power_ratio) +
+                    " x white)");
+  if (!where.empty()) s += "; misfit at " + where.front() + (where.size() > 1 ? " and " + where.back() : "");
+  return s;
+}
+
 json termsJson(const NoiseTerms& t) {
   json j = json::object();
   for (NoiseTerm term : kAllNoiseTerms) j[std::string(noiseTermKey(term))] = t.get(term);
@@ -221,6 +259,7 @@ json axisJson(const AxisModelCheck& r) {
   return {{"effects", effects},
           {"gain", gainJson(r.gain)},
           {"extension", verdictJson(r.verdict)},
+          {"misfit", misfitJson(r.misfit)},
           {"samples", r.samples},
           {"base_terms", termsJson(r.base_fit.value)},
           {"extended_terms", termsJson(r.extended_fit.value)},
@@ -231,12 +270,13 @@ json axisJson(const AxisModelCheck& r) {
 
 void printAxisText(std::ostream& o, const std::string& name, const AxisModelCheck& r) {
   o << "\n== " << name << " ==\n";
-  if (r.effects.empty()) o << "  the base model holds: no effect\n";
+  if (r.effects.empty() && !r.misfit.fails()) o << "  the base model holds: no effect\n";
   for (const DetectedEffect& e : r.effects) {
     o << "  " << modelEffectName(e.effect) << " (" << paramsText(e) << ")";
     if (!e.explained) o << ": seen, not explained (" << notExplainedReason(r.verdict) << ")";
     o << "\n      " << evidenceText(e) << '\n';
   }
+  if (r.misfit.fails()) o << "  the " << finalModelName(r) << " model does not fit: " << misfitText(r.misfit) << '\n';
   const ModelCheckGain& g = r.gain;
   char line[256];
   o << "  gain                    base        extended\n";
@@ -364,15 +404,18 @@ void writeReport(const std::string& dir_text, const ModelCheckCliOptions& opt, c
   if (!plots) md << "\n(gnuplot is not installed: the plot data and scripts are written, the pictures are not.)\n";
   for (const auto& [name, r] : results) {
     md << "\n## " << name << "\n\n";
-    if (r.effects.empty())
+    if (r.effects.empty() && !r.misfit.fails())
       md << "The base model holds: no effect found.\n";
-    else {
+    else if (!r.effects.empty()) {
       md << "| effect | parameters | evidence |\n|---|---|---|\n";
       for (const DetectedEffect& e : r.effects)
         md << "| `" << modelEffectName(e.effect) << "`" << (e.explained ? "" : " (seen, not explained)") << " | "
            << paramsText(e) << " | " << evidenceText(e)
            << (e.explained ? "" : "; not explained: " + notExplainedReason(r.verdict)) << " |\n";
     }
+    if (r.misfit.fails())
+      md << (r.effects.empty() ? "" : "\n") << "The " << finalModelName(r)
+         << " model does not fit: " << misfitText(r.misfit) << ".\n";
     const ModelCheckGain& g = r.gain;
     md << "\n| figure | base | extended |\n|---|---|---|\n"
        << "| mean \\|log10(measured/median simulated ADEV)\\| | " << fmt("%.4g", g.adev_log_error_base) << " | "
