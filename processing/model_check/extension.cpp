@@ -5,7 +5,6 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
-#include <utility>
 
 #include "processing/base/detrend.hpp"
 #include "processing/model_check/intervals.hpp"
@@ -92,7 +91,6 @@ void checkUnexplained(const AllanNull& ext_allan, const std::vector<double>& mea
 struct InnovationFigures {
   double variance = 0.0, ljung_box_p = 0.0;
   std::vector<std::size_t> rejected;  // samples the robust filter left out
-  std::vector<double> innovations;    // those the Ljung–Box test saw (the misfit's spectrum)
 };
 
 // The base Kalman model (AR(p) by AIC) fitted on `fit`, its innovations on `score`. The
@@ -115,8 +113,7 @@ InnovationFigures baseInnovations(std::span<const double> fit, std::span<const d
     if (next < left_out.size() && left_out[next] == i + burn_in) continue;
     kept.push_back(inn.innovations[i]);
   }
-  const double p = ljungBoxTest(kept, o.ljung_box_lags, m.order()).p_value;
-  return {inn.variance, p, {}, std::move(kept)};
+  return {inn.variance, ljungBoxTest(kept, o.ljung_box_lags, m.order()).p_value, {}};
 }
 
 // The innovations of the extended model's Kalman filter on `z` (the measured series minus the
@@ -152,7 +149,7 @@ InnovationFigures extendedInnovations(const ExtensionInputs& in, std::span<const
   }
   const InnovationStats inn = kalmanInnovations(z, phi, noise_var, gm_decay, gm_q, in.outliers.count > 0);
   return {inn.variance, ljungBoxTest(inn.innovations, o.ljung_box_lags, phi.size() + (gm_q > 0.0 ? 2 : 0)).p_value,
-          inn.rejected_samples, inn.innovations};
+          inn.rejected_samples};
 }
 
 // The measured series minus the named deterministic effects, detrended.
@@ -230,7 +227,7 @@ void checkExtendedModel(const ExtensionInputs& in, const Context& c, const Model
     g.innovation_var_base_held_out = g.innovation_var_extended_held_out = held.variance;
     g.ljung_box_p_base_held_out = g.ljung_box_p_extended_held_out = held.ljung_box_p;
     checkUnexplained(ext_allan, *in.measured_log_adev, false, c, o.replicas, out);
-    out.misfit = judgeMisfit(g.ljung_box_p_base_held_out, out.allan_base, g.in_band_base, held.innovations, c.rate);
+    out.misfit = judgeMisfit(in.xd, out.allan_base, g.in_band_base, in.base_allan->whiteness_q, c.rate, out);
     return;
   }
   const std::vector<double> z = withoutDeterministic(in, c);
@@ -252,11 +249,10 @@ void checkExtendedModel(const ExtensionInputs& in, const Context& c, const Model
   out.verdict = judgeExtension(g);
   if (out.verdict.accepted) {
     checkUnexplained(ext_allan, *in.measured_log_adev, true, c, o.replicas, out);
-    out.misfit = judgeMisfit(g.ljung_box_p_extended_held_out, out.allan_extended, g.in_band_extended,
-                             ext_held.innovations, c.rate);
+    out.misfit = judgeMisfit(in.xc, out.allan_extended, g.in_band_extended, in.base_allan->whiteness_q, c.rate, out);
     return;
   }
-  out.misfit = judgeMisfit(g.ljung_box_p_base_held_out, out.allan_base, g.in_band_base, base_held.innovations, c.rate);
+  out.misfit = judgeMisfit(in.xd, out.allan_base, g.in_band_base, in.base_allan->whiteness_q, c.rate, out);
   // Not accepted: the named effects were seen but do not explain the data, and what is
   // unexplained is judged against the base model (the extension's band is not a model held).
   for (DetectedEffect& e : out.effects)
