@@ -241,9 +241,8 @@ ModelMisfit judgeMisfit(std::span<const double> residual, const AllanBand& band,
     m.band_p = betaBinomialUpperTail(missed, taus, misses);
     m.band_fails = in_band < m.in_band_replica_lowest && m.band_p < kMisfitBandAlpha;
   }
-  if (!m.fails()) return m;
   // The τ range is stated when the band test fails, or when the curve is in band less often
-  // than every replica while another test fails.
+  // than every replica (a caller may add a failing test: the acquisition chain).
   if (m.band_fails || in_band < m.in_band_replica_lowest) {
     double farthest = -1.0;
     for (std::size_t j = 0; j < taus; ++j) {
@@ -257,6 +256,7 @@ ModelMisfit judgeMisfit(std::span<const double> residual, const AllanBand& band,
       }
     }
   }
+  if (!m.fails()) return m;
   const SpectralExcess excess = innovationSpectralExcess(w.errors, rate_hz);
   if (excess.found) {
     m.freq_lo_hz = excess.freq_lo_hz;

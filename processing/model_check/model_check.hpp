@@ -178,7 +178,7 @@ struct ExtensionVerdict {
 // replicas' misses puts that many or more below kMisfitBandAlpha. A named effect does not make
 // a model fit; an empty `effects` does not either, unless both tests pass.
 inline constexpr double kMisfitWhitenessP = 1e-3;
-inline constexpr double kMisfitBandAlpha = 1e-3;
+inline constexpr double kMisfitBandAlpha = 0.01;
 struct ModelMisfit {
   bool whiteness_fails = false;       // held-out Ljung–Box p < kMisfitWhitenessP
   bool band_fails = false;            // in-band share below the replicas' (see above)
@@ -192,7 +192,8 @@ struct ModelMisfit {
   double in_band_replica_median = std::numeric_limits<double>::quiet_NaN();
   double in_band_replica_lowest = std::numeric_limits<double>::quiet_NaN();
   double band_p = std::numeric_limits<double>::quiet_NaN();
-  // Where the Allan curve leaves the final model's band (stated when band_fails): the first
+  // Where the Allan curve leaves the final model's band (stated when band_fails, or when the
+  // curve is in band less often than every replica): the first
   // and last τ outside it, and measured/median at the τ outside farthest from the median
   // (> 1 above it, < 1 below). NaN when not stated.
   double tau_lo_s = std::numeric_limits<double>::quiet_NaN();
