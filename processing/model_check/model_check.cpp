@@ -102,6 +102,7 @@ void spectrumForPlots(const SeriesStats& measured, const std::vector<SeriesStats
     for (const SeriesStats& r : base_reps)
       if (std::isfinite(r.psd[j])) col.push_back(r.psd[j]);
     out.spectrum_base_median.push_back(col.empty() ? kNaN : medianOf(col));
+    out.spectrum_base_max.push_back(col.empty() ? kNaN : *std::max_element(col.begin(), col.end()));
   }
 }
 

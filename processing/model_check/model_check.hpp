@@ -17,6 +17,7 @@
 // depend on the number of threads.
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -138,6 +139,9 @@ struct AllanBand {
   std::vector<double> measured;  // oadev of the measured (detrended) series
   std::vector<double> median;    // median over replicas
   std::vector<double> lo, hi;    // 5 % and 95 % over replicas (the 90 % band)
+  // The in-band share of each replica against the band of the other replicas (leave one
+  // out): the null distribution of the measured curve's in-band share (the misfit's band test).
+  std::vector<double> replica_in_band;
 };
 
 struct ModelCheckGain {
@@ -161,6 +165,54 @@ struct ExtensionVerdict {
   bool adev_worse = false, band_worse = false, innovation_worse = false, ljung_box_worse = false;
   bool adev_better = false, band_better = false, innovation_better = false, ljung_box_better = false;
   bool operator==(const ExtensionVerdict&) const = default;
+};
+
+// Whether the model the check ends with (the extended model when its extension is accepted,
+// else the base model) passes two tests calibrated on clean records, and where it misses
+// (docs/model-check.md, "Misfit"). Whiteness: the held-out prediction errors of an AR model
+// (heldOutWhiteness: AIC up to kWhitenessMaxArOrder, fitted on the first half of the series
+// the model leaves, scored on the second) have a Ljung–Box p ≥ kMisfitWhitenessP. Band: the
+// measured Allan curve lies outside the 90 % band of the model's replicas at no more τ than
+// the replicas themselves do (each against the band of the others: AllanBand::replica_in_band);
+// it fails when it misses at more τ than every replica and a beta-binomial fitted to the
+// replicas' misses puts that many or more below kMisfitBandAlpha. A named effect does not make
+// a model fit; an empty `effects` does not either, unless both tests pass.
+inline constexpr double kMisfitWhitenessP = 1e-3;
+inline constexpr double kMisfitBandAlpha = 0.01;
+struct ModelMisfit {
+  bool whiteness_fails = false;       // held-out Ljung–Box p < kMisfitWhitenessP
+  bool band_fails = false;            // in-band share below the replicas' (see above)
+  double ljung_box_p_held_out = 0.0;  // the whiteness test's p (against the replicas' Q)
+  double whiteness_q = 0.0;           // its Ljung–Box Q
+  double whiteness_q_replica_median = std::numeric_limits<double>::quiet_NaN();
+  std::size_t whiteness_ar_order = 0;  // the AR order the whiteness test used
+  double in_band = 0.0;                // of the final model (a copy of ModelCheckGain's)
+  // The replicas' own in-band shares (leave one out): median and lowest; and the
+  // beta-binomial probability of missing the band at as many τ as the measured curve does.
+  double in_band_replica_median = std::numeric_limits<double>::quiet_NaN();
+  double in_band_replica_lowest = std::numeric_limits<double>::quiet_NaN();
+  double band_p = std::numeric_limits<double>::quiet_NaN();
+  // Where the Allan curve leaves the final model's band (stated when band_fails, or when the
+  // curve is in band less often than every replica): the first
+  // and last τ outside it, and measured/median at the τ outside farthest from the median
+  // (> 1 above it, < 1 below). NaN when not stated.
+  double tau_lo_s = std::numeric_limits<double>::quiet_NaN();
+  double tau_hi_s = std::numeric_limits<double>::quiet_NaN();
+  double adev_ratio = std::numeric_limits<double>::quiet_NaN();
+  // Where the misfit is in frequency (looked for when a test fails): the band where the
+  // held-out prediction errors carry excess power (innovationSpectralExcess; power over their
+  // white level), else the run of the spectrum's log bands (48 from 2/duration to Nyquist)
+  // where the record's power exceeds every base replica's, around the largest such excess
+  // (power over the replicas' median). NaN when not stated.
+  double freq_lo_hz = std::numeric_limits<double>::quiet_NaN();
+  double freq_hi_hz = std::numeric_limits<double>::quiet_NaN();
+  double power_ratio = std::numeric_limits<double>::quiet_NaN();
+  bool power_against_replicas = false;  // the ratio is over the replicas' median, not white
+  // Set by the caller that estimated the acquisition chain when no DLPF setting (nor none)
+  // fits the short-τ Allan curve: the base model's chain is then itself a misfit.
+  bool chain_fails = false;
+  double chain_reduced_chi2 = std::numeric_limits<double>::quiet_NaN();  // best, per axis
+  bool fails() const { return whiteness_fails || band_fails || chain_fails; }
 };
 
 struct ModelCheckOptions {
@@ -207,12 +259,14 @@ struct AxisModelCheck {
   // For plots: log-binned power spectral density [(°/s)²/Hz] of the measured series and the
   // median of the base replicas, and the low-passed residual against temperature.
   std::vector<double> spectrum_freq_hz, spectrum_measured, spectrum_base_median;
+  std::vector<double> spectrum_base_max;       // the largest replica's per band (the misfit's placement)
   std::vector<double> spectrum_measured_peak;  // largest single-bin PSD in each band (lines)
   std::vector<double> block_temperature_c, block_residual_dps;
   std::size_t ar_order = 0;  // AR order (AIC) of the base Kalman model
   std::size_t replicas_simulated = 0;
   AcquisitionChain chain;  // the acquisition chain in the base model
   ExtensionVerdict verdict;
+  ModelMisfit misfit;  // of the model the check ends with
 };
 
 // Throws std::invalid_argument for a rate that is not finite and > 0, fewer than
@@ -280,6 +334,51 @@ struct SinusoidFit {
   double freq_hz = 0.0, amp_dps = 0.0, phase_rad = 0.0;
 };
 SinusoidFit fitSinusoidAt(std::span<const double> x, double rate_hz, double freq_hz);
+
+// Excess power in a series that should be white (the misfit's innovations): Welch's
+// average of Hann-windowed periodograms (segments of L samples, the largest power of two
+// ≤ n/16 within 64..1024, overlapping by half), each bin 1..L/2−1 divided by the white level
+// (the bins' median over the median of χ²(ν)/ν, ν the segments' equivalent degrees of
+// freedom). A bin stands out when it exceeds the (1 − family_alpha/(L/2−1)) quantile of
+// χ²(ν)/ν: Bonferroni over the bins, so white noise shows a band in about
+// `family_alpha` of series. The band stated is the run of adjacent bins standing out that
+// holds the largest ratio: its edges (bin centres ± half a bin) and its mean ratio.
+struct SpectralExcess {
+  bool found = false;
+  double freq_lo_hz = 0.0, freq_hi_hz = 0.0;
+  double power_ratio = 0.0;  // mean power of the band over the white level
+  double peak_ratio = 0.0;   // largest single bin's, anywhere
+  double threshold = 0.0;    // on a bin's ratio
+  std::size_t segment = 0;   // L
+};
+SpectralExcess innovationSpectralExcess(std::span<const double> x, double rate_hz, double family_alpha = 1e-3);
+
+// The misfit's whiteness test (docs/model-check.md, "Misfit"): each half detrended on its own
+// (constant and line), an AR(p) chosen by AIC up to `max_order` fitted on `fit` (Yule–Walker),
+// its one-step prediction errors on `score` (after 100 samples), and Ljung–Box over `lags`
+// lags against χ²(lags): nothing was fitted to the held-out errors, so no degree of freedom is
+// taken off. Also returns the AR order used.
+struct HeldOutWhiteness {
+  LjungBox test;  // p against χ²(lags); the misfit's p is against the replicas' Q (whiteNullP)
+  std::size_t ar_order = 0;
+  std::vector<double> errors;  // the held-out prediction errors (the misfit's spectrum)
+};
+inline constexpr std::size_t kWhitenessMaxArOrder = 32;
+inline constexpr std::size_t kWhitenessBlock = 512;
+// Ljung–Box over `lags` of e with each block of `block` samples' mean removed and only lags
+// within a block counted (the slow noise an AR model cannot carry from one half to the
+// other is left to the Allan band test), the bias the block means give white noise
+// (−(B − k)/(B(B − 1)) at lag k) taken off; against χ²(lags). Plain Ljung–Box below 2 blocks.
+LjungBox blockLjungBox(std::span<const double> e, std::size_t lags, std::size_t block);
+HeldOutWhiteness heldOutWhiteness(std::span<const double> fit, std::span<const double> score,
+                                  std::size_t max_order = kWhitenessMaxArOrder, std::size_t lags = 30);
+// The upper tail of a Ljung–Box Q under the null of `null_q` (the same test on the replicas):
+// a Gumbel through the replicas' median and 90 % point, as the check's other one-sided
+// statistics. Noise the AR model fitted on one half cannot carry to the other (flicker, random
+// walk) inflates and widens Q alike in the record and its replicas; on white noise the Gumbel
+// is a little conservative against χ²(lags) in the tail (its 1e-3 point ≈ 67 against 60 at 30
+// lags). Without at least 8 replicas: χ²(lags).
+double whiteNullP(double q, const std::vector<double>& null_q, std::size_t lags = 30);
 
 // Robust z of each sample against its neighbours: (x_i − mean of the h neighbours on each
 // side) / (1.4826·MAD of those differences).

@@ -88,7 +88,8 @@ enum StatMask : unsigned {
   kStatSteps = 16u,
   kStatGaussMarkov = 32u,
   kStatPsd = 64u,
-  kStatAll = 127u,
+  kStatWhiteness = 128u,
+  kStatAll = 255u,
 };
 
 struct SeriesStats {
@@ -103,6 +104,7 @@ struct SeriesStats {
   std::vector<double> step_scale_max, step_scale_ms;
   double gm_statistic = kNaN;
   std::vector<double> psd, psd_max;
+  double whiteness_q = kNaN;  // Ljung–Box Q of heldOutWhiteness (the misfit's null)
 };
 
 SeriesStats measureSeries(std::span<const double> xd, const Context& c, unsigned mask);
@@ -142,6 +144,7 @@ struct AllanNull {
   AllanBand band;
   std::vector<double> median_log, spread_log;
   NullSummary max_z;
+  std::vector<double> whiteness_q;  // the replicas' held-out Ljung–Box Q (when measured)
 };
 AllanNull allanNull(const std::vector<SeriesStats>& reps, const std::vector<double>& measured_log, const Context& c,
                     double alpha);
@@ -266,6 +269,14 @@ struct ExtensionInputs {
   OutliersFound outliers;
   bool deterministic_found = false;
 };
+
+// The misfit of the final model (misfit.cpp): the whiteness of what it leaves (`residual`:
+// the detrended series, or the cleaned one when the extension is accepted), fitted on the
+// first half and scored on the second; its Allan band and in-band share.
+// The whiteness p is the measured Q's tail under a scaled χ² fitted to `null_q` (the base
+// replicas' Q: whiteNullP).
+ModelMisfit judgeMisfit(std::span<const double> residual, const AllanBand& band, double in_band,
+                        const std::vector<double>& null_q, double rate_hz, const AxisModelCheck& spectra);
 
 // Replicas of the extended model: its Allan band, what it leaves unexplained, and the gain
 // (Allan band and Kalman innovations, base against extended).

@@ -177,9 +177,27 @@ AllanNull allanNull(const std::vector<SeriesStats>& reps, const std::vector<doub
     a.band.hi.push_back(std::exp(sortedQuantile(col, 0.95)));
     a.band.measured.push_back(std::exp(measured_log[j]));
   }
+  // Leave one out: replica r against the 5–95 % band of the others, τ by τ.
+  std::vector<std::size_t> inside(reps.size(), 0);
+  std::vector<double> others;
+  for (std::size_t j = 0; j < k && reps.size() > 2; ++j) {
+    for (std::size_t r = 0; r < reps.size(); ++r) col[r] = reps[r].log_adev[j];
+    std::vector<double> sorted = col;
+    std::sort(sorted.begin(), sorted.end());
+    for (std::size_t r = 0; r < reps.size(); ++r) {
+      others = sorted;
+      others.erase(std::lower_bound(others.begin(), others.end(), col[r]));
+      inside[r] += (col[r] >= sortedQuantile(others, 0.05) && col[r] <= sortedQuantile(others, 0.95)) ? 1 : 0;
+    }
+  }
+  if (reps.size() > 2 && k > 0)
+    for (std::size_t r = 0; r < reps.size(); ++r)
+      a.band.replica_in_band.push_back(static_cast<double>(inside[r]) / static_cast<double>(k));
   std::vector<double> maxes(reps.size());
   for (std::size_t r = 0; r < reps.size(); ++r) maxes[r] = maxAbsZ(reps[r].log_adev, a.median_log, a.spread_log);
   a.max_z = summarizeNull(maxes, alpha, false);
+  for (const SeriesStats& r : reps)
+    if (std::isfinite(r.whiteness_q)) a.whiteness_q.push_back(r.whiteness_q);
   return a;
 }
 

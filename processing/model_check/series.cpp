@@ -114,6 +114,8 @@ SeriesStats measureSeries(std::span<const double> xd, const Context& c, unsigned
     if ((mask & kStatTemperature) && !c.temp_blocks.empty()) s.temp_slope = temperatureSlope(y, c.temp_blocks);
     if (mask & kStatSteps) measureStepScales(y, c, s);
   }
+  if (mask & kStatWhiteness)
+    s.whiteness_q = heldOutWhiteness(xd.first(xd.size() / 2), xd.subspan(xd.size() / 2)).test.q;
   return s;
 }
 

@@ -187,13 +187,127 @@ std::string evidenceText(const DetectedEffect& e) {
   return "";
 }
 
+// A value to 4 significant digits (the text; the JSON keeps full precision).
+std::string sig4(double v) { return fmt("%.4g", v); }
+
+// "31.41 Hz (31.38–31.44)": a value, its unit and its 95 % interval when stated.
+std::string withInterval(double v, const std::string& unit, const ParameterInterval& i) {
+  std::string s = sig4(v) + (unit.empty() ? "" : " " + unit);
+  if (i.stated) s += " (" + sig4(i.lo) + "–" + sig4(i.hi) + ")";
+  return s;
+}
+
+// The parameters in words, 4 significant digits with units and 95 % intervals
+// (docs/model-check.md, "Verdicts and output").
 std::string paramsText(const DetectedEffect& e) {
-  std::string s;
-  const json params = effectParams(e);
-  for (const auto& [k, v] : params.items()) {
-    if (!s.empty()) s += ", ";
-    s += k + " = " + (v.is_string() ? v.get<std::string>() : v.dump());
+  switch (e.effect) {
+    case ModelEffect::TemperatureBias: return "k = " + withInterval(e.k_dps_per_c, "deg/s per C", e.k_interval);
+    case ModelEffect::Sinusoid:
+      return sig4(e.freq_hz) + " Hz, amplitude " + withInterval(e.amp_dps, "deg/s", e.amp_interval);
+    case ModelEffect::GaussMarkov:
+      return "T = " + withInterval(e.tau_s, "s", e.tau_interval) +
+             ", sigma = " + withInterval(e.sigma_dps, "deg/s", e.sigma_interval);
+    case ModelEffect::BiasSteps: {
+      std::string s = std::to_string(e.count) + (e.count == 1 ? " step" : " steps");
+      for (std::size_t j = 0; j < e.times_s.size(); ++j) {
+        s += j == 0 ? ": " : "; ";
+        s += "at " + sig4(e.times_s[j]) + " s";
+        if (j < e.sizes_dps.size())
+          s += " by " + withInterval(e.sizes_dps[j], "deg/s",
+                                     j < e.size_intervals.size() ? e.size_intervals[j] : ParameterInterval{});
+      }
+      return s;
+    }
+    case ModelEffect::Outliers:
+      return withInterval(static_cast<double>(e.count), "samples", e.count_interval) + ", median excursion " +
+             withInterval(e.outlier_median_amplitude_dps, "deg/s", e.outlier_amplitude_interval);
+    case ModelEffect::SampleGaps: return std::to_string(e.count) + " gaps, " + std::to_string(e.lost) + " samples lost";
+    case ModelEffect::NarrowbandLine:
+      return "centre " + withInterval(e.centre_hz, "Hz", e.centre_interval) + ", width " +
+             withInterval(e.width_hz, "Hz", e.width_interval) + ", " +
+             withInterval(e.rms_dps, "deg/s rms", e.rms_interval);
+    case ModelEffect::Unexplained: return "tau " + sig4(e.where_lo) + " to " + sig4(e.where_hi) + " s";
   }
+  return "";
+}
+
+// ---- the misfit of the final model -------------------------------------------------------
+
+// The model the check ends with: the extended one when its extension was accepted.
+const char* finalModelName(const AxisModelCheck& r) {
+  return r.verdict.judged && r.verdict.accepted ? "extended" : "base";
+}
+
+json numberOrNull(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json misfitJson(const ModelMisfit& m) {
+  return {{"fails", m.fails()},
+          {"chain_fails", m.chain_fails},
+          {"chain_reduced_chi2", numberOrNull(m.chain_reduced_chi2)},
+          {"whiteness_fails", m.whiteness_fails},
+          {"band_fails", m.band_fails},
+          {"ljung_box_p_held_out", m.ljung_box_p_held_out},
+          {"whiteness_ar_order", m.whiteness_ar_order},
+          {"whiteness_q", m.whiteness_q},
+          {"whiteness_q_replica_median", numberOrNull(m.whiteness_q_replica_median)},
+          {"in_band", m.in_band},
+          {"in_band_replica_median", numberOrNull(m.in_band_replica_median)},
+          {"in_band_replica_lowest", numberOrNull(m.in_band_replica_lowest)},
+          {"band_p", numberOrNull(m.band_p)},
+          {"tau_lo_s", numberOrNull(m.tau_lo_s)},
+          {"tau_hi_s", numberOrNull(m.tau_hi_s)},
+          {"adev_ratio", numberOrNull(m.adev_ratio)},
+          {"freq_lo_hz", numberOrNull(m.freq_lo_hz)},
+          {"freq_hi_hz", numberOrNull(m.freq_hi_hz)},
+          {"power_ratio", numberOrNull(m.power_ratio)},
+          {"power_ratio_against", std::isfinite(m.power_ratio)
+                                      ? json(m.power_against_replicas ? "replicas_median" : "white_level")
+                                      : json(nullptr)}};
+}
+
+std::string percent(double share) { return fmt("%.3g", 100.0 * share) + " %"; }
+
+// The two tests' figures: "held-out whiteness p 0.43 (AR(5)), 95 % of the Allan curve in the
+// 90 % band (its replicas: median 95 %, lowest 80 %)".
+std::string fitFiguresText(const ModelMisfit& m) {
+  std::string s = "held-out whiteness p " + fmt("%.2g", m.ljung_box_p_held_out) + " (AR(" +
+                  std::to_string(m.whiteness_ar_order) + ")), " + percent(m.in_band) +
+                  " of the Allan curve in the 90 % band";
+  if (std::isfinite(m.in_band_replica_median))
+    s += " (its replicas: median " + percent(m.in_band_replica_median) + ", lowest " +
+         percent(m.in_band_replica_lowest) + ")";
+  return s;
+}
+
+// Why and where the model does not fit: "what it leaves is not white on the held-back half
+// (Ljung-Box p 3.1e-05 < 0.001); ...; misfit at tau 0.02–0.16 s (up to 1.6 x the replicas'
+// median) and 31.2–31.6 Hz (12 x white)".
+std::string misfitText(const ModelMisfit& m) {
+  std::vector<std::string> why;
+  if (m.chain_fails)
+    why.push_back("no DLPF setting fits its short-tau Allan curve (best reduced chi2 " +
+                  fmt("%.3g", m.chain_reduced_chi2) + ")");
+  if (m.whiteness_fails)
+    why.push_back("what it leaves is not white on the held-back half (Ljung-Box p " +
+                  fmt("%.2g", m.ljung_box_p_held_out) + " < " + fmt("%g", kMisfitWhitenessP) + ")");
+  if (m.band_fails)
+    why.push_back("the Allan curve leaves its replicas' 90 % band more often than any replica does (" +
+                  percent(m.in_band) + " in band against a lowest " + percent(m.in_band_replica_lowest) + ", median " +
+                  percent(m.in_band_replica_median) + "; p " + fmt("%.2g", m.band_p) + ")");
+  std::string s;
+  for (const std::string& w : why) s += (s.empty() ? "" : "; ") + w;
+  std::vector<std::string> where;
+  if (std::isfinite(m.tau_lo_s))
+    where.push_back("tau " + sig4(m.tau_lo_s) + "–" + sig4(m.tau_hi_s) + " s (Allan deviation " +
+                    (m.adev_ratio >= 1.0 ? "up to " : "down to ") + fmt("%.3g", m.adev_ratio) +
+                    " x the replicas' median)");
+  if (std::isfinite(m.freq_lo_hz))
+    where.push_back(sig4(m.freq_lo_hz) + "–" + sig4(m.freq_hi_hz) + " Hz (" + fmt("%.3g", m.power_ratio) +
+                    (m.power_against_replicas ? " x the replicas' median power)" : " x the white level)"));
+  if (!where.empty())
+    s += "; misfit at " + where.front() + (where.size() > 1 ? " and " + where.back() : "");
+  else
+    s += "; no tau range or frequency band stands out";
   return s;
 }
 
@@ -223,6 +337,7 @@ json axisJson(const AxisModelCheck& r) {
   return {{"effects", effects},
           {"gain", gainJson(r.gain)},
           {"extension", verdictJson(r.verdict)},
+          {"misfit", misfitJson(r.misfit)},
           {"samples", r.samples},
           {"base_terms", termsJson(r.base_fit.value)},
           {"extended_terms", termsJson(r.extended_fit.value)},
@@ -233,12 +348,18 @@ json axisJson(const AxisModelCheck& r) {
 
 void printAxisText(std::ostream& o, const std::string& name, const AxisModelCheck& r) {
   o << "\n== " << name << " ==\n";
-  if (r.effects.empty()) o << "  the base model holds: no effect\n";
+  if (r.effects.empty() && !r.misfit.fails())
+    o << "  the base model holds: no effect (" << fitFiguresText(r.misfit) << ")\n";
   for (const DetectedEffect& e : r.effects) {
     o << "  " << modelEffectName(e.effect) << " (" << paramsText(e) << ")";
     if (!e.explained) o << ": seen, not explained (" << notExplainedReason(r.verdict) << ")";
     o << "\n      " << evidenceText(e) << '\n';
   }
+  if (r.misfit.fails())
+    o << "  the " << finalModelName(r) << " model does not fit: " << misfitText(r.misfit) << "\n      ("
+      << fitFiguresText(r.misfit) << ")\n";
+  else if (!r.effects.empty())
+    o << "  the " << finalModelName(r) << " model fits (" << fitFiguresText(r.misfit) << ")\n";
   const ModelCheckGain& g = r.gain;
   char line[256];
   o << "  gain                    base        extended\n";
@@ -253,7 +374,8 @@ void printAxisText(std::ostream& o, const std::string& name, const AxisModelChec
   o << line;
   std::snprintf(line, sizeof line, "  in 90%% band       %12.3f    %12.3f\n", g.in_band_base, g.in_band_extended);
   o << line;
-  std::snprintf(line, sizeof line, "  held out: innovation var %.4g -> %.4g, Ljung-Box p %.4g -> %.4g\n",
+  std::snprintf(line, sizeof line,
+                "  held out (Kalman AR(p<=8)): innovation var %.4g -> %.4g, Ljung-Box p %.4g -> %.4g\n",
                 g.innovation_var_base_held_out, g.innovation_var_extended_held_out, g.ljung_box_p_base_held_out,
                 g.ljung_box_p_extended_held_out);
   o << line;
@@ -363,18 +485,22 @@ void writeReport(const std::string& dir_text, const ModelCheckCliOptions& opt, c
         "Kalman filter), seen through the acquisition chain. Every threshold comes from replicas simulated from the "
         "fitted model; see docs/model-check.md.\n\n"
      << "The " << chainText(chain) << ".\n";
+  if (chain.no_setting_fits) md << "\n" << noDlpfFitsText(chain, in.recording.axis_names) << ".\n";
   if (!plots) md << "\n(gnuplot is not installed: the plot data and scripts are written, the pictures are not.)\n";
   for (const auto& [name, r] : results) {
     md << "\n## " << name << "\n\n";
-    if (r.effects.empty())
-      md << "The base model holds: no effect found.\n";
-    else {
+    if (r.effects.empty() && !r.misfit.fails())
+      md << "The base model holds: no effect found (" << fitFiguresText(r.misfit) << ").\n";
+    else if (!r.effects.empty()) {
       md << "| effect | parameters | evidence |\n|---|---|---|\n";
       for (const DetectedEffect& e : r.effects)
         md << "| `" << modelEffectName(e.effect) << "`" << (e.explained ? "" : " (seen, not explained)") << " | "
            << paramsText(e) << " | " << evidenceText(e)
            << (e.explained ? "" : "; not explained: " + notExplainedReason(r.verdict)) << " |\n";
     }
+    if (r.misfit.fails())
+      md << (r.effects.empty() ? "" : "\n") << "The " << finalModelName(r)
+         << " model does not fit: " << misfitText(r.misfit) << ".\n";
     const ModelCheckGain& g = r.gain;
     md << "\n| figure | base | extended |\n|---|---|---|\n"
        << "| mean \\|log10(measured/median simulated ADEV)\\| | " << fmt("%.4g", g.adev_log_error_base) << " | "
@@ -438,6 +564,9 @@ int runModelCheck(const ModelCheckCliOptions& opt) {
     AxisModelCheckInput axis{rec.axes[idx], chain.rate_hz, rec.temp, rec.t, chain.chain};
     try {
       results.emplace_back(rec.axis_names[idx], checkAxisModel(axis, options));
+      ModelMisfit& m = results.back().second.misfit;
+      m.chain_fails = chain.noSettingFits(idx);
+      if (m.chain_fails) m.chain_reduced_chi2 = chain.axis_best_chi2.at(idx);
     } catch (const std::invalid_argument& e) {
       throw recording::RecordingError(opt.file + ": column '" + rec.axis_names[idx] + "': " + e.what());
     }
@@ -462,6 +591,7 @@ int runModelCheck(const ModelCheckCliOptions& opt) {
                 opt.file.c_str(), rec.size(), in.rate_hz, in.rate_source.c_str(),
                 static_cast<double>(rec.size()) / in.rate_hz, opt.replicas, static_cast<unsigned long long>(opt.seed));
     std::printf("%s\n", chainText(chain).c_str());
+    if (chain.no_setting_fits) std::printf("%s\n", noDlpfFitsText(chain, rec.axis_names).c_str());
     for (const auto& [name, r] : results) printAxisText(std::cout, name, r);
     std::printf("\nchecked in %.2f s\n", seconds);
   }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 
 #include "formats/recording_csv.hpp"
@@ -78,6 +79,10 @@ ChainChoice settleChain(const std::string& file, std::optional<int> dlpf_cfg, st
       } catch (const std::invalid_argument&) {
         continue;
       }
+      double axis_best = std::numeric_limits<double>::infinity();
+      for (const DlpfCandidate& cand : axis_scores) axis_best = std::min(axis_best, cand.chi2);
+      c.axis_best_chi2[idx] = axis_best;
+      c.no_setting_fits = c.no_setting_fits || axis_best > kNoDlpfFitsChi2;
       for (std::size_t k = 0; k < axis_scores.size(); ++k) {
         c.scores[k].chi2 += axis_scores[k].chi2;
         c.scores[k].axes_preferring += axis_scores[k].axes_preferring;
@@ -85,6 +90,13 @@ ChainChoice settleChain(const std::string& file, std::optional<int> dlpf_cfg, st
       ++scored;
     }
     c.chain.dlpf_cfg = scored > 0 ? chooseDlpf(c.scores, scored) : std::nullopt;
+    if (scored > 0) {
+      const DlpfCandidate* lowest = nullptr;
+      for (const DlpfCandidate& cand : c.scores)
+        if (!lowest || cand.chi2 < lowest->chi2) lowest = &cand;
+      c.best_chi2_per_axis = lowest->chi2 / static_cast<double>(scored);
+      c.best_candidate = lowest->dlpf_cfg;
+    }
     double none = 0.0, best = 0.0;
     for (const DlpfCandidate& cand : c.scores) {
       if (!cand.dlpf_cfg) none = cand.chi2;
@@ -107,6 +119,17 @@ ChainChoice settleChain(const std::string& file, std::optional<int> dlpf_cfg, st
   return c;
 }
 
+std::string noDlpfFitsText(const ChainChoice& c, const std::vector<std::string>& axis_names) {
+  std::string axes, values;
+  for (const auto& [idx, chi2] : c.axis_best_chi2) {
+    if (!(chi2 > kNoDlpfFitsChi2)) continue;
+    axes += (axes.empty() ? "" : ", ") + (idx < axis_names.size() ? axis_names[idx] : std::to_string(idx));
+    values += (values.empty() ? "" : ", ") + fmt("%.3g", chi2);
+  }
+  return "no DLPF setting fits the short-tau Allan curve of " + axes + ": best reduced chi2 " + values + " (> " +
+         fmt("%g", kNoDlpfFitsChi2) + ")";
+}
+
 std::string chainText(const ChainChoice& c) {
   return "acquisition chain: " + (c.chain.dlpf_cfg ? dlpfText(*c.chain.dlpf_cfg) : std::string("no DLPF")) + " [" +
          c.dlpf_source + "]; " +
@@ -127,6 +150,12 @@ json chainJson(const ChainChoice& c) {
     for (const DlpfCandidate& cand : c.scores)
       scores[cand.dlpf_cfg ? std::to_string(*cand.dlpf_cfg) : std::string("none")] = cand.chi2;
     j["dlpf_estimate_reduced_chi2"] = scores;
+    j["no_dlpf_setting_fits"] = c.no_setting_fits;
+    json per_axis = json::object();
+    for (const auto& [idx, chi2] : c.axis_best_chi2) per_axis[std::to_string(idx)] = chi2;
+    j["best_reduced_chi2_by_column"] = per_axis;
+    j["best_reduced_chi2_per_axis"] = c.best_chi2_per_axis;
+    j["best_dlpf_cfg"] = c.best_candidate ? json(*c.best_candidate) : json(nullptr);
   }
   return j;
 }

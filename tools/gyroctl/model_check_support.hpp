@@ -2,6 +2,7 @@
 // gyroctl model-check's support: where the acquisition chain comes from (--dlpf/--fs-sel, the
 // recording's '# device' header, or the DLPF estimated from the Allan curve), and the words
 // of the acceptance verdict ("seen, not explained"). docs/model-check.md.
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -12,13 +13,31 @@
 
 namespace gyrod::gyroctl {
 
+// A right model through a narrow DLPF keeps a reduced χ² of a few (docs/model-check.md, "The
+// acquisition chain"); a real record with a shape no setting gives showed 41.
+inline constexpr double kNoDlpfFitsChi2 = 10.0;
+
 // The acquisition chain the base model gets, and where each part came from.
 struct ChainChoice {
   processing::AcquisitionChain chain;
   double rate_hz = 0.0;  // the rate the check uses: the DLPF's exact rate when one is set
   std::string dlpf_source, fs_sel_source;
   std::vector<processing::DlpfCandidate> scores;  // when the DLPF was estimated
+  // When estimated: the lowest reduced χ² of any candidate (none included) summed over the
+  // axes, per axis, which candidate; and per axis (by column index) its own lowest, which is
+  // far from fitting (> kNoDlpfFitsChi2) when its short-τ Allan curve has a shape no DLPF
+  // setting gives: that axis does not "hold" (docs/model-check.md, "Misfit").
+  double best_chi2_per_axis = 0.0;
+  std::optional<int> best_candidate;
+  std::map<std::size_t, double> axis_best_chi2;
+  bool no_setting_fits = false;  // on some axis
+  bool noSettingFits(std::size_t axis) const {
+    const auto it = axis_best_chi2.find(axis);
+    return it != axis_best_chi2.end() && it->second > kNoDlpfFitsChi2;
+  }
 };
+// "no DLPF setting fits the short-tau Allan curve of gx, gz: best reduced chi2 41 and 52 (> 10)".
+std::string noDlpfFitsText(const ChainChoice& c, const std::vector<std::string>& axis_names);
 
 // --dlpf / --fs-sel first, then the recording's header, else the DLPF estimated. Throws
 // RecordingError for a bad header value or a rate the DLPF cannot make.
