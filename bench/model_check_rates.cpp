@@ -119,6 +119,11 @@ void recordErrors(Tally& t, const processing::HiddenEffect& h, const processing:
       t.errors["count abs"].push_back(std::fabs(static_cast<double>(d.count) - static_cast<double>(h.count)));
       t.errors["lost abs"].push_back(std::fabs(static_cast<double>(d.lost) - static_cast<double>(h.lost)));
       break;
+    case ModelEffect::NarrowbandLine:
+      t.errors["centre rel"].push_back(rel(d.centre_hz, h.centre_hz));
+      t.errors["width rel"].push_back(rel(d.width_hz, h.width_hz));
+      t.errors["rms rel"].push_back(rel(d.rms_dps, h.rms_dps));
+      break;
     case ModelEffect::Unexplained: break;
   }
 }

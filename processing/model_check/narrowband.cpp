@@ -181,6 +181,11 @@ double lineNegLogLikelihood(const LineWindow& w, const LineParameters& p, double
   const double centre = p[0], width = std::exp(p[1]), rms = std::exp(p[2]);
   if (!(centre > w.freq.front() && centre < w.freq.back() && width > 0.2 * df && width < 2.0 * w.half_width))
     return std::numeric_limits<double>::infinity();
+  // The background within a factor 10 of the block medians' level: a line strong enough that
+  // its tails fill the window would otherwise explain it all, the background would go to 0,
+  // and the shrink would take the whole band out with the line.
+  if (!(std::fabs(p[3]) <= std::log(10.0) && std::fabs(p[4]) <= 10.0 && std::fabs(p[5]) <= 20.0))
+    return std::numeric_limits<double>::infinity();
   NarrowbandLineRecursion r;
   try {
     r = narrowbandLineRecursion({centre, width, rms}, rate);

@@ -193,7 +193,9 @@ TEST(ModelCheckMisfit, ANoiseBumpDoesNotFitAndIsPlaced) {
   }
 }
 
-TEST(ModelCheckMisfit, AWanderingLineDoesNotFitAndIsPlaced) {
+// A line whose frequency wanders (0.3 Hz wide, of the axis's rms) is the catalogue's
+// narrowband line: named near its frequency, and the extended model with it fits.
+TEST(ModelCheckMisfit, AWanderingLineIsNamedAndTheExtendedModelFits) {
   for (std::uint64_t seed : {301u, 302u}) {
     GeneratedRecording g = HiddenEffectGenerator(seed).generate(kMisfitDuration, kMisfitRate, {});
     std::vector<double>& x = g.axes[1];
@@ -203,12 +205,11 @@ TEST(ModelCheckMisfit, AWanderingLineDoesNotFitAndIsPlaced) {
     for (std::size_t i = 0; i < x.size(); ++i) x[i] += line[i];
     const AxisModelCheck r = checkAxisModel({x, g.rate_hz, g.temp, g.t, {}}, misfitOptions(seed));
     const std::string what = "seed " + std::to_string(seed) + ": " + describeMisfit(r);
-    EXPECT_TRUE(r.misfit.fails()) << what;
-    EXPECT_LE(r.misfit.freq_lo_hz, freq) << what;
-    EXPECT_GE(r.misfit.freq_hi_hz, freq) << what;
-    // The innovations' band (0.2 Hz bins) or one of the spectrum's log bands (~20 % wide).
-    EXPECT_LT(r.misfit.freq_hi_hz - r.misfit.freq_lo_hz, 0.4 * freq) << what;
-    EXPECT_GT(r.misfit.power_ratio, 2.0) << what;
+    bool named = false;
+    for (const DetectedEffect& e : r.effects)
+      named = named || (e.effect == ModelEffect::NarrowbandLine && std::fabs(e.centre_hz - freq) < 0.1);
+    EXPECT_TRUE(named) << what;
+    EXPECT_FALSE(r.misfit.fails()) << what;
   }
 }
 
