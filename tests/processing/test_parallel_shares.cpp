@@ -83,7 +83,8 @@ TEST(ParallelShares, TheWholeAxisAnalysisIsTheSameBitsForAnyThreadCount) {
     const AxisAnalysis a = analyzeAxis(x, options);
     ASSERT_EQ(a.allan.size(), reference.allan.size());
     for (std::size_t k = 0; k < a.allan.size(); ++k) {
-      EXPECT_EQ(shareBitsOf(a.allan[k].oadev), shareBitsOf(reference.allan[k].oadev)) << threads << " threads, k = " << k;
+      EXPECT_EQ(shareBitsOf(a.allan[k].oadev), shareBitsOf(reference.allan[k].oadev))
+          << threads << " threads, k = " << k;
       EXPECT_EQ(shareBitsOf(a.allan[k].adev), shareBitsOf(reference.allan[k].adev)) << threads << " threads, k = " << k;
       EXPECT_EQ(a.allan[k].noise_alpha, reference.allan[k].noise_alpha) << threads << " threads, k = " << k;
     }
@@ -138,6 +139,7 @@ TEST(ParallelShares, TheInPlaceTablesAlongsideWorkReadsTheSamplesBeforeTheyBecom
     EXPECT_EQ(calls, 1) << threads << " threads";
     EXPECT_EQ(shareBitsOf(sum_seen), shareBitsOf(sum)) << threads << " threads";
     ASSERT_EQ(table.size(), reference.size());
-    for (std::size_t k = 0; k < table.size(); ++k) EXPECT_EQ(shareBitsOf(table[k].oadev), shareBitsOf(reference[k].oadev));
+    for (std::size_t k = 0; k < table.size(); ++k)
+      EXPECT_EQ(shareBitsOf(table[k].oadev), shareBitsOf(reference[k].oadev));
   }
 }
