@@ -2,6 +2,7 @@
 // Internal parts of the model check (processing/model_check/*.cpp), shared between its
 // files and the tests. Not a stable interface.
 #include <cstddef>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -53,6 +54,12 @@ Periodogram hannPeriodogram(std::span<const double> x);
 // (k/8, 16..128 bins), divided by ln 2 (the median of an exponential of mean 1), and
 // interpolated in log between block centres.
 std::vector<double> spectralBackground(const std::vector<double>& power);
+// What both backgrounds are made of: medians of consecutive blocks of bins from bin 1 (the
+// block at bin k `width_at(k)` wide; a last block shorter than `shortest_last` joins the one
+// before), ÷ ln 2, log-linear between block centres.
+std::vector<double> blockMedianLevels(const std::vector<double>& power,
+                                      const std::function<std::size_t(std::size_t)>& width_at,
+                                      std::size_t shortest_last);
 // Largest power/background over bins [k_lo, k_hi], and where.
 struct SpectralPeak {
   double ratio = 0.0;

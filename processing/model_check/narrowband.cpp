@@ -50,31 +50,8 @@ std::size_t lineBackgroundBlock(double df) {
 }
 
 std::vector<double> blockMedianBackground(const std::vector<double>& power, std::size_t block) {
-  const std::size_t n = power.size();
-  std::vector<double> centres, levels, scratch;
-  for (std::size_t k = 1; k < n;) {
-    std::size_t end = std::min(n, k + block);
-    if (n - end < block / 2) end = n;
-    scratch.assign(power.begin() + static_cast<std::ptrdiff_t>(k), power.begin() + static_cast<std::ptrdiff_t>(end));
-    const auto mid = scratch.begin() + static_cast<std::ptrdiff_t>(scratch.size() / 2);
-    std::nth_element(scratch.begin(), mid, scratch.end());
-    centres.push_back(0.5 * static_cast<double>(k + end - 1));
-    levels.push_back(std::max(*mid, std::numeric_limits<double>::min()) / std::numbers::ln2);
-    k = end;
-  }
-  std::vector<double> bg(n, levels.front());
-  std::size_t j = 0;
-  for (std::size_t i = 1; i < n; ++i) {
-    const double f = static_cast<double>(i);
-    while (j + 1 < centres.size() && centres[j + 1] < f) ++j;
-    if (f <= centres.front() || j + 1 >= centres.size()) {
-      bg[i] = f <= centres.front() ? levels.front() : levels.back();
-    } else {
-      const double u = (f - centres[j]) / (centres[j + 1] - centres[j]);
-      bg[i] = std::exp((1.0 - u) * std::log(levels[j]) + u * std::log(levels[j + 1]));
-    }
-  }
-  return bg;
+  return blockMedianLevels(
+      power, [block](std::size_t) { return block; }, block / 2);
 }
 
 LineScan scanForLines(const std::vector<double>& power, const std::vector<double>& background, std::size_t k_lo,

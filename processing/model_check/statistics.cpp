@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <functional>
 #include <limits>
 #include <numbers>
 #include <stdexcept>
@@ -124,15 +125,16 @@ Periodogram hannPeriodogram(std::span<const double> x) {
   return p;
 }
 
-std::vector<double> spectralBackground(const std::vector<double>& power) {
+std::vector<double> blockMedianLevels(const std::vector<double>& power,
+                                      const std::function<std::size_t(std::size_t)>& width_at,
+                                      std::size_t shortest_last) {
   const std::size_t n = power.size();
   std::vector<double> centres, levels;
   std::vector<double> scratch;
   std::size_t k = 1;
   while (k < n) {
-    const std::size_t width = std::clamp<std::size_t>(k / 8, 16, 128);
-    std::size_t end = std::min(n, k + width);
-    if (n - end < 16) end = n;  // no short last block: a median of a few bins is too noisy
+    std::size_t end = std::min(n, k + width_at(k));
+    if (n - end < shortest_last) end = n;  // no short last block: a median of a few bins is too noisy
     scratch.assign(power.begin() + static_cast<std::ptrdiff_t>(k), power.begin() + static_cast<std::ptrdiff_t>(end));
     const auto mid = scratch.begin() + static_cast<std::ptrdiff_t>(scratch.size() / 2);
     std::nth_element(scratch.begin(), mid, scratch.end());
@@ -155,6 +157,11 @@ std::vector<double> spectralBackground(const std::vector<double>& power) {
     }
   }
   return bg;
+}
+
+std::vector<double> spectralBackground(const std::vector<double>& power) {
+  return blockMedianLevels(
+      power, [](std::size_t k) { return std::clamp<std::size_t>(k / 8, 16, 128); }, 16);
 }
 
 SpectralPeak largestSpectralPeak(const std::vector<double>& power, const std::vector<double>& background,
