@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The model check on every real record the project ships (tests/data/mpu6050-*): per axis the
 # effects named, the held-out Ljung–Box p, the share of the Allan curve in the replicas' 90 %
-# band and the held-out innovation variance, base → extended. Prints the markdown table of
+# band (the simultaneous one) and the held-out innovation variance, base → extended. Prints the markdown table of
 # docs/model-check.md ("Real records"); with --pin also writes the figures the test
 # tests/tools/test_model_check_real_records.cpp holds the check to
 # (tests/data/model-check-real-records.json). Uses build/bin/gyroctl (scripts/test.sh builds it).
@@ -29,7 +29,7 @@ done
 import json, sys
 scratch, mode, commit, records = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4:]
 pinned = {"commit": commit, "records": []}
-print("| record | axis | effects named | verdict | held-out whiteness p | in 90 % band (band p) | held-out innovation var [(°/s)²] base → ext. | passes |")
+print("| record | axis | effects named | verdict | held-out whiteness p | in the simultaneous 90 % band (band p) | held-out innovation var [(°/s)²] base → ext. | passes |")
 print("|---|---|---|---|---|---|---|---|")
 passes = fits = total = 0
 for r in records:

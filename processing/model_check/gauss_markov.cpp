@@ -45,15 +45,17 @@ GaussMarkovFound checkGaussMarkov(std::span<const double> xc, const Context& c, 
   // stays the five-term fit's (the base replicas, or round 2's of the cleaned series).
   const double stat = gaussMarkovStatistic(gm.fit);
   const double alpha = o.false_alarm * kGaussMarkovAlphaFactor;
-  // A statistic at or below the base replicas' median fires against neither null (the joint
-  // null's threshold is above the largest of its replicas, which such a statistic would need
-  // to exceed with all of them below the base median): on a clean axis without a deterministic
-  // effect the extra round is skipped, about one axis in two, so an hour keeps to its budget.
+  // A statistic at or below the base replicas' median fires against neither null (a null's
+  // threshold is above the largest of its replicas, which such a statistic would need to
+  // exceed with all of them below the base median): the extra round is skipped then, about
+  // one axis in two, so an hour keeps to its budget. With a deterministic effect named the
+  // cleaned series' terms differ from the base fit's by what the effect took, which moves the
+  // statistic's null far less than from its median to above its largest replica.
   const std::vector<double> base_stats = column(base_reps, &SeriesStats::gm_statistic);
-  const bool joint =
-      !c.chain.dlpf_cfg.has_value() && (deterministic_found || stat > summarizeNull(base_stats, alpha, false).median);
+  const bool above_base_median = stat > summarizeNull(base_stats, alpha, false).median;
+  const bool joint = !c.chain.dlpf_cfg.has_value() && above_base_median;
   std::vector<SeriesStats> own_reps;
-  if (joint || deterministic_found) {
+  if (joint || (deterministic_found && above_base_median)) {
     const SimulationModel model = pureModel(c.rate, joint ? gm.fit.terms_with_gm : gm.clean_fit.value);
     own_reps = runReplicas(model, statisticalUncertainty(gm.clean_fit), c, {}, o, kGaussMarkovRound, kStatGaussMarkov);
     out.replicas_simulated += o.replicas;

@@ -215,8 +215,8 @@ void placeInSpectrum(const AxisModelCheck& s, ModelMisfit& m) {
 
 }  // namespace
 
-ModelMisfit judgeMisfit(std::span<const double> residual, const AllanBand& band, double in_band,
-                        const std::vector<double>& null_q, double rate_hz, const AxisModelCheck& spectra) {
+ModelMisfit judgeMisfit(std::span<const double> residual, const AllanBand& band, const std::vector<double>& null_q,
+                        double rate_hz, const AxisModelCheck& spectra) {
   ModelMisfit m;
   const std::size_t half = residual.size() / 2;
   const HeldOutWhiteness w = heldOutWhiteness(residual.first(half), residual.subspan(half));
@@ -229,14 +229,24 @@ ModelMisfit judgeMisfit(std::span<const double> residual, const AllanBand& band,
   }
   m.whiteness_ar_order = w.ar_order;
   m.whiteness_fails = !(m.ljung_box_p_held_out >= kMisfitWhitenessP);
-  m.in_band = in_band;
+  // The whole curve is judged against the simultaneous band; with too few replicas to draw
+  // one (tests with a handful), against the per-τ band.
+  const bool joint = !band.joint_lo.empty();
+  const std::vector<double>& lo = joint ? band.joint_lo : band.lo;
+  const std::vector<double>& hi = joint ? band.joint_hi : band.hi;
+  const std::vector<double>& replica_shares = joint ? band.replica_in_joint_band : band.replica_in_band;
   const std::size_t taus = band.tau_s.size();
-  if (!band.replica_in_band.empty() && taus > 0) {
-    std::vector<double> shares = band.replica_in_band, misses;
+  std::size_t inside = 0;
+  for (std::size_t j = 0; j < taus; ++j) inside += (band.measured[j] >= lo[j] && band.measured[j] <= hi[j]) ? 1 : 0;
+  const double in_band = taus > 0 ? static_cast<double>(inside) / static_cast<double>(taus) : 1.0;
+  m.in_band = in_band;
+  m.joint_band = joint;
+  if (!replica_shares.empty() && taus > 0) {
+    std::vector<double> shares = replica_shares, misses;
     std::sort(shares.begin(), shares.end());
     m.in_band_replica_median = sortedQuantile(shares, 0.5);
     m.in_band_replica_lowest = shares.front();
-    for (double v : band.replica_in_band) misses.push_back(std::round((1.0 - v) * static_cast<double>(taus)));
+    for (double v : replica_shares) misses.push_back(std::round((1.0 - v) * static_cast<double>(taus)));
     const auto missed = static_cast<std::size_t>(std::lround((1.0 - in_band) * static_cast<double>(taus)));
     m.band_p = betaBinomialUpperTail(missed, taus, misses);
     m.band_fails = in_band < m.in_band_replica_lowest && m.band_p < kMisfitBandAlpha;
@@ -246,7 +256,7 @@ ModelMisfit judgeMisfit(std::span<const double> residual, const AllanBand& band,
   if (m.band_fails || in_band < m.in_band_replica_lowest) {
     double farthest = -1.0;
     for (std::size_t j = 0; j < taus; ++j) {
-      if (band.measured[j] >= band.lo[j] && band.measured[j] <= band.hi[j]) continue;
+      if (band.measured[j] >= lo[j] && band.measured[j] <= hi[j]) continue;
       if (!(m.tau_lo_s <= band.tau_s[j])) m.tau_lo_s = band.tau_s[j];
       m.tau_hi_s = band.tau_s[j];
       const double ratio = band.measured[j] / band.median[j];

@@ -140,8 +140,19 @@ struct AllanBand {
   std::vector<double> median;    // median over replicas
   std::vector<double> lo, hi;    // 5 % and 95 % over replicas (the 90 % band)
   // The in-band share of each replica against the band of the other replicas (leave one
-  // out): the null distribution of the measured curve's in-band share (the misfit's band test).
+  // out), τ by τ.
   std::vector<double> replica_in_band;
+  // The simultaneous 90 % band, the one a whole curve is judged by: median ± c one-sided
+  // spreads in log ADEV (the 15.87–84.13 % half-widths below and above the median), c the 90 %
+  // quantile of the replicas' largest |z| over τ, each replica against the others (the sup-t
+  // band: Montiel Olea & Plagborg-Møller 2019). 90 % of a right model's curves lie inside it
+  // at every τ; the per-τ band above leaves a right model's curve in band at only ~87 % of τ
+  // on average. `replica_in_joint_band`: each replica's share against the others' band, the
+  // null distribution of the measured curve's share (the misfit's band test).
+  double joint_z = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> joint_lo, joint_hi;
+  std::vector<double> replica_in_joint_band;
+  double measured_in_joint_band = 0.0;
 };
 
 struct ModelCheckGain {
@@ -172,8 +183,9 @@ struct ExtensionVerdict {
 // (docs/model-check.md, "Misfit"). Whiteness: the held-out prediction errors of an AR model
 // (heldOutWhiteness: AIC up to kWhitenessMaxArOrder, fitted on the first half of the series
 // the model leaves, scored on the second) have a Ljung–Box p ≥ kMisfitWhitenessP. Band: the
-// measured Allan curve lies outside the 90 % band of the model's replicas at no more τ than
-// the replicas themselves do (each against the band of the others: AllanBand::replica_in_band);
+// measured Allan curve lies outside the simultaneous 90 % band of the model's replicas at no
+// more τ than the replicas themselves do (each against the band of the others:
+// AllanBand::replica_in_joint_band);
 // it fails when it misses at more τ than every replica and a beta-binomial fitted to the
 // replicas' misses puts that many or more below kMisfitBandAlpha. A named effect does not make
 // a model fit; an empty `effects` does not either, unless both tests pass.
@@ -186,7 +198,8 @@ struct ModelMisfit {
   double whiteness_q = 0.0;           // its Ljung–Box Q
   double whiteness_q_replica_median = std::numeric_limits<double>::quiet_NaN();
   std::size_t whiteness_ar_order = 0;  // the AR order the whiteness test used
-  double in_band = 0.0;                // of the final model (a copy of ModelCheckGain's)
+  double in_band = 0.0;                // share of τ inside the final model's simultaneous band
+  bool joint_band = true;              // false: too few replicas, the per-τ band instead
   // The replicas' own in-band shares (leave one out): median and lowest; and the
   // beta-binomial probability of missing the band at as many τ as the measured curve does.
   double in_band_replica_median = std::numeric_limits<double>::quiet_NaN();

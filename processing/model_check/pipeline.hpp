@@ -272,11 +272,11 @@ struct ExtensionInputs {
 
 // The misfit of the final model (misfit.cpp): the whiteness of what it leaves (`residual`:
 // the detrended series, or the cleaned one when the extension is accepted), fitted on the
-// first half and scored on the second; its Allan band and in-band share.
+// first half and scored on the second; the share of its Allan curve in the simultaneous band.
 // The whiteness p is the measured Q's tail under a scaled χ² fitted to `null_q` (the base
 // replicas' Q: whiteNullP).
-ModelMisfit judgeMisfit(std::span<const double> residual, const AllanBand& band, double in_band,
-                        const std::vector<double>& null_q, double rate_hz, const AxisModelCheck& spectra);
+ModelMisfit judgeMisfit(std::span<const double> residual, const AllanBand& band, const std::vector<double>& null_q,
+                        double rate_hz, const AxisModelCheck& spectra);
 
 // Replicas of the extended model: its Allan band, what it leaves unexplained, and the gain
 // (Allan band and Kalman innovations, base against extended).

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cmath>
 #include <exception>
+#include <limits>
 #include <mutex>
 #include <thread>
 
@@ -159,6 +160,68 @@ double maxAbsZ(const std::vector<double>& log_adev, const std::vector<double>& m
   return m;
 }
 
+namespace {
+
+// One τ's spread of the replicas in log ADEV, each side of the median on its own (the
+// distribution of a log ADEV is skewed at long τ, where few clusters average).
+struct LogSpread {
+  double median = 0.0, below = 0.0, above = 0.0;
+  double z(double v) const {
+    const double w = v >= median ? above : below;
+    return w > 0.0 ? (v - median) / w : (v == median ? 0.0 : std::numeric_limits<double>::infinity());
+  }
+};
+LogSpread logSpread(const std::vector<double>& sorted) {
+  LogSpread s;
+  s.median = sortedQuantile(sorted, 0.5);
+  s.below = s.median - sortedQuantile(sorted, 0.1587);
+  s.above = sortedQuantile(sorted, 0.8413) - s.median;
+  return s;
+}
+
+// AllanBand's simultaneous band (see model_check.hpp): every replica's |z| at every τ against
+// the other replicas, their largest |z| per replica, and its 90 % quantile.
+void jointAllanBand(const std::vector<SeriesStats>& reps, const std::vector<double>& measured_log, AllanBand& band) {
+  const std::size_t n = reps.size(), k = measured_log.size();
+  if (n < 4 || k == 0) return;
+  std::vector<std::vector<double>> z(n, std::vector<double>(k));
+  std::vector<LogSpread> all(k);
+  std::vector<double> col(n), others;
+  for (std::size_t j = 0; j < k; ++j) {
+    for (std::size_t r = 0; r < n; ++r) col[r] = reps[r].log_adev[j];
+    std::vector<double> sorted = col;
+    std::sort(sorted.begin(), sorted.end());
+    all[j] = logSpread(sorted);
+    for (std::size_t r = 0; r < n; ++r) {
+      others = sorted;
+      others.erase(std::lower_bound(others.begin(), others.end(), col[r]));
+      z[r][j] = std::fabs(logSpread(others).z(col[r]));
+    }
+  }
+  std::vector<double> largest(n);
+  for (std::size_t r = 0; r < n; ++r) largest[r] = *std::max_element(z[r].begin(), z[r].end());
+  std::vector<double> sorted_largest = largest;
+  std::sort(sorted_largest.begin(), sorted_largest.end());
+  band.joint_z = sortedQuantile(sorted_largest, 0.9);
+  for (std::size_t j = 0; j < k; ++j) {
+    band.joint_lo.push_back(std::exp(all[j].median - band.joint_z * all[j].below));
+    band.joint_hi.push_back(std::exp(all[j].median + band.joint_z * all[j].above));
+  }
+  for (std::size_t r = 0; r < n; ++r) {
+    // Replica r against the others' band: their 90 % quantile of the largest |z|.
+    others = sorted_largest;
+    others.erase(std::lower_bound(others.begin(), others.end(), largest[r]));
+    const double c = sortedQuantile(others, 0.9);
+    const auto inside = std::count_if(z[r].begin(), z[r].end(), [c](double v) { return v <= c; });
+    band.replica_in_joint_band.push_back(static_cast<double>(inside) / static_cast<double>(k));
+  }
+  std::size_t inside = 0;
+  for (std::size_t j = 0; j < k; ++j) inside += std::fabs(all[j].z(measured_log[j])) <= band.joint_z ? 1 : 0;
+  band.measured_in_joint_band = static_cast<double>(inside) / static_cast<double>(k);
+}
+
+}  // namespace
+
 AllanNull allanNull(const std::vector<SeriesStats>& reps, const std::vector<double>& measured_log, const Context& c,
                     double alpha) {
   AllanNull a;
@@ -193,6 +256,7 @@ AllanNull allanNull(const std::vector<SeriesStats>& reps, const std::vector<doub
   if (reps.size() > 2 && k > 0)
     for (std::size_t r = 0; r < reps.size(); ++r)
       a.band.replica_in_band.push_back(static_cast<double>(inside[r]) / static_cast<double>(k));
+  jointAllanBand(reps, measured_log, a.band);
   std::vector<double> maxes(reps.size());
   for (std::size_t r = 0; r < reps.size(); ++r) maxes[r] = maxAbsZ(reps[r].log_adev, a.median_log, a.spread_log);
   a.max_z = summarizeNull(maxes, alpha, false);
