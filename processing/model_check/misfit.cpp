@@ -251,9 +251,12 @@ ModelMisfit judgeMisfit(std::span<const double> residual, const AllanBand& band,
     m.band_p = betaBinomialUpperTail(missed, taus, misses);
     m.band_fails = in_band < m.in_band_replica_lowest && m.band_p < kMisfitBandAlpha;
   }
+  m.marginal = !m.whiteness_fails && !m.band_fails &&
+               (m.ljung_box_p_held_out < kMarginalWhitenessP || in_band < kMarginalInBand);
   // The τ range is stated when the band test fails, or when the curve is in band less often
-  // than every replica (a caller may add a failing test: the acquisition chain).
-  if (m.band_fails || in_band < m.in_band_replica_lowest) {
+  // than every replica or than kMarginalInBand (a caller may add a failing test: the
+  // acquisition chain).
+  if (m.band_fails || in_band < m.in_band_replica_lowest || in_band < kMarginalInBand) {
     double farthest = -1.0;
     for (std::size_t j = 0; j < taus; ++j) {
       if (band.measured[j] >= lo[j] && band.measured[j] <= hi[j]) continue;
@@ -266,7 +269,7 @@ ModelMisfit judgeMisfit(std::span<const double> residual, const AllanBand& band,
       }
     }
   }
-  if (!m.fails()) return m;
+  if (!m.fails() && !m.marginal) return m;
   const SpectralExcess excess = innovationSpectralExcess(w.errors, rate_hz);
   if (excess.found) {
     m.freq_lo_hz = excess.freq_lo_hz;

@@ -4,7 +4,8 @@
 // records"). A change that makes the check worse on real data is seen here: an axis that
 // passed (held-out whiteness p ≥ 0.01, ≥ 90 % in band) or fitted (the check's own misfit
 // tests) no longer doing so, fewer such axes, the held-out whiteness p down by more than a
-// factor 10, the in-band share down by more than one τ in ten, or other effects named.
+// factor 10, the in-band share down by more than one τ in ten, or other effects named; and
+// an axis that does not pass must be told where it misses (a misfit, or a marginal fit).
 // A change that makes it better fails too, on purpose, until the pin and the table are
 // written again.
 #include <gtest/gtest.h>
@@ -69,6 +70,15 @@ TEST(ModelCheckRealRecords, NoRecordGetsWorseThanItsPinnedFigures) {
       }
       if (want.at("fits").get<bool>()) {
         EXPECT_TRUE(fits) << misfit.dump();
+      }
+      // An axis that does not pass is told where it misses: as a misfit, or as a marginal fit.
+      if (!passes) {
+        EXPECT_TRUE(!fits || misfit.at("marginal").get<bool>()) << misfit.dump();
+        EXPECT_TRUE(!misfit.at("tau_lo_s").is_null() || !misfit.at("freq_lo_hz").is_null() ||
+                    misfit.at("chain_fails").get<bool>())
+            << misfit.dump();
+      } else {
+        EXPECT_FALSE(misfit.at("marginal").get<bool>()) << misfit.dump();
       }
       EXPECT_GE(p, want.at("ljung_box_p_held_out").get<double>() / 10.0);
       EXPECT_GE(band, want.at("in_band").get<double>() - 0.1);

@@ -246,6 +246,7 @@ json misfitJson(const ModelMisfit& m) {
           {"chain_reduced_chi2", numberOrNull(m.chain_reduced_chi2)},
           {"whiteness_fails", m.whiteness_fails},
           {"band_fails", m.band_fails},
+          {"marginal", m.marginal},
           {"ljung_box_p_held_out", m.ljung_box_p_held_out},
           {"whiteness_ar_order", m.whiteness_ar_order},
           {"whiteness_q", m.whiteness_q},
@@ -282,6 +283,20 @@ std::string fitFiguresText(const ModelMisfit& m) {
   return s;
 }
 
+// Where a misfit is: "misfit at tau 0.02–0.16 s (...) and 31.2–31.6 Hz (...)".
+std::string whereText(const ModelMisfit& m) {
+  std::vector<std::string> where;
+  if (std::isfinite(m.tau_lo_s))
+    where.push_back("tau " + sig4(m.tau_lo_s) + "–" + sig4(m.tau_hi_s) + " s (Allan deviation " +
+                    (m.adev_ratio >= 1.0 ? "up to " : "down to ") + fmt("%.3g", m.adev_ratio) +
+                    " x the replicas' median)");
+  if (std::isfinite(m.freq_lo_hz))
+    where.push_back(sig4(m.freq_lo_hz) + "–" + sig4(m.freq_hi_hz) + " Hz (" + fmt("%.3g", m.power_ratio) +
+                    (m.power_against_replicas ? " x the replicas' median power)" : " x the white level)"));
+  if (where.empty()) return "no tau range or frequency band stands out";
+  return "misfit at " + where.front() + (where.size() > 1 ? " and " + where.back() : "");
+}
+
 // Why and where the model does not fit: "what it leaves is not white on the held-back half
 // (Ljung-Box p 3.1e-05 < 0.001); ...; misfit at tau 0.02–0.16 s (up to 1.6 x the replicas'
 // median) and 31.2–31.6 Hz (12 x white)".
@@ -299,19 +314,24 @@ std::string misfitText(const ModelMisfit& m) {
                   percent(m.in_band_replica_median) + "; p " + fmt("%.2g", m.band_p) + ")");
   std::string s;
   for (const std::string& w : why) s += (s.empty() ? "" : "; ") + w;
-  std::vector<std::string> where;
-  if (std::isfinite(m.tau_lo_s))
-    where.push_back("tau " + sig4(m.tau_lo_s) + "–" + sig4(m.tau_hi_s) + " s (Allan deviation " +
-                    (m.adev_ratio >= 1.0 ? "up to " : "down to ") + fmt("%.3g", m.adev_ratio) +
-                    " x the replicas' median)");
-  if (std::isfinite(m.freq_lo_hz))
-    where.push_back(sig4(m.freq_lo_hz) + "–" + sig4(m.freq_hi_hz) + " Hz (" + fmt("%.3g", m.power_ratio) +
-                    (m.power_against_replicas ? " x the replicas' median power)" : " x the white level)"));
-  if (!where.empty())
-    s += "; misfit at " + where.front() + (where.size() > 1 ? " and " + where.back() : "");
-  else
-    s += "; no tau range or frequency band stands out";
-  return s;
+  return s + "; " + whereText(m);
+}
+
+// A model that fits but only just: "marginal: held-out whiteness p 0.0069 (< 0.01); weakest at
+// 12.1–12.9 Hz (1.9 x the white level)".
+std::string marginalText(const ModelMisfit& m) {
+  std::vector<std::string> why;
+  if (m.ljung_box_p_held_out < kMarginalWhitenessP)
+    why.push_back("held-out whiteness p " + fmt("%.2g", m.ljung_box_p_held_out) + " (< " +
+                  fmt("%g", kMarginalWhitenessP) + ")");
+  if (m.in_band < kMarginalInBand)
+    why.push_back(percent(m.in_band) + " of the Allan curve in the " + bandName(m) + " (< " + percent(kMarginalInBand) +
+                  ")");
+  std::string s = "marginal: ";
+  for (std::size_t i = 0; i < why.size(); ++i) s += (i ? " and " : "") + why[i];
+  std::string where = whereText(m);
+  where.replace(0, where.find(' '), "weakest");  // "misfit at ..." → "weakest at ..."
+  return s + "; " + where;
 }
 
 json termsJson(const NoiseTerms& t) {
@@ -353,6 +373,7 @@ void printAxisText(std::ostream& o, const std::string& name, const AxisModelChec
   o << "\n== " << name << " ==\n";
   if (r.effects.empty() && !r.misfit.fails())
     o << "  the base model holds: no effect (" << fitFiguresText(r.misfit) << ")\n";
+  if (r.effects.empty() && r.misfit.marginal) o << "      " << marginalText(r.misfit) << "\n";
   for (const DetectedEffect& e : r.effects) {
     o << "  " << modelEffectName(e.effect) << " (" << paramsText(e) << ")";
     if (!e.explained) o << ": seen, not explained (" << notExplainedReason(r.verdict) << ")";
@@ -363,6 +384,7 @@ void printAxisText(std::ostream& o, const std::string& name, const AxisModelChec
       << fitFiguresText(r.misfit) << ")\n";
   else if (!r.effects.empty())
     o << "  the " << finalModelName(r) << " model fits (" << fitFiguresText(r.misfit) << ")\n";
+  if (!r.effects.empty() && r.misfit.marginal) o << "      " << marginalText(r.misfit) << "\n";
   const ModelCheckGain& g = r.gain;
   char line[256];
   o << "  gain                    base        extended\n";
@@ -494,6 +516,8 @@ void writeReport(const std::string& dir_text, const ModelCheckCliOptions& opt, c
     md << "\n## " << name << "\n\n";
     if (r.effects.empty() && !r.misfit.fails())
       md << "The base model holds: no effect found (" << fitFiguresText(r.misfit) << ").\n";
+    if (r.effects.empty() && r.misfit.marginal)
+      md << "It is " << marginalText(r.misfit) << ".\n";
     else if (!r.effects.empty()) {
       md << "| effect | parameters | evidence |\n|---|---|---|\n";
       for (const DetectedEffect& e : r.effects)
@@ -504,6 +528,8 @@ void writeReport(const std::string& dir_text, const ModelCheckCliOptions& opt, c
     if (r.misfit.fails())
       md << (r.effects.empty() ? "" : "\n") << "The " << finalModelName(r)
          << " model does not fit: " << misfitText(r.misfit) << ".\n";
+    if (!r.effects.empty() && r.misfit.marginal)
+      md << "\nThe " << finalModelName(r) << " model fits, " << marginalText(r.misfit) << ".\n";
     const ModelCheckGain& g = r.gain;
     md << "\n| figure | base | extended |\n|---|---|---|\n"
        << "| mean \\|log10(measured/median simulated ADEV)\\| | " << fmt("%.4g", g.adev_log_error_base) << " | "
@@ -575,6 +601,7 @@ int runModelCheck(const ModelCheckCliOptions& opt) {
       const bool explained = r.extended_fit.reduced_chi2 <= kNoDlpfFitsChi2;
       m.chain_fails = chain.noSettingFits(idx) && !(r.verdict.judged && r.verdict.accepted && explained);
       if (m.chain_fails) m.chain_reduced_chi2 = chain.axis_best_chi2.at(idx);
+      m.marginal = m.marginal && !m.chain_fails;
     } catch (const std::invalid_argument& e) {
       throw recording::RecordingError(opt.file + ": column '" + rec.axis_names[idx] + "': " + e.what());
     }
