@@ -1,5 +1,6 @@
 #include "processing/base/portable_random.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -105,6 +106,32 @@ Layers buildNormalZigguratLayers() {
   return z;
 }
 
+// Where a wedge's point (x, y) lies against the density without computing it: the density is
+// concave below x = 1, so there it lies above the chord through the layer's corners and below
+// both tangents there, and convex above x = 1, where chord and tangents swap (Marsaglia &
+// Tsang 2000 note such squeezes; f' = −x·f). Decided only beyond a margin of 1e-9 of the
+// layer's height, far above the rounding of the bounds and of the density itself, so every
+// decision is the one the density would give: the deviates are the same, bit for bit
+// (ZigguratNormalGenerator.SqueezedWedgesDecideAsTheDensity). Half or more of the wedge
+// points are decided so, and the exponential was ~5 % of a model check's time.
+enum class WedgeSqueeze { Below, Above, Unsure };
+WedgeSqueeze wedgeSqueeze(const Layers& z, std::size_t i, double x, double y) {
+  const double x_in = z.x[i + 1], x_out = z.x[i];  // x_in < x ≤ x_out
+  const double f_in = z.f[i + 1], f_out = z.f[i];  // the density there: f_in > f_out
+  const double chord = f_in + (f_out - f_in) * (x - x_in) / (x_out - x_in);
+  const double tangent_in = f_in * (1.0 - x_in * (x - x_in));
+  const double tangent_out = f_out * (1.0 - x_out * (x - x_out));
+  const double margin = 1e-9 * f_in;
+  if (x_out <= 1.0) {  // concave: chord ≤ f ≤ min(tangents)
+    if (y < chord - margin) return WedgeSqueeze::Below;
+    if (y > std::min(tangent_in, tangent_out) + margin) return WedgeSqueeze::Above;
+  } else if (x_in >= 1.0) {  // convex: max(tangents) ≤ f ≤ chord
+    if (y < std::max(tangent_in, tangent_out) - margin) return WedgeSqueeze::Below;
+    if (y > chord + margin) return WedgeSqueeze::Above;
+  }
+  return WedgeSqueeze::Unsure;
+}
+
 }  // namespace
 
 const NormalZigguratLayers& normalZigguratLayers() {
@@ -132,7 +159,9 @@ double ZigguratNormalGenerator::nextOutsideTheCore(std::uint64_t u) {
     }
     // A wedge: a uniform height inside layer i, accepted under the density.
     const double y = z.f[i] + uniform_.uniform() * (z.f[i + 1] - z.f[i]);
-    if (y < halfNormalDensity(x)) return negative ? -x : x;
+    const WedgeSqueeze squeeze = wedgeSqueeze(z, i, x, y);
+    if (squeeze == WedgeSqueeze::Below || (squeeze == WedgeSqueeze::Unsure && y < halfNormalDensity(x)))
+      return negative ? -x : x;
     u = uniform_.next();
   }
 }
