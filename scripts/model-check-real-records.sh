@@ -14,7 +14,11 @@ gyroctl=build/bin/gyroctl
 scratch=$(mktemp -d)
 trap 'rm -rf "$scratch"' EXIT
 records=(mpu6050-arduino-100hz/imu_static_test.csv mpu6050-arduino-100hz/example_data_tinit_calc.csv
-         mpu6050-sensor-fusion-set1/unmoved-x-pointing-forward.csv mpu6050-sensor-fusion-set1/unmoved-x-pointing-up.csv)
+         mpu6050-sensor-fusion-set1/unmoved-x-pointing-forward.csv mpu6050-sensor-fusion-set1/unmoved-x-pointing-up.csv
+         mpu6050-sensor-fusion-set1/unmoved-z-pointing-left.csv
+         mpu6050-sensor-fusion-set2/unmoved-with-x-pointing-forward.csv
+         mpu6050-sensor-fusion-set2/unmoved-with-z-pointing-front-and-x-up.csv
+         mpu6050-sensor-fusion-set2/unmoved-with-z-pointing-front-and-y-down.csv)
 for r in "${records[@]}"; do
   src=tests/data/$r
   name=$(echo "$r" | tr '/' '_')
