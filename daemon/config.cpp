@@ -15,6 +15,7 @@
 #include "daemon/memory_budget.hpp"
 #include "daemon/sample_pipeline.hpp"
 #include "driver/mpu6050_config.hpp"
+#include "formats/input_file.hpp"
 #include "formats/model_toml.hpp"
 #include "formats/motion_spec.hpp"
 #include "formats/quoted_value.hpp"
@@ -463,7 +464,9 @@ void checkReferences(const Section& filter, const Section& socket, const Section
   if (config.device.backend == DeviceBackend::Mock && config.mock.source == MockSource::Replay) {
     double rate = 50.0;  // as the replay source assumes for a file without t
     try {
-      const recording::Recording rec = recording::readRecordingCsv(config.mock.replay_file);
+      recording::ReadOptions replay;
+      replay.input_kind = &formats::kReplayInput;
+      const recording::Recording rec = recording::readRecordingCsv(config.mock.replay_file, replay);
       if (rec.t.size() >= 2) rate = recording::sampleRateFromTimes(rec);
     } catch (const std::exception& e) {
       mock.failValue("replay_file", e.what());
@@ -545,12 +548,13 @@ GyrodConfig parseConfig(std::string_view toml_text, const std::string& source_na
 }
 
 GyrodConfig loadConfigFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ConfigError(path + ": cannot open: " + std::strerror(errno));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw ConfigError(path + ": read error: " + std::strerror(errno));
-  return parseConfig(text.str(), path, ReferenceChecks::On);
+  std::string text;
+  try {
+    text = formats::readInputFile(path, formats::kConfigurationInput);
+  } catch (const formats::InputFileError& e) {
+    throw ConfigError(e.what());
+  }
+  return parseConfig(text, path, ReferenceChecks::On);
 }
 
 }  // namespace gyrod::daemon

@@ -14,6 +14,7 @@
 #include <sstream>
 #include <system_error>
 
+#include "daemon/command_line.hpp"
 #include "daemon/watchdog.hpp"
 #include "driver/counter_names.hpp"
 #include "driver/mpu6050_config.hpp"
@@ -229,6 +230,10 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
                config_.device.rate_hz, config_.device.dlpf, config_.device.full_scale_dps,
                server_->socketPath().empty() ? std::string("(socket activation)") : server_->socketPath(),
                recorder_ ? ", recording to " + recorder_->currentFile() : std::string());
+  if (config_file_.empty())
+    spdlog::info("configuration: no file (no --config, and no {}): running on the defaults", kDefaultConfigPath);
+  else
+    spdlog::info("configuration: loaded from {}", config_file_);
   if (!device_.virtual_clock) spdlog::info("event loop scheduling: {}", loopSchedulingNote());
   spdlog::info("rate stream: {}", pipeline_.rateModel() == RateModel::SensorModel
                                       ? "raw - the bias of the sensor model " + config_.filter.model
