@@ -103,9 +103,12 @@ LoadedRateModel Gyrod::loadRateModel(const GyrodConfig& c) {
   }
   try {
     processing::RateEstimatorParameters p = recording::rateEstimatorParameters(model);
-    if (std::fabs(p.rate_hz - c.device.rate_hz) > 1e-9 * c.device.rate_hz)
-      spdlog::warn("{}: model rate {} Hz, device {} Hz: the rate stream runs at the device's", f.model, p.rate_hz,
-                   c.device.rate_hz);
+    if (std::fabs(p.rate_hz - c.device.rate_hz) > 1e-9 * c.device.rate_hz) {
+      std::ostringstream warning;
+      warning << f.model << ": model rate " << p.rate_hz << " Hz, device " << c.device.rate_hz
+              << " Hz: the rate stream runs at the device's";
+      loaded.warning = warning.str();
+    }
     p.rate_hz = c.device.rate_hz;
     if (f.rate_low_pass_hz) p.low_pass_hz = *f.rate_low_pass_hz > 0.0 ? f.rate_low_pass_hz : std::nullopt;
     processing::validateRateEstimatorParameters(p);
@@ -151,7 +154,13 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
       device_(makeDeviceParts(config)),
       pipeline_(pipelineSettings(config, rate_model_)),
       noise_refit_(loop_, pipeline_, config.device.rate_hz, [this] { allan_reply_.invalidate(); }),
-      allan_reply_([this] { return allanReport(); }) {
+      allan_reply_([this] { return allanReport(); }),
+      reload_(
+          loop_, kReloadTimeLimit,
+          [file = config_file_, rate_hz = config.device.rate_hz] { return loadReload(file, rate_hz); },
+          [this](ReloadedFilter&& reloaded) { applyReload(std::move(reloaded)); },
+          [](const std::string& why) { spdlog::error("SIGHUP: keeping the running filter: {}", why); }) {
+  if (!rate_model_.warning.empty()) spdlog::warn("{}", rate_model_.warning);
   start_real_ns_ = monotonicNowNs();
   last_pump_real_ns_ = start_real_ns_;
 
@@ -190,7 +199,10 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
 
   loop_.addSignals({SIGTERM, SIGINT, SIGHUP}, [this](int signal_number) {
     if (signal_number == SIGHUP) {
-      reload();
+      if (config_file_.empty())
+        spdlog::warn("SIGHUP: no configuration file was loaded, nothing to reload");
+      else
+        reload_.request();  // read and checked off the loop; applied here when ready
     } else {
       spdlog::info("{} received: stopping", signal_number == SIGTERM ? "SIGTERM" : "SIGINT");
       loop_.stop();
@@ -383,16 +395,21 @@ void Gyrod::petWatchdog() {
   if (watchdogPingDue(monotonicNowNs(), last_sample_real_ns_, watchdog_usec_)) ::sd_notify(0, "WATCHDOG=1");
 }
 
-void Gyrod::reload() {
-  if (config_file_.empty()) {
-    spdlog::warn("SIGHUP: no configuration file was loaded, nothing to reload");
-    return;
-  }
+// On the reload's thread: nothing here touches the running daemon.
+ReloadedFilter Gyrod::loadReload(const std::string& config_file, double device_rate_hz) {
+  GyrodConfig fresh = loadConfigFile(config_file);
+  fresh.device.rate_hz = device_rate_hz;  // [device] applies at restart
+  ReloadedFilter reloaded;
+  reloaded.rate_model = loadRateModel(fresh);
+  reloaded.filter = fresh.filter;
+  return reloaded;
+}
+
+void Gyrod::applyReload(ReloadedFilter&& reloaded) {
   try {
-    GyrodConfig fresh = loadConfigFile(config_file_);
-    fresh.device.rate_hz = config_.device.rate_hz;  // [device] applies at restart
-    const auto& f = fresh.filter;
-    LoadedRateModel rate_model = loadRateModel(fresh);  // before anything changes
+    const FilterConfig& f = reloaded.filter;
+    LoadedRateModel& rate_model = reloaded.rate_model;
+    if (!rate_model.warning.empty()) spdlog::warn("{}", rate_model.warning);
     pipeline_.reloadFilter(f.mean_window, f.mean_threshold_dps, {f.kalman.a, f.kalman.q, f.kalman.r});
     const bool new_rate_model = rate_model.identity != rate_model_.identity;
     if (new_rate_model) {
