@@ -245,6 +245,7 @@ void readSocket(const Section& s, SocketConfig& c) {
 
 void readRecord(const Section& s, RecordConfig& r) {
   if (auto v = s.string("path")) {
+    if (hasControlCharacter(*v)) s.failValue("path", "must be a path without control characters");
     if (!v->empty() && (v->back() == '/' || std::filesystem::path(*v).filename() == "."))
       s.failValue("path", "must name a file (e.g. /var/lib/gyrod/gyro.csv), not a directory");
     r.path = *v;
@@ -360,7 +361,9 @@ void readMock(const Section& s, MockConfig& m) {
     m.seed = static_cast<std::uint64_t>(*v);
   }
   if (auto v = s.number("speed")) {
-    if (!(*v > 0.0 && *v <= 1000.0)) s.failValue("speed", "must be > 0 and ≤ 1000 (1 = real time)");
+    if (!(*v >= kMinMockSpeed && *v <= kMaxMockSpeed))
+      s.failValue("speed", "must be between " + shortest(kMinMockSpeed) + " and " + shortest(kMaxMockSpeed) +
+                               " (1 = real time)");
     m.speed = *v;
   }
   readMockMotion(s, m);
@@ -538,6 +541,13 @@ GyrodConfig readConfig(const formats::TomlDocument& doc, ReferenceChecks checks)
 }
 
 }  // namespace
+
+bool hasControlCharacter(std::string_view text) {
+  return std::any_of(text.begin(), text.end(), [](char c) {
+    const auto byte = static_cast<unsigned char>(c);
+    return byte < 0x20 || byte == 0x7f;
+  });
+}
 
 GyrodConfig parseConfig(std::string_view toml_text, const std::string& source_name, ReferenceChecks checks) {
   try {
