@@ -17,6 +17,7 @@
 #include "daemon/command_line.hpp"
 #include "daemon/watchdog.hpp"
 #include "driver/counter_names.hpp"
+#include "driver/fifo_frame.hpp"
 #include "driver/mpu6050_config.hpp"
 #include "formats/calibration.hpp"
 #include "formats/model_toml.hpp"
@@ -27,8 +28,9 @@ namespace gyrod::daemon {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-// The accelerated mock's virtual clock is pumped from this real-time timer, in steps of
-// at most kMaxVirtualStepNs so that the FIFO (2.5 s at 50 Hz) never overflows in a step.
+// The accelerated mock's virtual clock is pumped from this real-time timer, in steps of at
+// most kMaxVirtualStepNs, and at most half of what the FIFO holds at the device's rate
+// (maxVirtualStepNs), so that the FIFO never overflows in a step.
 constexpr auto kPumpPeriod = std::chrono::milliseconds(10);
 constexpr std::int64_t kMaxVirtualStepNs = 200'000'000;
 // Real time one pump may spend before returning to the loop.
@@ -63,6 +65,18 @@ std::string loopSchedulingNote() {
   }
   return "SCHED_OTHER: when the CPUs are busy a sample can reach clients a scheduler tick late (1-10 ms); "
          "run gyrod SCHED_FIFO for sub-millisecond delivery (the systemd unit does; by hand: chrt -f 10 gyrod ...)";
+}
+
+// Half the time the FIFO takes to fill, or the host's queue of data-ready edges (16, as the
+// kernel's GPIO line-event FIFO) when that is shorter: 73 frames of 14 bytes are 73 ms at 1 kHz,
+// so a fixed step (200 ms, 2.5 s of FIFO at 50 Hz) overflowed the FIFO at every step, and an edge
+// queue that overflows leaves the driver without the edge that dates a new segment.
+std::int64_t maxVirtualStepNs(const driver::Mpu6050Config& chip) {
+  const auto fifo_frames = driver::mpu6050::fifo::kSize / driver::frameBytesFor(chip.accel);
+  const auto queued_edges = driver::MockMpu6050Config{}.data_ready_queue_depth;
+  const double samples = 0.5 * static_cast<double>(std::min(fifo_frames, queued_edges));
+  const double step_ns = samples / chip.sample_rate_hz * 1e9;
+  return std::max<std::int64_t>(1, std::min(kMaxVirtualStepNs, static_cast<std::int64_t>(step_ns)));
 }
 
 Vec3 modelBias(const std::string& path) {
@@ -163,6 +177,7 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
   if (!rate_model_.warning.empty()) spdlog::warn("{}", rate_model_.warning);
   start_real_ns_ = monotonicNowNs();
   last_pump_real_ns_ = start_real_ns_;
+  max_virtual_step_ns_ = maxVirtualStepNs(device_.driver_config);
 
   SocketOptions socket_options;
   socket_options.path = config_.socket.path;
@@ -310,7 +325,7 @@ void Gyrod::pumpVirtualClock() {
   }
   while (budget > 0) {
     if (monotonicNowNs() - now > kMaxPumpWorkNs) break;  // the rest of this slice is dropped
-    const std::int64_t step = std::min(budget, kMaxVirtualStepNs);
+    const std::int64_t step = std::min(budget, max_virtual_step_ns_);
     device_.virtual_clock->advanceNs(step);
     budget -= step;
     device_.mock->sync();

@@ -95,6 +95,7 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   std::uint64_t watchdog_usec_ = 0;
   bool ready_sent_ = false;
   bool pump_lagging_warned_ = false;
+  std::int64_t max_virtual_step_ns_ = 0;  // the accelerated mock's longest step of sensor time
   std::uint64_t samples_published_ = 0;
   std::uint64_t gaps_ = 0;
   std::uint64_t missing_samples_ = 0;
