@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -34,12 +35,31 @@ std::int64_t runQueueDelayNs() {
 
 }  // namespace
 
+constexpr const char* kUsage =
+    "usage: gyrod_latency SOCKET [LINES]\n"
+    "Watches gyrod's RATE stream on SOCKET and prints the latency from each sample's data-ready\n"
+    "edge to its arrival here (p50, p90, p99, max in us) over LINES lines (default 3000), and\n"
+    "this client's own run-queue delay. Real-time backends only (not an accelerated mock).\n";
+
 int main(int argc, char** argv) {
-  if (argc < 2) {
-    std::fprintf(stderr, "usage: %s SOCKET [LINES]\n", argv[0]);
-    return 2;
+  if (argc >= 2 && (std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0)) {
+    std::fputs(kUsage, stdout);
+    return 0;
   }
-  const std::size_t wanted = argc > 2 ? std::stoul(argv[2]) : 3000;
+  if (argc < 2 || argc > 3) {
+    std::fputs(kUsage, stderr);
+    return 64;  // EX_USAGE, as gyrod and gyroctl
+  }
+  std::size_t wanted = 3000;
+  if (argc > 2) {
+    char* end = nullptr;
+    const unsigned long long lines = std::strtoull(argv[2], &end, 10);
+    if (end == argv[2] || *end != '\0' || lines == 0 || argv[2][0] == '-') {
+      std::fprintf(stderr, "gyrod_latency: LINES must be a positive whole number (got '%s')\n", argv[2]);
+      return 64;
+    }
+    wanted = static_cast<std::size_t>(lines);
+  }
   const int fd = ::socket(AF_UNIX, SOCK_STREAM, 0);
   sockaddr_un addr{};
   addr.sun_family = AF_UNIX;

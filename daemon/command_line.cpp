@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "daemon/recorder.hpp"
+#include "formats/quoted_value.hpp"
 #include "formats/toml_document.hpp"
 
 #ifndef GYROD_VERSION
@@ -26,13 +27,17 @@ void applyOverrides(GyrodConfig& config, const CommandLineOverrides& o) {
     config.socket.path = *o.socket_path;
   }
   if (o.record_path) {
+    if (hasControlCharacter(*o.record_path))
+      throw ConfigError("--record: must be a path without control characters (got " +
+                        formats::quotedValue(*o.record_path) + ")");
     // A folder (DIR/ or an existing DIR) is recorded into, as DIR/gyro-<time>-<index>.csv.
     config.record.path = *o.record_path;
     if (!o.record_path->empty() && o.record_path->back() == '/') config.record.path += kDefaultRecordingName;
   }
   if (o.mock_speed) {
-    if (!(*o.mock_speed > 0.0 && *o.mock_speed <= 1000.0))
-      throw ConfigError("--mock-speed: must be > 0 and ≤ 1000 (got " + shortest(*o.mock_speed) + ")");
+    if (!(*o.mock_speed >= kMinMockSpeed && *o.mock_speed <= kMaxMockSpeed))
+      throw ConfigError("--mock-speed: must be between " + shortest(kMinMockSpeed) + " and " + shortest(kMaxMockSpeed) +
+                        " (got " + shortest(*o.mock_speed) + ")");
     config.mock.speed = *o.mock_speed;
   }
   if (o.log_level) config.log.level = *o.log_level;

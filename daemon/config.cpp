@@ -15,6 +15,7 @@
 #include "daemon/memory_budget.hpp"
 #include "daemon/sample_pipeline.hpp"
 #include "driver/mpu6050_config.hpp"
+#include "formats/input_file.hpp"
 #include "formats/model_toml.hpp"
 #include "formats/motion_spec.hpp"
 #include "formats/quoted_value.hpp"
@@ -244,6 +245,7 @@ void readSocket(const Section& s, SocketConfig& c) {
 
 void readRecord(const Section& s, RecordConfig& r) {
   if (auto v = s.string("path")) {
+    if (hasControlCharacter(*v)) s.failValue("path", "must be a path without control characters");
     if (!v->empty() && (v->back() == '/' || std::filesystem::path(*v).filename() == "."))
       s.failValue("path", "must name a file (e.g. /var/lib/gyrod/gyro.csv), not a directory");
     r.path = *v;
@@ -359,7 +361,9 @@ void readMock(const Section& s, MockConfig& m) {
     m.seed = static_cast<std::uint64_t>(*v);
   }
   if (auto v = s.number("speed")) {
-    if (!(*v > 0.0 && *v <= 1000.0)) s.failValue("speed", "must be > 0 and ≤ 1000 (1 = real time)");
+    if (!(*v >= kMinMockSpeed && *v <= kMaxMockSpeed))
+      s.failValue("speed", "must be between " + shortest(kMinMockSpeed) + " and " + shortest(kMaxMockSpeed) +
+                               " (1 = real time)");
     m.speed = *v;
   }
   readMockMotion(s, m);
@@ -463,7 +467,9 @@ void checkReferences(const Section& filter, const Section& socket, const Section
   if (config.device.backend == DeviceBackend::Mock && config.mock.source == MockSource::Replay) {
     double rate = 50.0;  // as the replay source assumes for a file without t
     try {
-      const recording::Recording rec = recording::readRecordingCsv(config.mock.replay_file);
+      recording::ReadOptions replay;
+      replay.input_kind = &formats::kReplayInput;
+      const recording::Recording rec = recording::readRecordingCsv(config.mock.replay_file, replay);
       if (rec.t.size() >= 2) rate = recording::sampleRateFromTimes(rec);
     } catch (const std::exception& e) {
       mock.failValue("replay_file", e.what());
@@ -536,6 +542,13 @@ GyrodConfig readConfig(const formats::TomlDocument& doc, ReferenceChecks checks)
 
 }  // namespace
 
+bool hasControlCharacter(std::string_view text) {
+  return std::any_of(text.begin(), text.end(), [](char c) {
+    const auto byte = static_cast<unsigned char>(c);
+    return byte < 0x20 || byte == 0x7f;
+  });
+}
+
 GyrodConfig parseConfig(std::string_view toml_text, const std::string& source_name, ReferenceChecks checks) {
   try {
     return readConfig(formats::TomlDocument(toml_text, source_name, formats::SyntaxErrorColumn::Shown), checks);
@@ -545,12 +558,13 @@ GyrodConfig parseConfig(std::string_view toml_text, const std::string& source_na
 }
 
 GyrodConfig loadConfigFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ConfigError(path + ": cannot open: " + std::strerror(errno));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw ConfigError(path + ": read error: " + std::strerror(errno));
-  return parseConfig(text.str(), path, ReferenceChecks::On);
+  std::string text;
+  try {
+    text = formats::readInputFile(path, formats::kConfigurationInput);
+  } catch (const formats::InputFileError& e) {
+    throw ConfigError(e.what());
+  }
+  return parseConfig(text, path, ReferenceChecks::On);
 }
 
 }  // namespace gyrod::daemon

@@ -136,11 +136,20 @@ struct MockFaults {
   bool operator==(const MockFaults&) const = default;
 };
 
+// A control character (C0 or DEL) in `text`: a path holding one (an escape sequence) would act on
+// the terminal of whoever reads gyrod's log, which names the recording's file.
+bool hasControlCharacter(std::string_view text);
+
+// mock.speed's range. Below the minimum the mock's virtual clock hardly moves: at 0.01 its
+// start-up (a few hundred ms of the chip's time) already takes most of a minute.
+inline constexpr double kMinMockSpeed = 0.01;
+inline constexpr double kMaxMockSpeed = 1000.0;
+
 struct MockConfig {
   MockSource source = MockSource::Simulator;
   std::string replay_file;  // recording CSV (t,gx,gy,gz,temp) when source = replay
   std::uint64_t seed = 1;
-  double speed = 1.0;  // 1 = real time; 10 = ten times faster
+  double speed = 1.0;  // 1 = real time; 10 = ten times faster (kMinMockSpeed .. kMaxMockSpeed)
   // The board's true rotation as a motion spec (formats/motion_spec.hpp: profiles such as
   // "constant:axis=z,rate=30,start=10", or a CSV t,wx,wy,wz); empty = at rest. Simulator only.
   std::string motion;

@@ -9,6 +9,7 @@
 #include "driver/mock/simulator_signal_source.hpp"
 #include "driver/mpu6050_config.hpp"
 #include "driver/polling_data_ready.hpp"
+#include "formats/input_file.hpp"
 #include "formats/model_toml.hpp"
 #include "formats/motion_spec.hpp"
 #include "formats/recording_csv.hpp"
@@ -31,7 +32,9 @@ int fsSelFor(int full_scale_dps) {
 // A recording at its own rate, held for internal/rate ticks per sample, so that the mock
 // (which ticks at the DLPF's internal rate) replays it at the recording's pace.
 std::unique_ptr<driver::SignalSource> replaySource(const std::string& path, int dlpf_cfg) {
-  const recording::Recording rec = recording::readRecordingCsv(path);
+  recording::ReadOptions replay;
+  replay.input_kind = &formats::kReplayInput;
+  const recording::Recording rec = recording::readRecordingCsv(path, replay);
   const double internal = driver::mpu6050::gyroOutputRateHz(dlpf_cfg);
   const double rate = rec.t.size() >= 2 ? recording::sampleRateFromTimes(rec) : 50.0;
   const double ratio = internal / rate;

@@ -14,8 +14,10 @@
 #include <sstream>
 #include <system_error>
 
+#include "daemon/command_line.hpp"
 #include "daemon/watchdog.hpp"
 #include "driver/counter_names.hpp"
+#include "driver/fifo_frame.hpp"
 #include "driver/mpu6050_config.hpp"
 #include "formats/calibration.hpp"
 #include "formats/model_toml.hpp"
@@ -26,8 +28,9 @@ namespace gyrod::daemon {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-// The accelerated mock's virtual clock is pumped from this real-time timer, in steps of
-// at most kMaxVirtualStepNs so that the FIFO (2.5 s at 50 Hz) never overflows in a step.
+// The accelerated mock's virtual clock is pumped from this real-time timer, in steps of at
+// most kMaxVirtualStepNs, and at most half of what the FIFO holds at the device's rate
+// (maxVirtualStepNs), so that the FIFO never overflows in a step.
 constexpr auto kPumpPeriod = std::chrono::milliseconds(10);
 constexpr std::int64_t kMaxVirtualStepNs = 200'000'000;
 // Real time one pump may spend before returning to the loop.
@@ -62,6 +65,18 @@ std::string loopSchedulingNote() {
   }
   return "SCHED_OTHER: when the CPUs are busy a sample can reach clients a scheduler tick late (1-10 ms); "
          "run gyrod SCHED_FIFO for sub-millisecond delivery (the systemd unit does; by hand: chrt -f 10 gyrod ...)";
+}
+
+// Half the time the FIFO takes to fill, or the host's queue of data-ready edges (16, as the
+// kernel's GPIO line-event FIFO) when that is shorter: 73 frames of 14 bytes are 73 ms at 1 kHz,
+// so a fixed step (200 ms, 2.5 s of FIFO at 50 Hz) overflowed the FIFO at every step, and an edge
+// queue that overflows leaves the driver without the edge that dates a new segment.
+std::int64_t maxVirtualStepNs(const driver::Mpu6050Config& chip) {
+  const auto fifo_frames = driver::mpu6050::fifo::kSize / driver::frameBytesFor(chip.accel);
+  const auto queued_edges = driver::MockMpu6050Config{}.data_ready_queue_depth;
+  const double samples = 0.5 * static_cast<double>(std::min(fifo_frames, queued_edges));
+  const double step_ns = samples / chip.sample_rate_hz * 1e9;
+  return std::max<std::int64_t>(1, std::min(kMaxVirtualStepNs, static_cast<std::int64_t>(step_ns)));
 }
 
 Vec3 modelBias(const std::string& path) {
@@ -102,9 +117,12 @@ LoadedRateModel Gyrod::loadRateModel(const GyrodConfig& c) {
   }
   try {
     processing::RateEstimatorParameters p = recording::rateEstimatorParameters(model);
-    if (std::fabs(p.rate_hz - c.device.rate_hz) > 1e-9 * c.device.rate_hz)
-      spdlog::warn("{}: model rate {} Hz, device {} Hz: the rate stream runs at the device's", f.model, p.rate_hz,
-                   c.device.rate_hz);
+    if (std::fabs(p.rate_hz - c.device.rate_hz) > 1e-9 * c.device.rate_hz) {
+      std::ostringstream warning;
+      warning << f.model << ": model rate " << p.rate_hz << " Hz, device " << c.device.rate_hz
+              << " Hz: the rate stream runs at the device's";
+      loaded.warning = warning.str();
+    }
     p.rate_hz = c.device.rate_hz;
     if (f.rate_low_pass_hz) p.low_pass_hz = *f.rate_low_pass_hz > 0.0 ? f.rate_low_pass_hz : std::nullopt;
     processing::validateRateEstimatorParameters(p);
@@ -150,9 +168,16 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
       device_(makeDeviceParts(config)),
       pipeline_(pipelineSettings(config, rate_model_)),
       noise_refit_(loop_, pipeline_, config.device.rate_hz, [this] { allan_reply_.invalidate(); }),
-      allan_reply_([this] { return allanReport(); }) {
+      allan_reply_([this] { return allanReport(); }),
+      reload_(
+          loop_, kReloadTimeLimit,
+          [file = config_file_, rate_hz = config.device.rate_hz] { return loadReload(file, rate_hz); },
+          [this](ReloadedFilter&& reloaded) { applyReload(std::move(reloaded)); },
+          [](const std::string& why) { spdlog::error("SIGHUP: keeping the running filter: {}", why); }) {
+  if (!rate_model_.warning.empty()) spdlog::warn("{}", rate_model_.warning);
   start_real_ns_ = monotonicNowNs();
   last_pump_real_ns_ = start_real_ns_;
+  max_virtual_step_ns_ = maxVirtualStepNs(device_.driver_config);
 
   SocketOptions socket_options;
   socket_options.path = config_.socket.path;
@@ -189,7 +214,10 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
 
   loop_.addSignals({SIGTERM, SIGINT, SIGHUP}, [this](int signal_number) {
     if (signal_number == SIGHUP) {
-      reload();
+      if (config_file_.empty())
+        spdlog::warn("SIGHUP: no configuration file was loaded, nothing to reload");
+      else
+        reload_.request();  // read and checked off the loop; applied here when ready
     } else {
       spdlog::info("{} received: stopping", signal_number == SIGTERM ? "SIGTERM" : "SIGINT");
       loop_.stop();
@@ -229,6 +257,10 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
                config_.device.rate_hz, config_.device.dlpf, config_.device.full_scale_dps,
                server_->socketPath().empty() ? std::string("(socket activation)") : server_->socketPath(),
                recorder_ ? ", recording to " + recorder_->currentFile() : std::string());
+  if (config_file_.empty())
+    spdlog::info("configuration: no file (no --config, and no {}): running on the defaults", kDefaultConfigPath);
+  else
+    spdlog::info("configuration: loaded from {}", config_file_);
   if (!device_.virtual_clock) spdlog::info("event loop scheduling: {}", loopSchedulingNote());
   spdlog::info("rate stream: {}", pipeline_.rateModel() == RateModel::SensorModel
                                       ? "raw - the bias of the sensor model " + config_.filter.model
@@ -293,7 +325,7 @@ void Gyrod::pumpVirtualClock() {
   }
   while (budget > 0) {
     if (monotonicNowNs() - now > kMaxPumpWorkNs) break;  // the rest of this slice is dropped
-    const std::int64_t step = std::min(budget, kMaxVirtualStepNs);
+    const std::int64_t step = std::min(budget, max_virtual_step_ns_);
     device_.virtual_clock->advanceNs(step);
     budget -= step;
     device_.mock->sync();
@@ -378,16 +410,21 @@ void Gyrod::petWatchdog() {
   if (watchdogPingDue(monotonicNowNs(), last_sample_real_ns_, watchdog_usec_)) ::sd_notify(0, "WATCHDOG=1");
 }
 
-void Gyrod::reload() {
-  if (config_file_.empty()) {
-    spdlog::warn("SIGHUP: no configuration file was loaded, nothing to reload");
-    return;
-  }
+// On the reload's thread: nothing here touches the running daemon.
+ReloadedFilter Gyrod::loadReload(const std::string& config_file, double device_rate_hz) {
+  GyrodConfig fresh = loadConfigFile(config_file);
+  fresh.device.rate_hz = device_rate_hz;  // [device] applies at restart
+  ReloadedFilter reloaded;
+  reloaded.rate_model = loadRateModel(fresh);
+  reloaded.filter = fresh.filter;
+  return reloaded;
+}
+
+void Gyrod::applyReload(ReloadedFilter&& reloaded) {
   try {
-    GyrodConfig fresh = loadConfigFile(config_file_);
-    fresh.device.rate_hz = config_.device.rate_hz;  // [device] applies at restart
-    const auto& f = fresh.filter;
-    LoadedRateModel rate_model = loadRateModel(fresh);  // before anything changes
+    const FilterConfig& f = reloaded.filter;
+    LoadedRateModel& rate_model = reloaded.rate_model;
+    if (!rate_model.warning.empty()) spdlog::warn("{}", rate_model.warning);
     pipeline_.reloadFilter(f.mean_window, f.mean_threshold_dps, {f.kalman.a, f.kalman.q, f.kalman.r});
     const bool new_rate_model = rate_model.identity != rate_model_.identity;
     if (new_rate_model) {

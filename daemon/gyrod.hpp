@@ -17,6 +17,7 @@
 #include "daemon/memory_budget.hpp"
 #include "daemon/noise_refit_worker.hpp"
 #include "daemon/recorder.hpp"
+#include "daemon/reload_worker.hpp"
 #include "daemon/sample_pipeline.hpp"
 #include "daemon/unix_socket_server.hpp"
 #include "driver/mpu6050_driver.hpp"
@@ -28,7 +29,17 @@ namespace gyrod::daemon {
 struct LoadedRateModel {
   std::optional<processing::RateEstimatorParameters> params;
   std::string identity;
+  std::string warning;  // for the log, written by the loop thread (the load may run on another)
 };
+
+// What a SIGHUP reads and checks off the loop: the [filter] section and its rate model.
+struct ReloadedFilter {
+  FilterConfig filter;
+  LoadedRateModel rate_model;
+};
+
+// How long a SIGHUP's reading and checking may take before it is abandoned.
+inline constexpr std::chrono::milliseconds kReloadTimeLimit{5000};
 
 class Gyrod final : public driver::SampleSink, public ServerContent {
  public:
@@ -59,7 +70,8 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   void serviceDriver();
   void rearmDriverTimer();
   void pumpVirtualClock();
-  void reload();
+  static ReloadedFilter loadReload(const std::string& config_file, double device_rate_hz);
+  void applyReload(ReloadedFilter&& reloaded);
   void petWatchdog();
   void notifyReadyOnce();
 
@@ -74,6 +86,7 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   AllanReplyCache allan_reply_;
   std::unique_ptr<UnixSocketServer> server_;
   std::unique_ptr<Recorder> recorder_;
+  ReloadWorker<ReloadedFilter> reload_;
   Fd driver_timer_;  // absolute CLOCK_MONOTONIC deadline of the driver (real-time clocks)
 
   std::int64_t start_real_ns_ = 0;
@@ -82,6 +95,7 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   std::uint64_t watchdog_usec_ = 0;
   bool ready_sent_ = false;
   bool pump_lagging_warned_ = false;
+  std::int64_t max_virtual_step_ns_ = 0;  // the accelerated mock's longest step of sensor time
   std::uint64_t samples_published_ = 0;
   std::uint64_t gaps_ = 0;
   std::uint64_t missing_samples_ = 0;

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "formats/input_file.hpp"
 #include "formats/toml_document.hpp"
 
 namespace gyrod::recording {
@@ -421,16 +422,7 @@ processing::SimulationModel parseModelToml(std::string_view text, const std::str
 processing::SimulationModel readModelToml(const std::string& path) { return readSensorModelToml(path).simulation; }
 
 SensorModel readSensorModelToml(const std::string& path) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) throw RecordingError(path + ": cannot open: " + std::strerror(errno));
-  std::string text;
-  char buf[65536];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
-  const bool failed = std::ferror(f);
-  std::fclose(f);
-  if (failed) throw RecordingError(path + ": cannot read");
-  return parseSensorModelToml(text, path);
+  return parseSensorModelToml(formats::readInputFile(path, formats::kModelInput), path);
 }
 
 namespace {

@@ -5,7 +5,6 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -13,6 +12,7 @@
 #include <vector>
 
 #include "formats/csv_fields.hpp"
+#include "formats/input_file.hpp"
 #include "formats/quoted_value.hpp"
 #include "formats/recording_csv.hpp"
 
@@ -239,8 +239,7 @@ MotionProfile parseMotionProfileText(std::string_view text) {
 }
 
 MotionProfile readMotionCsv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) failFile(path, 0, std::string("cannot open: ") + std::strerror(errno));
+  std::istringstream in(formats::readInputFile(path, formats::kMotionInput));
   std::vector<std::size_t> columns;
   std::vector<MotionPoint> points;
   std::size_t header_line = 0;
@@ -265,7 +264,6 @@ MotionProfile readMotionCsv(const std::string& path) {
       failFile(path, line_no, s.str());
     }
   }
-  if (in.bad()) failFile(path, 0, std::string("read error: ") + std::strerror(errno));
   if (columns.empty()) failFile(path, 0, "empty file: no header t,wx,wy,wz and no rows");
   if (points.empty()) failFile(path, header_line, "no rows after the header");
   return MotionProfile::table(std::move(points));

@@ -1,5 +1,7 @@
 #include "formats/recording_csv.hpp"
 
+#include "formats/input_file.hpp"
+
 #include <algorithm>
 #include <array>
 #include <barrier>
@@ -451,8 +453,8 @@ Recording parseRecordingFile(std::FILE* file, const std::string& path, const Rea
 }  // namespace
 
 Recording readRecordingCsv(const std::string& path, const ReadOptions& options) {
-  const std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
-  if (!file) fail(path, 0, std::string("cannot open: ") + std::strerror(errno));
+  const formats::InputFile file =
+      formats::openInputFile(path, options.input_kind ? *options.input_kind : formats::kRecordingInput);
   return parseRecordingFile(file.get(), path, options);
 }
 

@@ -20,6 +20,10 @@
 
 #include "formats/recording_format.hpp"
 
+namespace gyrod::formats {
+struct InputKind;  // formats/input_file.hpp
+}
+
 namespace gyrod::recording {
 
 // A problem with an input file, already phrased for the user: "FILE:LINE: cause".
@@ -80,10 +84,13 @@ struct ReadOptions {
   bool line_numbers = true;
   // Called every kProgressLines lines with the lines and bytes read so far.
   std::function<void(std::size_t lines, std::uint64_t bytes)> progress;
+  // What the file is read as (its size limit, formats/input_file.hpp); null: a recording
+  // (formats::kRecordingInput).
+  const formats::InputKind* input_kind = nullptr;
 };
 
 // Reads and validates the whole file in one pass (numbers by std::from_chars, no allocation
-// per line). Throws RecordingError naming file, line and cause.
+// per line), opened by formats::openInputFile. Throws RecordingError naming file, line and cause.
 Recording readRecordingCsv(const std::string& path, const ReadOptions& options = {});
 // The same from a stream already open; `path` names it in messages and in Recording::path.
 Recording parseRecordingCsv(std::istream& in, const std::string& path);

@@ -2,10 +2,11 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <vector>
 
+#include "formats/input_file.hpp"
 #include "formats/recording_csv.hpp"
 #include "formats/toml_document.hpp"
 
@@ -96,11 +97,14 @@ AcquisitionHeader parseAcquisitionHeader(std::string_view text, const std::strin
 }
 
 AcquisitionHeader readAcquisitionHeader(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return {};
+  formats::InputFile in;
+  try {
+    in = formats::openInputFile(path, formats::kRecordingInput);
+  } catch (const formats::InputFileError&) {
+    return {};  // the reading of the recording itself says why
+  }
   std::string text(kMaxHeaderRead, '\0');
-  in.read(text.data(), static_cast<std::streamsize>(text.size()));
-  text.resize(static_cast<std::size_t>(in.gcount()));
+  text.resize(std::fread(text.data(), 1, text.size(), in.get()));
   // Only whole lines: a comment cut at the end of the buffer is not parsed.
   const std::size_t last = text.rfind('\n');
   if (text.size() == kMaxHeaderRead && last != std::string::npos) text.resize(last + 1);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -151,6 +152,7 @@ std::string watchLine(bool enable, std::uint32_t decimate) {
 
 std::string_view errorCodeName(ErrorCode code) {
   switch (code) {
+    case ErrorCode::BadRequest: return "bad_request";
     case ErrorCode::NotJson: return "not_json";
     case ErrorCode::NotObject: return "not_object";
     case ErrorCode::MissingField: return "missing_field";
@@ -316,7 +318,32 @@ std::string requestLine(const Request& request) {
   return R"({"cmd":"status"})";
 }
 
+namespace {
+
+// A client's string in a message, as a JSON string: an escaped NUL ("\u0000") decodes to a NUL
+// byte, which would end the message (exceptions carry C strings), and other control bytes
+// would reach the client's terminal.
+std::string quotedText(const std::string& text) {
+  return json(text).dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+}  // namespace
+
 Request parseRequest(std::string_view line) {
+  // The JSON parser takes a NUL for the end of its input: `{"cmd":"status"}\0garbage` would be
+  // answered as a status request, and whatever follows the NUL silently dropped. A request is
+  // text: a control byte anywhere (tab and carriage return, JSON whitespace, excepted) refuses
+  // the whole line.
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const auto byte = static_cast<unsigned char>(line[i]);
+    if ((byte < 0x20 && byte != '\t' && byte != '\r') || byte == 0x7f) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "0x%02X", byte);
+      throw ProtocolError(ErrorCode::BadRequest, std::string("control byte ") + hex + " at byte " +
+                                                     std::to_string(i + 1) +
+                                                     " of the line: a request is one line of JSON text");
+    }
+  }
   // JSON parsers keep the last of two equal keys; a request naming "cmd" twice is ambiguous,
   // so the first repeated key of the request object is noted and the request refused.
   std::vector<std::string> keys;
@@ -334,7 +361,7 @@ Request parseRequest(std::string_view line) {
   const json j = json::parse(line.begin(), line.end(), noteDuplicateKeys, /*allow_exceptions=*/false);
   if (j.is_discarded()) throw ProtocolError(ErrorCode::NotJson, "the line is not valid JSON");
   if (duplicate && j.is_object())
-    throw ProtocolError(ErrorCode::DuplicateField, "field \"" + *duplicate + "\" appears more than once");
+    throw ProtocolError(ErrorCode::DuplicateField, "field " + quotedText(*duplicate) + " appears more than once");
   if (!j.is_object())
     throw ProtocolError(ErrorCode::NotObject, std::string("expected a JSON object, got ") + jsonTypeName(j));
   const auto cmd_it = j.find("cmd");
@@ -347,7 +374,8 @@ Request parseRequest(std::string_view line) {
     for (auto it = j.begin(); it != j.end(); ++it) {
       bool known = it.key() == "cmd";
       for (const auto a : allowed) known = known || it.key() == a;
-      if (!known) throw ProtocolError(ErrorCode::UnknownField, "\"" + cmd + "\" takes no field \"" + it.key() + "\"");
+      if (!known)
+        throw ProtocolError(ErrorCode::UnknownField, quotedText(cmd) + " takes no field " + quotedText(it.key()));
     }
   };
 
@@ -382,7 +410,7 @@ Request parseRequest(std::string_view line) {
     rejectOtherFields({});
     return StatusRequest{};
   }
-  throw ProtocolError(ErrorCode::UnknownCommand, "unknown cmd \"" + cmd + "\" (known: watch, allan, status)");
+  throw ProtocolError(ErrorCode::UnknownCommand, "unknown cmd " + quotedText(cmd) + " (known: watch, allan, status)");
 }
 
 }  // namespace gyrod::protocol

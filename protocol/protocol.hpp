@@ -23,7 +23,7 @@
 namespace gyrod::protocol {
 
 inline constexpr int kProtocolMajor = 1;  // incompatible changes
-inline constexpr int kProtocolMinor = 3;  // compatible additions (new classes, new fields)
+inline constexpr int kProtocolMinor = 4;  // compatible additions (new classes, new fields)
 
 // A client line longer than this (not counting the '\n' and an optional '\r') is refused
 // with an ERROR and the client is disconnected.
@@ -87,6 +87,7 @@ std::string watchLine(bool enable, std::uint32_t decimate);
 
 // What ERROR lines name as the problem ("code" field).
 enum class ErrorCode {
+  BadRequest,      // the line holds a control byte (NUL, ESC, ...): refused whole, never cut there
   NotJson,         // the line does not parse as JSON
   NotObject,       // JSON, but not an object
   MissingField,    // a required field is absent ("cmd")

@@ -35,7 +35,7 @@ TEST_F(ServerTest, VersionOnConnect) {
   TestClient c(socketPath());
   const json v = c.readObject(loop_);
   EXPECT_EQ(v, json::parse(std::string(R"({"class":"VERSION","release":")") + GYROD_RELEASE +
-                           R"(","proto_major":1,"proto_minor":3})"));
+                           R"(","proto_major":1,"proto_minor":4})"));
   EXPECT_EQ(server_->clientCount(), 1u);
 }
 
@@ -189,6 +189,26 @@ TEST_F(ServerTest, BadRequestsGetNamedErrorsAndTheClientStays) {
   EXPECT_EQ(s["class"], "STATUS");
   EXPECT_EQ(s["client_list"][0]["watch"], false);
   EXPECT_EQ(server_->clientCount(), 1u);
+}
+
+// The rest of a line after a NUL is never read as another request: the whole line is one
+// bad_request error, and the watch it held is not turned on.
+TEST_F(ServerTest, ALineWithANulIsOneBadRequestAndNothingElse) {
+  using namespace std::string_literals;
+  startServer();
+  auto c = connect();
+  c->send("{\"cmd\":\"status\"}\0garbage\n"s + "{\"cmd\":\"watch\",\"enable\":false}\0{\"cmd\":\"watch\"}\n"s);
+  const auto replies = c->readLines(loop_, 2);
+  ASSERT_EQ(replies.size(), 2u);
+  for (const auto& reply : replies) {
+    const json e = parse(reply);
+    EXPECT_EQ(e["class"], "ERROR") << reply;
+    EXPECT_EQ(e["code"], "bad_request") << reply;
+  }
+  c->send("{\"cmd\":\"status\"}\n");
+  const json s = c->readObject(loop_);
+  EXPECT_EQ(s["class"], "STATUS");
+  EXPECT_EQ(s["client_list"][0]["watch"], false);
 }
 
 TEST_F(ServerTest, LineOfExactlyTheLimitIsServed) {

@@ -357,7 +357,11 @@ TEST(ConfigErrors, OutOfRangeNamesKeyRangeAndValue) {
       errorOf("[log]\nlevel = \"verbose\"\n"),
       "x.toml:2: key 'log.level': must be one of trace, debug, info, warn, error, critical, off (got \"verbose\")");
   EXPECT_EQ(errorOf("[mock]\nspeed = 0\n"),
-            "x.toml:2: key 'mock.speed': must be > 0 and ≤ 1000 (1 = real time) (got 0)");
+            "x.toml:2: key 'mock.speed': must be between 0.01 and 1000 (1 = real time) (got 0)");
+  EXPECT_EQ(errorOf("[record]\npath = \"/tmp/\\u001b[2Jrec.csv\"\n"),
+            "x.toml:2: key 'record.path': must be a path without control characters (got '/tmp/\\x1B[2Jrec.csv')");
+  EXPECT_EQ(errorOf("[mock]\nspeed = 1e-320\n"),
+            "x.toml:2: key 'mock.speed': must be between 0.01 and 1000 (1 = real time) (got 1e-320)");
   EXPECT_EQ(errorOf("[mock.faults]\ntransfer_error_fraction = 1.5\n"),
             "x.toml:2: key 'mock.faults.transfer_error_fraction': must be between 0 and 1 (got 1.5)");
   EXPECT_EQ(errorOf("[mock.faults]\nfifo_overflow_at_s = [1,\n -2]\n"),
@@ -471,7 +475,11 @@ TEST(CommandLine, BadUsageExitsWith64AndSaysWhy) {
   EXPECT_NE(bad_backend.message.find("spi"), std::string::npos) << bad_backend.message;
   const auto bad_speed = parseArgs({"--mock-speed", "-1"}, none);
   EXPECT_EQ(bad_speed.exit_code, 64);
-  EXPECT_EQ(bad_speed.message, "--mock-speed: must be > 0 and ≤ 1000 (got -1)\n");
+  EXPECT_EQ(bad_speed.message, "--mock-speed: must be between 0.01 and 1000 (got -1)\n");
+  EXPECT_EQ(parseArgs({"--record", "/tmp/\x1b[2Jrec.csv"}, none).message,
+            "--record: must be a path without control characters (got '/tmp/\\x1B[2Jrec.csv')\n");
+  EXPECT_EQ(parseArgs({"--mock-speed", "1e-320"}, none).message,
+            "--mock-speed: must be between 0.01 and 1000 (got 1e-320)\n");
   const auto bad_level = parseArgs({"--log-level", "loud"}, none);
   EXPECT_EQ(bad_level.exit_code, 64);
   const auto help = parseArgs({"--help"}, none);

@@ -119,14 +119,17 @@ TEST(GyrodLimits, AFailedAllocationIsOneLineAndExit71NotACrash) {
     GTEST_SKIP() << "emulator gap: under qemu-user RLIMIT_AS limits the emulator's own address space, not the "
                     "guest's (the limit is checked natively)";
   ScratchDir d;
-  // A 100 MB configuration file cannot be read into 120 MB of address space (the text and its copy).
-  std::string text = "[device]\nbackend = \"mock\"\n";
+  // A 100 MB motion CSV (within the 256 MiB a motion CSV may hold) cannot be read into 120 MB of
+  // address space (the text and its copy).
+  std::string text = "t,wx,wy,wz\n";
   const std::string comment = "#" + std::string(999, 'x') + "\n";
   text.reserve(text.size() + 100000 * comment.size());
   for (int i = 0; i < 100000; ++i) text += comment;
-  const auto cfg = d.write("big.toml", text);
+  const auto motion = d.write("motion.csv", text);
   text.clear();
   text.shrink_to_fit();
+  const auto cfg =
+      d.write("gyrod.toml", "[device]\nbackend = \"mock\"\n[mock]\nmotion = \"" + motion.string() + "\"\n");
   GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt", limitAddressSpaceTo120Mb);
   EXPECT_EQ(gyrod.waitExit(10000ms), std::optional<int>(71));
   const std::string log = readWholeFile(d.path() / "log.txt");

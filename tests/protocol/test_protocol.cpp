@@ -163,7 +163,7 @@ TEST(ProtocolGap, FormatsAndRejectsMalformedGaps) {
 TEST(ProtocolReplies, VersionAndWatch) {
   const std::string v = versionLine("1.2.3");
   ASSERT_EQ(v.back(), '\n');
-  EXPECT_EQ(json::parse(v), json::parse(R"({"class":"VERSION","release":"1.2.3","proto_major":1,"proto_minor":3})"));
+  EXPECT_EQ(json::parse(v), json::parse(R"({"class":"VERSION","release":"1.2.3","proto_major":1,"proto_minor":4})"));
   EXPECT_EQ(json::parse(watchLine(false, 5)), json::parse(R"({"class":"WATCH","enable":false,"decimate":5})"));
 }
 
@@ -286,6 +286,39 @@ TEST(ProtocolRequests, EachProblemIsNamed) {
       EXPECT_EQ(e.code(), c.code) << c.line << ": " << e.what();
       EXPECT_NE(std::string(e.what()).find(c.message_part), std::string::npos) << c.line << ": " << e.what();
     }
+  }
+}
+
+// A NUL ends the JSON parser's input: without the check, `{"cmd":"status"}\0garbage` would be
+// a status request. Every control byte refuses the whole line; an escaped one in a string is
+// quoted back escaped, never cut.
+TEST(ProtocolRequests, ControlBytesRefuseTheWholeLine) {
+  using namespace std::string_literals;
+  const std::pair<std::string, std::string> cases[] = {
+      {"{\"cmd\":\"status\"}\0garbage"s, "control byte 0x00 at byte 17"},
+      {"{\"cmd\":\"watch\",\"enable\":false}\0{\"cmd\":\"watch\"}"s, "control byte 0x00 at byte 31"},
+      {"{\"cmd\":\"status\x1b[2J\"}"s, "control byte 0x1B"},
+      {"\x7f{\"cmd\":\"status\"}"s, "control byte 0x7F at byte 1"},
+      {"{\"cmd\":\n\"allan\"}"s, "control byte 0x0A"},
+  };
+  for (const auto& [line, message_part] : cases) {
+    try {
+      parseRequest(line);
+      ADD_FAILURE() << line << " was accepted";
+    } catch (const ProtocolError& e) {
+      EXPECT_EQ(e.code(), ErrorCode::BadRequest) << e.what();
+      EXPECT_NE(std::string(e.what()).find(message_part), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(errorCodeName(ErrorCode::BadRequest), "bad_request");
+  // Tab and carriage return are JSON whitespace.
+  EXPECT_TRUE(std::holds_alternative<StatusRequest>(parseRequest("{\t\"cmd\":\"status\"}\r")));
+  try {
+    parseRequest(R"({"cmd":"bogus\u0000x"})");
+    ADD_FAILURE() << "an escaped NUL in cmd was accepted";
+  } catch (const ProtocolError& e) {
+    EXPECT_EQ(e.code(), ErrorCode::UnknownCommand);
+    EXPECT_EQ(std::string(e.what()), R"(unknown cmd "bogus\u0000x" (known: watch, allan, status))");
   }
 }
 

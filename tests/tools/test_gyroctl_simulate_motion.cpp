@@ -167,8 +167,11 @@ TEST(GyroctlSimulateMotion, BadSpecsExitTwoNamingTheProblem) {
   for (const auto& [spec, message] : cases) {
     const auto r = runGyroctl("simulate --arw 1 --duration 1 --motion '" + spec + "' -o " + out, d.path());
     // A spec that is not one is a bad option value (EX_USAGE); a motion file that cannot be
-    // used, missing included (formats reports it as a bad recording), is EX_DATAERR.
-    EXPECT_EQ(r.exit_status, spec.find(".csv") == std::string::npos ? 64 : 65) << spec;
+    // used is EX_DATAERR, one that is missing EX_NOINPUT.
+    const int expected = spec.find(".csv") == std::string::npos       ? 64
+                         : spec.find("none.csv") != std::string::npos ? 66
+                                                                      : 65;
+    EXPECT_EQ(r.exit_status, expected) << spec;
     EXPECT_NE(r.err.find(message), std::string::npos) << spec << ": " << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
     EXPECT_FALSE(std::filesystem::exists(out)) << spec;

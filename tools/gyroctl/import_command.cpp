@@ -5,12 +5,13 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
 #include "formats/imucal_recording.hpp"
+#include "formats/input_file.hpp"
 #include "formats/output_file.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
@@ -30,9 +31,7 @@ int runImport(const ImportOptions& opt) {
   if (opt.format != "auto" && opt.format != "imucal")
     throw std::invalid_argument("--format '" + opt.format + "': known formats are imucal (or auto)");
   formats::checkOutputTarget(opt.output, {opt.file});  // before the work, and again when writing
-  requireNotADirectory(opt.file);
-  std::ifstream in(opt.file);
-  if (!in) throw recording::RecordingError(opt.file + ": cannot open: " + std::strerror(errno));
+  std::istringstream in(formats::readInputFile(opt.file, formats::kImportInput));
   const auto converted = recording::convertImucal(in, opt.file, opt.fs_sel, opt.afs_sel);
   formats::writeFileAtomically(opt.output, converted.csv, {opt.file});
   std::fprintf(stderr, "imported %zu samples at %g Hz (FS_SEL %d, %g LSB per deg/s", converted.samples,

@@ -22,7 +22,6 @@ LoadedInput loadInput(const std::string& path, std::optional<double> rate_hz, co
     s << "--rate " << *rate_hz << ": the sample rate must be a positive number of Hz";
     throw std::invalid_argument(s.str());
   }
-  requireNotADirectory(path);
   in.recording = recording::readRecordingCsv(path, read);
   const auto& rec = in.recording;
   if (!rec.t.empty()) {
@@ -74,14 +73,6 @@ std::function<void(std::size_t, std::uint64_t)> readingProgress(const std::strin
     else
       std::fprintf(stderr, "\rreading %s: %.1f M lines\033[K", path.c_str(), static_cast<double>(lines) / 1e6);
   };
-}
-
-void requireNotADirectory(const std::string& path) {
-  struct stat st {};
-  // A file that is not there or not readable is "no input" (66), not a malformed one (65).
-  if (::stat(path.c_str(), &st) != 0 || ::access(path.c_str(), R_OK) != 0)
-    throw ExitError(ExitCode::NoInput, path + ": cannot open: " + std::strerror(errno));
-  if (S_ISDIR(st.st_mode)) throw ExitError(ExitCode::NoInput, path + ": cannot read: it is a directory, not a file");
 }
 
 }  // namespace gyrod::gyroctl

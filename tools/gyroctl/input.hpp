@@ -31,9 +31,4 @@ bool stderrIsTerminal();
 // a terminal.
 std::function<void(std::size_t, std::uint64_t)> readingProgress(const std::string& path);
 
-// Refuses a directory as an input file, saying so (reading one would look like an empty
-// file), and a file that does not exist or cannot be read: ExitError with ExitCode::NoInput.
-// FIFOs and devices stay readable: `analyze /dev/stdin` works.
-void requireNotADirectory(const std::string& path);
-
 }  // namespace gyrod::gyroctl

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "formats/edit_distance.hpp"
+#include "formats/input_file.hpp"
 #include "formats/output_file.hpp"
 #include "formats/recording_csv.hpp"
 #include "formats/toml_document.hpp"
@@ -59,6 +60,8 @@ int reportError() {
     throw;
   } catch (const ExitError& e) {
     return fail(e.code(), e);
+  } catch (const gyrod::formats::InputFileError& e) {  // missing, unreadable, not a file, or too large
+    return fail(e.unreadable() ? ExitCode::NoInput : ExitCode::DataError, e);
   } catch (const gyrod::recording::RecordingError& e) {  // a recording that cannot be used
     return fail(ExitCode::DataError, e);
   } catch (const gyrod::formats::TomlError& e) {  // a model or motion file that cannot be used
