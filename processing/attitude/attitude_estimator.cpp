@@ -38,6 +38,7 @@ AttitudeEstimator::AttitudeEstimator(const AttitudeParameters& params) : p_(para
   dt_ = 1.0 / p_.rate_hz;
   rest_alpha_ = 1.0 - std::exp(-dt_ / kRestLowpassTimeConstantS);
   rest_bias_alpha_ = 1.0 - std::exp(-dt_ / p_.rest_bias_time_constant_s);
+  rest_bias_variance_alpha_ = 1.0 - std::exp(-2.0 * dt_ / p_.rest_bias_time_constant_s);
   // Bilinear transform of the analog Butterworth pair at fc = √2/(2π·τ).
   const double fc = std::sqrt(2.0) / (2.0 * kPi * p_.accel_time_constant_s);
   const double c = std::tan(kPi * fc * dt_);
@@ -158,8 +159,8 @@ AttitudeSample AttitudeEstimator::update(const Vector3& rate_dps, const Vector3&
   const double arw = p_.gyro_angle_random_walk_dps_per_sqrt_hz * kDegToRad;
   const double rrw = p_.gyro_rate_random_walk_dps_per_sqrt_s * kDegToRad;
   if (p_.estimate_bias) {
-    if (rest_)
-      bias_variance_ += rest_bias_alpha_ * (bias_variance_rest_ - bias_variance_);
+    if (rest_)  // the rest mean's error decays as e^{−t/T_rest}, its variance at twice that rate
+      bias_variance_ += rest_bias_variance_alpha_ * (bias_variance_rest_ - bias_variance_);
     else
       bias_variance_ += rrw * rrw * dt_;
   }

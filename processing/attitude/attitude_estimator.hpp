@@ -38,7 +38,7 @@
 //     gyro angle random walk N_g through its complement, a residual bias σ_b for τ;
 //   heading σ² = N_g²·t + (∫σ_b dt)²: the angle random walk and the residual bias (fully
 //     correlated in time) integrated from the start; σ_b² starts at initial_bias_std_dps²,
-//     relaxes to N_g²/(2·T_rest) at rest and grows by K_g²·Δt (rate random walk) otherwise.
+//     relaxes to N_g²/(2·T_rest) at rest (as e^{−2t/T_rest}) and grows by K_g²·Δt (rate random walk) otherwise.
 //
 // update() allocates nothing and is O(1).
 #include <cstddef>
@@ -92,9 +92,10 @@ class AttitudeEstimator {
 
   AttitudeParameters p_;
   double dt_ = 0.0;
-  double rest_alpha_ = 0.0;          // the 0.5 s low-pass of the rest test
-  double rest_bias_alpha_ = 0.0;     // Δt/T_rest as a first-order step
-  double bias_variance_rest_ = 0.0;  // σ_b² that the rest mean reaches, (rad/s)²
+  double rest_alpha_ = 0.0;                // the 0.5 s low-pass of the rest test
+  double rest_bias_alpha_ = 0.0;           // Δt/T_rest as a first-order step
+  double rest_bias_variance_alpha_ = 0.0;  // the same for σ_b², 2Δt/T_rest
+  double bias_variance_rest_ = 0.0;        // σ_b² that the rest mean reaches, (rad/s)²
   Quaternion q_gyro_{kIdentityQuaternion};
   Quaternion q_correction_{kIdentityQuaternion};
   // The Butterworth low-pass: coefficients and, per axis, the transposed direct form II state.
