@@ -71,8 +71,8 @@ void AttitudeEstimator::reset() {
   heading_bias_drift_ = 0.0;
 }
 
-// The rest test: every component of the rate and of the accel within its bound of its 0.5 s
-// low-pass, for rest_duration_s without a break.
+// The rest test: the rate and the accel within their bounds of their 0.5 s low-pass and that
+// low-passed rate below bias_limit_dps, for rest_duration_s without a break.
 void AttitudeEstimator::updateRest(const Vector3& rate_dps, const Vector3& accel_g) {
   if (!started_) {
     rest_rate_mean_ = rate_dps;
@@ -85,7 +85,12 @@ void AttitudeEstimator::updateRest(const Vector3& rate_dps, const Vector3& accel
     rate_dev2 += (rate_dps[i] - rest_rate_mean_[i]) * (rate_dps[i] - rest_rate_mean_[i]);
     accel_dev2 += (accel_g[i] - rest_accel_mean_[i]) * (accel_g[i] - rest_accel_mean_[i]);
   }
-  const bool quiet = rate_dev2 < p_.rest_gyro_deviation_dps * p_.rest_gyro_deviation_dps &&
+  // A steady turn passes the deviation tests; a mean rate beyond any bias the estimator accepts
+  // is motion.
+  const double mean_rate2 = rest_rate_mean_[0] * rest_rate_mean_[0] + rest_rate_mean_[1] * rest_rate_mean_[1] +
+                            rest_rate_mean_[2] * rest_rate_mean_[2];
+  const bool quiet = mean_rate2 < p_.bias_limit_dps * p_.bias_limit_dps &&
+                     rate_dev2 < p_.rest_gyro_deviation_dps * p_.rest_gyro_deviation_dps &&
                      accel_dev2 < p_.rest_accel_deviation_g * p_.rest_accel_deviation_g;
   rest_time_s_ = quiet ? rest_time_s_ + dt_ : 0.0;
   rest_ = rest_time_s_ >= p_.rest_duration_s;

@@ -21,8 +21,9 @@
 // stays put in that frame.
 //
 // The gyro bias b̂ (sensor frame), when estimate_bias is set:
-//   at rest (the rate and the accel stay within rest_* of their 0.5 s low-pass for
-//   rest_duration_s): b̂ ← b̂ + (ω − b̂)·Δt/T_rest, the rest mean of the raw rate;
+//   at rest (the rate and the accel stay within rest_* of their 0.5 s low-pass, and that
+//   low-passed rate below bias_limit_dps, for rest_duration_s; a steady turn slower than
+//   bias_limit_dps is taken for rest and learned as bias): b̂ ← b̂ + (ω − b̂)·Δt/T_rest, the rest mean of the raw rate;
 //   in motion: a residual bias e turns q_g by R(q)·e·Δt a step, which the inclination correction
 //   undoes about the horizontal axes: the correction's rotation vector c (world, z = 0)
 //   estimates −R(q)·e·Δt, so b̂ ← b̂ − w·R(q)ᵀ·c/T_motion: an integral term that learns the

@@ -211,7 +211,7 @@ TEST(AttitudeEstimator, BroadTrialsWithinTheirBounds) {
   };
   for (const Bound& b : {Bound{"09_undisturbed_fast_rotation_with_breaks_B", 1.2, 1.0},
                          Bound{"14_undisturbed_slow_translation_with_breaks_B", 0.6, 0.6}}) {
-    const gyrod::broad::Trial trial = gyrod::broad::readTrial(std::string(GYROD_TEST_DATA_DIR) + "/broad", b.name);
+    const gyrod::broad::Trial trial = gyrod::broad::readTrial(GYROD_TEST_DATA_DIR "/broad", b.name);
     const gyrod::broad::TrialErrors e = gyrod::broad::broadErrors(gyrod::broad::estimateTrial(trial, {}), trial);
     AttitudeParameters no_bias;
     no_bias.estimate_bias = false;
