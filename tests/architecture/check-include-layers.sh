@@ -16,6 +16,7 @@ declare -A allowed=(
   [processing/simulation]="processing/simulation processing/base"
   [processing/motion]="processing/motion processing/paper processing/allan processing/simulation processing/base"
   [processing/model_check]="processing/model_check processing/paper processing/allan processing/simulation processing/base"
+  [processing/attitude]="processing/attitude processing/base"
   [processing]="processing"
   [formats]="formats processing"
   [protocol]="protocol processing"

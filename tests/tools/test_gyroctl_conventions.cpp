@@ -72,9 +72,10 @@ TEST(GyroctlConventions, AWordFarFromEveryCommandGetsNoSuggestionButTheList) {
   ScratchDir d;
   const auto r = runGyroctl("--json frobnicate", d.path());
   EXPECT_EQ(r.exit_status, 64);
-  EXPECT_EQ(r.err,
-            "gyroctl: unknown command 'frobnicate' (commands: analyze, filter, import, simulate, watch, allan, "
-            "status, model-check)\n");
+  EXPECT_EQ(
+      r.err,
+      "gyroctl: unknown command 'frobnicate' (commands: analyze, filter, attitude, import, simulate, watch, allan, "
+      "status, model-check)\n");
 }
 
 TEST(GyroctlConventions, AKnownCommandStillParsesItsOwnOptions) {

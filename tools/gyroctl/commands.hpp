@@ -18,6 +18,7 @@ inline constexpr int kExitFailure = toInt(ExitCode::Failure);  // anything else
 
 void addAnalyzeCommand(CLI::App& app, CommandRunner& run);
 void addFilterCommand(CLI::App& app, CommandRunner& run);
+void addAttitudeCommand(CLI::App& app, CommandRunner& run);
 void addImportCommand(CLI::App& app, CommandRunner& run);
 void addSimulateCommand(CLI::App& app, CommandRunner& run);
 // watch, allan, status: talk to a running gyrod over its socket.

@@ -87,6 +87,7 @@ int main(int argc, char** argv) {
   CommandRunner run;
   addAnalyzeCommand(app, run);
   addFilterCommand(app, run);
+  addAttitudeCommand(app, run);
   addImportCommand(app, run);
   addSimulateCommand(app, run);
   addClientCommands(app, run);
