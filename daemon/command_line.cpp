@@ -27,8 +27,7 @@ void applyOverrides(GyrodConfig& config, const CommandLineOverrides& o) {
   }
   if (o.record_path) {
     // A folder (DIR/ or an existing DIR) is recorded into, as DIR/gyro-<time>-<index>.csv.
-    config.record.path = *o.record_path;
-    if (!o.record_path->empty() && o.record_path->back() == '/') config.record.path += kDefaultRecordingName;
+    config.record.path = recordingBaseName(*o.record_path);
   }
   if (o.mock_speed) {
     if (!(*o.mock_speed > 0.0 && *o.mock_speed <= 1000.0))

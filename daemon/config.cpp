@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "daemon/memory_budget.hpp"
+#include "daemon/recorder.hpp"
 #include "daemon/sample_pipeline.hpp"
 #include "driver/mpu6050_config.hpp"
 #include "formats/model_toml.hpp"
@@ -243,11 +244,7 @@ void readSocket(const Section& s, SocketConfig& c) {
 }
 
 void readRecord(const Section& s, RecordConfig& r) {
-  if (auto v = s.string("path")) {
-    if (!v->empty() && (v->back() == '/' || std::filesystem::path(*v).filename() == "."))
-      s.failValue("path", "must name a file (e.g. /var/lib/gyrod/gyro.csv), not a directory");
-    r.path = *v;
-  }
+  if (auto v = s.string("path")) r.path = recordingBaseName(*v);
   if (auto v = s.number("rotate_mb")) {
     if (!(*v == 0.0 || *v >= 0.01)) s.failValue("rotate_mb", "must be 0 (never) or ≥ 0.01 MB");
     r.rotate_mb = *v;
@@ -427,6 +424,11 @@ std::string_view toString(BiasSource s) {
   return kBiasSourceNames[s == BiasSource::Estimate ? 0 : s == BiasSource::Model ? 1 : 2];
 }
 std::string_view toString(MockSource s) { return kMockSourceNames[s == MockSource::Simulator ? 0 : 1]; }
+
+std::string recordingBaseName(const std::string& setting) {
+  if (!setting.empty() && setting.back() == '/') return setting + kDefaultRecordingName;
+  return setting;
+}
 
 std::string i2cDevicePath(std::string_view bus) {
   if (isAllDigits(bus) && bus.size() <= 6) return "/dev/i2c-" + std::to_string(std::stoul(std::string(bus)));
