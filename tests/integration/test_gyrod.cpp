@@ -231,6 +231,31 @@ TEST(Gyrod, StalledClientIsDroppedAndTheOthersReceiveEverything) {
   EXPECT_GE(status["clients_dropped"].get<int>(), 1) << status.dump();
 }
 
+// STATUS device_retrying: false from a fresh start, both while the device is brought up and
+// once it streams; nothing is being retried.
+TEST(Gyrod, AFreshStartIsNotRetrying) {
+  ScratchDir d;
+  const auto cfg = d.write("gyrod.toml", mockConfig(d.path(), 10.0));
+  GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt");
+  const std::string sock = (d.path() / "gyrod.sock").string();
+  LineClient asker(sock);
+  ASSERT_TRUE(asker.connected());
+  ASSERT_TRUE(asker.readLine());
+  asker.send("{\"cmd\":\"status\"}\n");
+  const json early = json::parse(*asker.readLine());
+  EXPECT_EQ(early["device_retrying"], false) << early.dump();
+  LineClient w(sock);
+  startWatching(w);
+  if (HasFatalFailure()) return;
+  ASSERT_EQ(readRates(w, 5).rates.size(), 5u);
+  asker.send("{\"cmd\":\"status\"}\n");
+  const json streaming = json::parse(*asker.readLine());
+  EXPECT_EQ(streaming["device_state"], "streaming") << streaming.dump();
+  EXPECT_EQ(streaming["device_retrying"], false) << streaming.dump();
+  gyrod.signal(SIGINT);
+  EXPECT_EQ(gyrod.waitExit(1000ms), std::optional<int>(0));
+}
+
 TEST(Gyrod, MalformedAndOversizedClientLines) {
   ScratchDir d;
   const auto cfg = d.write("gyrod.toml", mockConfig(d.path(), 10.0));
