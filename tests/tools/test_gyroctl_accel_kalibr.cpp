@@ -110,8 +110,10 @@ TEST(GyroctlAnalyzeAccel, AMissingAccelColumnIsNamed) {
   ScratchDir d;
   const auto rec = d.write("g.csv", "t,gx\n0,1\n0.02,2\n");
   const auto r = runGyroctl("analyze " + rec.string() + " --axis az", d.path());
-  EXPECT_EQ(r.exit_status, 65);  // EX_DATAERR
-  EXPECT_NE(r.err.find(rec.string() + ": no column 'az' (the file has gx)"), std::string::npos) << r.err;
+  EXPECT_EQ(r.exit_status, 64);  // EX_USAGE: a bad --axis value
+  EXPECT_NE(r.err.find("--axis 'az': " + rec.string() + " has no column 'az' (the file has gx; or all)"),
+            std::string::npos)
+      << r.err;
 }
 
 // The shipped real recording: imu.yaml holds the means of the JSON's SI values per sensor.

@@ -134,11 +134,28 @@ TEST(GyroctlErrors, ValuesTheAnalysisCannotCarryAreRefusedBeforeAnyOutput) {
   EXPECT_EQ(c.err.find("Test:"), std::string::npos) << c.err;
 }
 
+// A misspelt option or axis: one line in gyroctl's style, with the nearest name, exit 64;
+// the columns listed are every gyro and accelerometer column the file has.
+TEST(GyroctlErrors, MisspeltOptionsAndAxesSuggestTheNearestName) {
+  ScratchDir d;
+  const auto f = d.write("a.csv", "t,gx,gy,gz,ax,ay,az\n0,1,2,3,0,0,1\n0.02,1,2,3,0,0,1\n");
+  expectOneLineError(runGyroctl("analyze " + f.string() + " --axsi gx", d.path()),
+                     "gyroctl: analyze: unknown option '--axsi'; did you mean '--axis'? (gyroctl analyze --help", 64);
+  expectOneLineError(runGyroctl("filter " + f.string() + " -o x.csv --mean-windw 5", d.path()),
+                     "gyroctl: filter: unknown option '--mean-windw'; did you mean '--mean-window'?", 64);
+  expectOneLineError(runGyroctl("analyze " + f.string() + " --axis gq", d.path()),
+                     "gyroctl: --axis 'gq': " + f.string() +
+                         " has no column 'gq'; did you mean 'gx'? (the file has gx,gy,gz,ax,ay,az; or all)",
+                     64);
+  expectOneLineError(runGyroctl("analyze " + f.string() + " --rate abc", d.path()), "gyroctl: analyze: ", 64);
+}
+
 TEST(GyroctlErrors, MissingColumn) {
   ScratchDir d;
   const auto f = d.write("w.csv", whiteNoiseCsv(500, 50.0, 1));
+  // A column the file lacks is a bad --axis value (64), named with what the file has.
   expectOneLineError(runGyroctl("analyze " + f.string() + " --axis gz", d.path()),
-                     f.string() + ": no column 'gz' (the file has gx,gy)");
+                     "--axis 'gz': " + f.string() + " has no column 'gz'", 64);
   const auto no_gyro = d.write("ng.csv", "t,temp\n0,25\n");
   expectOneLineError(runGyroctl("analyze " + no_gyro.string(), d.path()), ":1: no gyro column");
 }

@@ -107,9 +107,7 @@ void selectAccelColumns(LoadedInput& in, const std::string& axis) {
       rec.axes.push_back(std::move(column));
       in.axis_indices.push_back(rec.axes.size() - 1);
     } else if (axis == name) {
-      std::string have;
-      for (const auto& n : rec.axis_names) have += (have.empty() ? "" : ",") + n;
-      throw recording::RecordingError(in.recording.path + ": no column '" + axis + "' (the file has " + have + ")");
+      throwNoSuchAxis(rec, axis);
     }
     column = std::vector<double>();
   }
