@@ -62,7 +62,7 @@ std::string didYouMean(std::string_view word, const Names& names) {
     if (d < best_distance) best = name, best_distance = d;
   }
   if (best.empty() || best_distance > std::max<std::size_t>(2, word.size() / 3)) return "";
-  return "; did you mean '" + std::string(best) + "'?";
+  return "; did you mean " + formats::quotedValue(best) + "?";  // a header's name may hold any byte
 }
 
 std::string joined(const std::vector<std::string_view>& names) {
@@ -187,7 +187,7 @@ MappedConversion convertMappedColumns(std::istream& in, const std::string& path,
         if (std::find(have.begin(), have.end(), w) == have.end())
           failAt(path, first_line,
                  "no column " + formats::quotedValue(w) + " in the header" + didYouMean(w, have) + " (the header has " +
-                     joined(have) + ")");
+                     formats::quotedValue(joined(have)) + ")");
       failAt(path, first_line, "no header line names all of the mapped columns");
     }
     if (trimField(line).empty()) continue;

@@ -137,7 +137,10 @@ TEST(GyroctlImportColumns, MistakesAreOneLineNamingFileLineColumnAndValue) {
   expectOneLine("--columns gx=gx_dps,gy=gy_dps --time t_host_s",
                 in.string() + ":3: column 'gx_dps': 'abc' is not a number", 65);
   expectOneLine("--columns gx=gx_dsp --rate 100",
-                in.string() + ":1: no column 'gx_dsp' in the header; did you mean 'gx_dps'?", 65);
+                in.string() +
+                    ":1: no column 'gx_dsp' in the header; did you mean 'gx_dps'? (the header has "
+                    "'sample,t_host_s,gx_dps,gy_dps')",
+                65);
   expectOneLine("--columns gq=gx_dps --rate 100", "--columns: 'gq' is not a gyrod column; did you mean 'gx'?", 64);
   expectOneLine("--columns gx:gx_dps --rate 100", "--columns: 'gx:gx_dps' is not TARGET=COLUMN", 64);
   expectOneLine("--columns ax=gy_dps --rate 100", "no gyro column mapped", 64);
@@ -146,4 +149,14 @@ TEST(GyroctlImportColumns, MistakesAreOneLineNamingFileLineColumnAndValue) {
   expectOneLine("--columns gx=gx_dps --rate 100 --format imucal", "--format imucal and --columns", 64);
   expectOneLine("--rate 100", "--rate applies to --columns only", 64);
   EXPECT_FALSE(std::ifstream(out).good());
+}
+
+// A header is the file's text: echoed quoted and escaped, so that it cannot act on a terminal.
+TEST(GyroctlImportColumns, AHostileHeaderIsEchoedEscaped) {
+  ScratchDir d;
+  const auto in = d.write("h.csv", "gx\x1b,b\n1,2\n");
+  const auto r = runGyroctl("import " + in.string() + " --columns gx=gx --rate 10 -o o.csv", d.path());
+  EXPECT_EQ(r.exit_status, 65) << r.err;
+  EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("did you mean 'gx\\x1B'? (the header has 'gx\\x1B,b')"), std::string::npos) << r.err;
 }
