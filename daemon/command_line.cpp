@@ -31,8 +31,7 @@ void applyOverrides(GyrodConfig& config, const CommandLineOverrides& o) {
       throw ConfigError("--record: must be a path without control characters (got " +
                         formats::quotedValue(*o.record_path) + ")");
     // A folder (DIR/ or an existing DIR) is recorded into, as DIR/gyro-<time>-<index>.csv.
-    config.record.path = *o.record_path;
-    if (!o.record_path->empty() && o.record_path->back() == '/') config.record.path += kDefaultRecordingName;
+    config.record.path = recordingBaseName(*o.record_path);
   }
   if (o.mock_speed) {
     if (!(*o.mock_speed >= kMinMockSpeed && *o.mock_speed <= kMaxMockSpeed))

@@ -13,7 +13,9 @@
 #include <unistd.h>
 
 #include "daemon/memory_budget.hpp"
+#include "daemon/recorder.hpp"
 #include "daemon/sample_pipeline.hpp"
+#include "driver/mock/replay_clock.hpp"
 #include "driver/mpu6050_config.hpp"
 #include "formats/input_file.hpp"
 #include "formats/model_toml.hpp"
@@ -246,9 +248,7 @@ void readSocket(const Section& s, SocketConfig& c) {
 void readRecord(const Section& s, RecordConfig& r) {
   if (auto v = s.string("path")) {
     if (hasControlCharacter(*v)) s.failValue("path", "must be a path without control characters");
-    if (!v->empty() && (v->back() == '/' || std::filesystem::path(*v).filename() == "."))
-      s.failValue("path", "must name a file (e.g. /var/lib/gyrod/gyro.csv), not a directory");
-    r.path = *v;
+    r.path = recordingBaseName(*v);
   }
   if (auto v = s.number("rotate_mb")) {
     if (!(*v == 0.0 || *v >= 0.01)) s.failValue("rotate_mb", "must be 0 (never) or ≥ 0.01 MB");
@@ -432,6 +432,11 @@ std::string_view toString(BiasSource s) {
 }
 std::string_view toString(MockSource s) { return kMockSourceNames[s == MockSource::Simulator ? 0 : 1]; }
 
+std::string recordingBaseName(const std::string& setting) {
+  if (!setting.empty() && setting.back() == '/') return setting + kDefaultRecordingName;
+  return setting;
+}
+
 std::string i2cDevicePath(std::string_view bus) {
   if (isAllDigits(bus) && bus.size() <= 6) return "/dev/i2c-" + std::to_string(std::stoul(std::string(bus)));
   if (!bus.empty() && bus.front() == '/') return std::string(bus);
@@ -474,14 +479,13 @@ void checkReferences(const Section& filter, const Section& socket, const Section
     } catch (const std::exception& e) {
       mock.failValue("replay_file", e.what());
     }
-    // The mock holds each recorded sample for a whole number of the chip's internal periods.
+    // The mock holds each recorded sample for a whole number of the chip's ticks, its clock
+    // run fast or slow by up to 10 % to make up the rest (driver/mock/replay_clock.hpp).
     const double internal = driver::mpu6050::gyroOutputRateHz(config.device.dlpf);
-    const double ratio = internal / rate;
-    const double hold = std::round(ratio);
-    if (hold < 1.0 || std::abs(ratio - hold) > 1e-6 * ratio) {
+    if (!driver::replayClockFor(rate, internal)) {
       std::ostringstream cause;  // 6 digits: a rate inferred from t is not exact anyway
       cause << "a recording at " << rate << " Hz cannot be replayed at the chip's internal rate of " << internal
-            << " Hz (it must divide it)";
+            << " Hz (no whole number of ticks per sample within the mock's 10 % clock tolerance)";
       mock.failValue("replay_file", cause.str());
     }
   }

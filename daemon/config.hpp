@@ -100,6 +100,11 @@ struct RecordConfig {
   bool operator==(const RecordConfig&) const = default;
 };
 
+// The base file name that a record.path value or --record names, one rule for both: a value
+// ending in '/' is a folder, recorded into as FOLDER/gyro.csv (an existing folder named
+// without the '/' is recorded into too: the recorder finds it is one). "" stays "" (off).
+std::string recordingBaseName(const std::string& setting);
+
 // Resources the configuration may claim; checked at load, before anything is allocated
 // (daemon/memory_budget.hpp computes the figure).
 struct LimitsConfig {

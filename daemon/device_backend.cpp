@@ -1,11 +1,14 @@
 #include "daemon/device_backend.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
 #include "driver/gpio_data_ready.hpp"
 #include "driver/linux_i2c_bus.hpp"
+#include "driver/mock/replay_clock.hpp"
 #include "driver/mock/simulator_signal_source.hpp"
 #include "driver/mpu6050_config.hpp"
 #include "driver/polling_data_ready.hpp"
@@ -29,22 +32,25 @@ int fsSelFor(int full_scale_dps) {
   throw std::invalid_argument("device.full_scale_dps must be 250, 500, 1000 or 2000");
 }
 
-// A recording at its own rate, held for internal/rate ticks per sample, so that the mock
-// (which ticks at the DLPF's internal rate) replays it at the recording's pace.
-std::unique_ptr<driver::SignalSource> replaySource(const std::string& path, int dlpf_cfg) {
+// A recording at its own rate: each sample held for a whole number of the chip's ticks, the
+// chip's clock run fast or slow by what that rounding leaves (driver/mock/replay_clock.hpp),
+// so that the mock presents the recording's rate as the chip's. The end of the recording is
+// logged each time the replay starts over.
+std::unique_ptr<driver::SignalSource> replaySource(const std::string& path, int dlpf_cfg, double& clock_error_ppm) {
   recording::ReadOptions replay;
   replay.input_kind = &formats::kReplayInput;
   const recording::Recording rec = recording::readRecordingCsv(path, replay);
   const double internal = driver::mpu6050::gyroOutputRateHz(dlpf_cfg);
   const double rate = rec.t.size() >= 2 ? recording::sampleRateFromTimes(rec) : 50.0;
-  const double ratio = internal / rate;
-  const auto hold = static_cast<std::size_t>(std::llround(ratio));
-  if (hold < 1 || std::abs(ratio - static_cast<double>(hold)) > 1e-6 * ratio) {
+  const auto clock = driver::replayClockFor(rate, internal);
+  if (!clock) {
     std::ostringstream s;
     s << path << ": a recording at " << rate << " Hz cannot be replayed at the chip's internal rate of " << internal
-      << " Hz (it must divide it)";
+      << " Hz (no whole number of ticks per sample within the mock's 10 % clock tolerance)";
     throw std::runtime_error(s.str());
   }
+  clock_error_ppm = clock->clock_error_ppm;
+  const std::size_t hold = clock->hold;
   const std::vector<double>* columns[3] = {nullptr, nullptr, nullptr};
   for (std::size_t c = 0; c < rec.axis_names.size(); ++c)
     if (const auto axis = recording::axisOfColumn(rec.axis_names[c])) columns[*axis] = &rec.axes[c];
@@ -56,8 +62,13 @@ std::unique_ptr<driver::SignalSource> replaySource(const std::string& path, int 
   }
   for (std::size_t i = 0; i < rec.size(); ++i)
     for (std::size_t k = 0; k < hold; ++k) temp.push_back(rec.temp.empty() ? 25.0 : rec.temp[i]);
-  return std::make_unique<driver::ReplaySource>(std::move(axes[0]), std::move(axes[1]), std::move(axes[2]),
-                                                std::move(temp), internal);
+  auto source = std::make_unique<driver::ReplaySource>(std::move(axes[0]), std::move(axes[1]), std::move(axes[2]),
+                                                       std::move(temp), internal);
+  source->onEnd([path, samples = rec.size()](std::uint64_t loops) {
+    spdlog::info("mock: the replay of {} reached its end ({} samples); starting over (pass {})", path, samples,
+                 loops + 1);
+  });
+  return source;
 }
 
 }  // namespace
@@ -108,8 +119,9 @@ DeviceParts makeDeviceParts(const GyrodConfig& config) {
 
   if (config.device.backend == DeviceBackend::Mock) {
     const auto& mc = config.mock;
+    double replay_clock_error_ppm = 0.0;
     if (mc.source == MockSource::Replay) {
-      b.source = replaySource(mc.replay_file, config.device.dlpf);
+      b.source = replaySource(mc.replay_file, config.device.dlpf, replay_clock_error_ppm);
     } else {
       processing::SimulationModel model =
           config.filter.model.empty() ? defaultMockModel() : recording::readModelToml(config.filter.model);
@@ -132,6 +144,7 @@ DeviceParts makeDeviceParts(const GyrodConfig& config) {
     }
     driver::MockMpu6050Config mock_config;
     mock_config.address = dc.address;
+    mock_config.clock_error_ppm = replay_clock_error_ppm;
     mock_config.accel_noise_seed = mc.seed;
     // A zero-g offset of a few mg per axis, like a real part's (product spec §6.2: ±50 mg).
     mock_config.accel_bias_g = {0.012, -0.008, 0.02};
@@ -150,6 +163,9 @@ DeviceParts makeDeviceParts(const GyrodConfig& config) {
       d << mc.speed << "x real time";
     if (!mc.motion.empty()) d << ", motion " << mc.motion;
     if (!mc.warm_up.empty()) d << ", warm-up " << mc.warm_up;
+    if (replay_clock_error_ppm != 0.0)
+      d << ", chip clock " << std::showpos << replay_clock_error_ppm << std::noshowpos
+        << " ppm to replay at the recording's rate";
     d << ')';
     b.description = d.str();
     return b;

@@ -212,8 +212,8 @@ void Mpu6050Driver::doProbe() {
 void Mpu6050Driver::doReset() {
   step_ = Step::Reset;
   if (ever_streamed_) {
-    setState(status_.state == DeviceState::Failed ? DeviceState::Failed : DeviceState::Recovering, status_.reason,
-             status_.retrying);
+    const bool failed = status_.state == DeviceState::Failed;
+    setState(failed ? DeviceState::Failed : DeviceState::Recovering, status_.reason, !failed || status_.retrying);
   } else {
     setState(DeviceState::Configuring);
   }
@@ -365,6 +365,10 @@ int Mpu6050Driver::readWord(Register r, std::uint16_t& value) {
 // State and messages
 
 void Mpu6050Driver::setState(DeviceState state, std::string reason, bool retrying) {
+  // STATUS shows the flag as is: a device that streams, configures or is probed for the first
+  // time is not being retried, whatever the caller's default says.
+  retrying = retrying && (state == DeviceState::Recovering || state == DeviceState::Failed ||
+                          (state == DeviceState::Probing && !reason.empty()));
   if (status_.state == state && status_.reason == reason && status_.retrying == retrying) return;
   status_.state = state;
   status_.reason = std::move(reason);

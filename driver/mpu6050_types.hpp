@@ -67,8 +67,11 @@ const char* deviceStateName(DeviceState state);
 
 struct DeviceStatus {
   DeviceState state = DeviceState::Probing;
-  std::string reason;         // empty while all is well
-  bool retrying = true;       // false only for a refusal that retrying cannot fix (wrong chip)
+  std::string reason;  // empty while all is well
+  // Whether the driver is retrying now: while recovering, probing again after an error, and in
+  // Failed while it keeps trying (false there only for a refusal that retrying cannot fix,
+  // a wrong chip). False on the first probe, while configuring and while streaming.
+  bool retrying = false;
   std::uint8_t who_am_i = 0;  // last value read, 0 before the first probe
 };
 

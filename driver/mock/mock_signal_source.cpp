@@ -92,8 +92,12 @@ AnalogSample ReplaySource::nextTick(double) {
     if (at_end_ == AtEnd::Loop) {
       ++exhausted_;
       next_ = 0;
+      if (on_end_) on_end_(exhausted_);
     } else {
-      if (exhausted_ == 0) ++exhausted_;
+      if (exhausted_ == 0) {
+        ++exhausted_;
+        if (on_end_) on_end_(exhausted_);
+      }
       const std::size_t last = x_.size() - 1;
       return AnalogSample{{x_[last], y_[last], z_[last]}, temperature_[last]};
     }

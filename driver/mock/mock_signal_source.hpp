@@ -12,7 +12,9 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <limits>
+#include <utility>
 #include <vector>
 
 namespace gyrod::driver {
@@ -81,6 +83,9 @@ class ReplaySource final : public SignalSource {
   AnalogSample nextTick(double t_s) override;
   std::size_t position() const { return next_; }
   std::uint64_t timesExhausted() const { return exhausted_; }
+  // Called each time the end is reached, with timesExhausted(), so that the owner can say so
+  // (gyrod logs that the replay starts over): a loop is otherwise invisible in the data.
+  void onEnd(std::function<void(std::uint64_t)> callback) { on_end_ = std::move(callback); }
 
  private:
   std::vector<double> x_, y_, z_, temperature_;
@@ -88,6 +93,7 @@ class ReplaySource final : public SignalSource {
   AtEnd at_end_;
   std::size_t next_ = 0;
   std::uint64_t exhausted_ = 0;
+  std::function<void(std::uint64_t)> on_end_;
 };
 
 }  // namespace gyrod::driver

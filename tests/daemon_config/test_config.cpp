@@ -532,16 +532,27 @@ TEST(ConfigErrors, ReferencedFilesAndGroupAreCheckedWhenLoadingAFile) {
     const std::string m = e.what();
     EXPECT_EQ(m.rfind(replay + ":5: key 'mock.replay_file': " + bad_csv + ":2: ", 0), 0u) << m;
   }
-  // 30 Hz does not divide the chip's 1 kHz internal rate (dlpf 4): the mock could not replay it.
+  // 30 Hz and a real record's 100.31 Hz do not divide the chip's 1 kHz internal rate (dlpf 4):
+  // the mock replays them at their own rate, its clock 1 % slow and 0.31 % fast.
   const auto odd_rate = d.write("odd.csv", "t,gx\n0,1\n0.0333333333333,2\n0.0666666666667,3\n");
   const auto odd = d.write(
       "odd.toml", "[device]\nbackend = \"mock\"\n[mock]\nsource = \"replay\"\nreplay_file = \"" + odd_rate + "\"\n");
+  EXPECT_NO_THROW(loadConfigFile(odd));
+  const std::string real =
+      std::string(GYROD_TEST_DATA_DIR) + "/mpu6050-sensor-fusion-set1/unmoved-x-pointing-forward.csv";
+  const auto real_toml = d.write(
+      "real.toml", "[device]\nbackend = \"mock\"\n[mock]\nsource = \"replay\"\nreplay_file = \"" + real + "\"\n");
+  EXPECT_NO_THROW(loadConfigFile(real_toml));
+  // 400 Hz: 2.5 ticks of 1 kHz; 2 or 3 would need the clock 20 % off, beyond the mock's 10 %.
+  const auto fast_rate = d.write("fast.csv", "t,gx\n0,1\n0.0025,2\n0.005,3\n");
+  const auto fast = d.write(
+      "fast.toml", "[device]\nbackend = \"mock\"\n[mock]\nsource = \"replay\"\nreplay_file = \"" + fast_rate + "\"\n");
   try {
-    loadConfigFile(odd);
+    loadConfigFile(fast);
     FAIL() << "no error";
   } catch (const ConfigError& e) {
     const std::string m = e.what();
-    EXPECT_EQ(m.rfind(odd + ":5: key 'mock.replay_file': a recording at 30", 0), 0u) << m;
+    EXPECT_EQ(m.rfind(fast + ":5: key 'mock.replay_file': a recording at 400", 0), 0u) << m;
     EXPECT_NE(m.find("cannot be replayed at the chip's internal rate of 1000 Hz"), std::string::npos) << m;
   }
   const auto good_rate = d.write("good.csv", "t,gx\n0,1\n0.02,2\n0.04,3\n");

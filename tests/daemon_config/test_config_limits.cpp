@@ -122,3 +122,16 @@ TEST(ConfigRecordFlag, AFolderWithASlashIsRecordedInto) {
   applyOverrides(c, o);
   EXPECT_EQ(c.record.path, "/tmp/x.csv");
 }
+
+// record.path and --record follow one rule: a value ending in '/' is a folder recorded into.
+TEST(ConfigRecordFlag, TheFileAndTheFlagTakeAFolderAlike) {
+  const GyrodConfig from_file = parseConfig("[record]\npath = \"/x/rec/\"\n", "g.toml");
+  EXPECT_EQ(from_file.record.path, "/x/rec/gyro.csv");
+  GyrodConfig from_flag;
+  CommandLineOverrides o;
+  o.record_path = "/x/rec/";
+  applyOverrides(from_flag, o);
+  EXPECT_EQ(from_flag.record.path, from_file.record.path);
+  EXPECT_EQ(parseConfig("[record]\npath = \"/x/rec/a.csv\"\n", "g.toml").record.path, "/x/rec/a.csv");
+  EXPECT_FALSE(parseConfig("[record]\npath = \"\"\n", "g.toml").record.enabled());
+}

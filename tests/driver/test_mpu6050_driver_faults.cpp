@@ -142,6 +142,7 @@ TEST(Mpu6050DriverFaults, LongOutageMarksTheSensorNotFunctionalUntilItAnswersAga
   SinusoidSource source = movingSource();
   DriverRig rig(source);
   rig.startStreaming();
+  EXPECT_FALSE(rig.driver.status().retrying);  // a fresh start that streams is not a retry
   FaultPlan plan;
   plan.outages.push_back({rig.clock.nowNs() - rig.mock.epochNs() + kNsPerSecond, 40 * kNsPerSecond, EREMOTEIO, false});
   rig.mock.setFaultPlan(plan);
@@ -151,6 +152,7 @@ TEST(Mpu6050DriverFaults, LongOutageMarksTheSensorNotFunctionalUntilItAnswersAga
   EXPECT_NE(rig.driver.status().reason.find("EREMOTEIO"), std::string::npos);
   rig.runFor(20 * kNsPerSecond);
   EXPECT_EQ(rig.driver.status().state, DeviceState::Streaming);
+  EXPECT_FALSE(rig.driver.status().retrying);  // retrying only while it retries
   const StreamCheck c = checkStream(rig.recorder, rig.truth, rig.truePeriodNs(), kEdgeCheck);
   expectTotals(rig, c);
   expectSpanEqualsProduced(rig);  // 40 s at 50 Hz through one gap, still exact

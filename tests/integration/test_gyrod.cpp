@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <csignal>
+#include <cstdio>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -231,6 +232,31 @@ TEST(Gyrod, StalledClientIsDroppedAndTheOthersReceiveEverything) {
   EXPECT_GE(status["clients_dropped"].get<int>(), 1) << status.dump();
 }
 
+// STATUS device_retrying: false from a fresh start, both while the device is brought up and
+// once it streams; nothing is being retried.
+TEST(Gyrod, AFreshStartIsNotRetrying) {
+  ScratchDir d;
+  const auto cfg = d.write("gyrod.toml", mockConfig(d.path(), 10.0));
+  GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt");
+  const std::string sock = (d.path() / "gyrod.sock").string();
+  LineClient asker(sock);
+  ASSERT_TRUE(asker.connected());
+  ASSERT_TRUE(asker.readLine());
+  asker.send("{\"cmd\":\"status\"}\n");
+  const json early = json::parse(*asker.readLine());
+  EXPECT_EQ(early["device_retrying"], false) << early.dump();
+  LineClient w(sock);
+  startWatching(w);
+  if (HasFatalFailure()) return;
+  ASSERT_EQ(readRates(w, 5).rates.size(), 5u);
+  asker.send("{\"cmd\":\"status\"}\n");
+  const json streaming = json::parse(*asker.readLine());
+  EXPECT_EQ(streaming["device_state"], "streaming") << streaming.dump();
+  EXPECT_EQ(streaming["device_retrying"], false) << streaming.dump();
+  gyrod.signal(SIGINT);
+  EXPECT_EQ(gyrod.waitExit(1000ms), std::optional<int>(0));
+}
+
 TEST(Gyrod, MalformedAndOversizedClientLines) {
   ScratchDir d;
   const auto cfg = d.write("gyrod.toml", mockConfig(d.path(), 10.0));
@@ -361,6 +387,44 @@ TEST(Gyrod, AConstantSignalIsLoggedWithoutInternalNames) {
   static const std::regex internal_name(
       R"(\b([a-z][a-z0-9_]*[A-Z]\w*|[A-Z][a-z0-9_]+[A-Z]\w*|[A-Za-z_]\w*(::\w+)+)(\(\))?: |\w\(\): )");
   EXPECT_FALSE(std::regex_search(log, internal_name)) << log;
+}
+
+// A recording at 100.31 Hz (a real record's rate, which divides neither internal rate) replays
+// at its own rate: the mock's chip clock runs 3100 ppm fast, so the 50 Hz the daemon asks for
+// comes out at 50.155 Hz. Each time the recording ends, the log says that it starts over.
+TEST(Gyrod, AReplayRunsAtTheRecordingsOwnRateAndSaysWhenItStartsOver) {
+  ScratchDir d;
+  constexpr double kRecordedRateHz = 100.31;
+  std::string csv = "t,gx,gy,gz,temp\n";
+  char line[128];
+  for (int i = 0; i < 200; ++i) {  // 2 s: the replay loops within the test
+    std::snprintf(line, sizeof line, "%.17g,%.2f,0.25,-0.5,30\n", i / kRecordedRateHz, 0.1 * (i % 7));
+    csv += line;
+  }
+  const auto replay = d.write("real-rate.csv", csv);
+  const auto cfg = d.write(
+      "gyrod.toml", mockConfig(d.path(), 10.0, "source = \"replay\"\nreplay_file = \"" + replay.string() + "\"\n"));
+  GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt");
+  const std::string sock = (d.path() / "gyrod.sock").string();
+  LineClient w(sock);
+  startWatching(w);
+  if (HasFatalFailure()) return;
+  const Stream s = readRates(w, 400);  // 8 s of the sensor's time: the 2 s recording four times
+  ASSERT_EQ(s.rates.size(), 400u) << readWholeFile(d.path() / "log.txt");
+  const double span = s.rates.back()["t"].get<double>() - s.rates[100]["t"].get<double>();
+  EXPECT_NEAR(299.0 / span, 50.0 * kRecordedRateHz / 100.0, 0.02) << "RATE t spacing";
+  LineClient asker(sock);
+  ASSERT_TRUE(asker.readLine());
+  asker.send("{\"cmd\":\"status\"}\n");
+  const json status = json::parse(*asker.readLine());
+  EXPECT_NEAR(status["rate"].get<double>(), 50.0 * kRecordedRateHz / 100.0, 0.02) << status.dump();
+  gyrod.signal(SIGTERM);
+  EXPECT_EQ(gyrod.waitExit(2000ms), std::optional<int>(0));
+  const std::string log = readWholeFile(d.path() / "log.txt");
+  EXPECT_NE(log.find("ppm to replay at the recording's rate"), std::string::npos) << log;
+  EXPECT_NE(log.find("the replay of " + replay.string() + " reached its end (200 samples); starting over (pass 2)"),
+            std::string::npos)
+      << log;
 }
 
 TEST(Gyrod, UnknownSocketGroupAndBadReplayFileExitWithExConfig) {

@@ -8,7 +8,8 @@
 # A key or option added to the program and not to its man page (or the reverse) fails here.
 # The man pages' convention (see their headers): a documented option or key is a .TP item
 # whose first line is .B/.BI/.BR naming it; gyroctl's commands and gyrod.toml's tables are .SS.
-# The bash completions (completion/) must offer the same commands and options.
+# The bash completions (completion/) must offer the same commands and options. The configuration
+# keys that README.md and docs/ name exist, and config/gyrod.toml shows every key.
 # Usage: check-man-pages.sh SOURCE_DIR GYROD GYROCTL
 # GYROD_TEST_LAUNCHER (e.g. "qemu-aarch64-static -L SYSROOT") runs a cross build's binaries.
 set -euo pipefail
@@ -121,5 +122,92 @@ compare "gyrod.toml(5) tables" "$work/tables.prog" "$work/tables.man"
 tr '\t' ' ' <"$work/toml.prog" >"$work/toml.prog.txt"
 tr '\t' ' ' <"$work/toml.man" >"$work/toml.man.txt"
 compare "gyrod.toml(5) keys" "$work/toml.prog.txt" "$work/toml.man.txt"
+
+# README.md and docs/*.md name configuration keys as `table.key`, `[table] key` or in an
+# indented example under a `[table]` line; every such name of one of gyrod's tables must be a
+# key (or sub-table) gyrod accepts. Dotted names of other things (`counters.retries`,
+# `np.loadtxt`, a model file's `[x.extra]`) do not start with one of gyrod's tables and are
+# not checked; a bare `key` cannot be told from a JSON or model-file name and is not either.
+sed -E 's/^\[([^]]*)\]\t(.*)$/\1.\2/' "$work/toml.prog" >"$work/names.prog"
+sed -E 's/^\[(.*)\]$/\1/' "$work/tables.prog" >>"$work/names.prog"
+sed -E 's/^\[(.*)\]$/\1/' "$work/tables.prog" >"$work/tables.plain"
+for doc in "$1/README.md" "$1"/docs/*.md; do
+  awk -v tables="$work/tables.plain" -v names="$work/names.prog" -v doc="${doc#"$1"/}" '
+    BEGIN {
+      while ((getline t <tables) > 0) table[t] = 1
+      while ((getline n <names) > 0) known[n] = 1
+    }
+    function check(tbl, key) {
+      if (key ~ /^(c|h|cpp|hpp|md|csv|toml|yaml|json|py|sh|txt|png|service|socket)$/) return  # a file name
+      if ((tbl in table) && !((tbl "." key) in known)) print doc ":" FNR ": `" tbl "." key "` is not a gyrod configuration key"
+    }
+    # An indented example: "    [table]" then "    key = value" lines.
+    /^    \[[a-z_.]+\] *$/ { block = $0; gsub(/[][ ]/, "", block); next }
+    block != "" && /^    [a-z_0-9]+ *=/ { k = $0; sub(/^ +/, "", k); sub(/ *=.*/, "", k); check(block, k); next }
+    block != "" && !/^    / { block = "" }
+    {
+      line = $0
+      while (match(line, /`[^`]+`/)) {
+        span = substr(line, RSTART + 1, RLENGTH - 2); line = substr(line, RSTART + RLENGTH)
+        if (match(span, /^\[[a-z_.]+\] [a-z_0-9]+/)) {
+          t = substr(span, 2, index(span, "]") - 2); k = substr(span, index(span, "]") + 2, RLENGTH - index(span, "]") - 1)
+          check(t, k); continue
+        }
+        rest = span
+        while (match(rest, /(^|[^A-Za-z0-9_.\/-])[a-z_]+(\.[a-z_0-9]+)+/)) {
+          d = substr(rest, RSTART, RLENGTH); rest = substr(rest, RSTART + RLENGTH)
+          sub(/^[^a-z_]/, "", d)
+          if (rest ~ /^[A-Za-z0-9_\/-]/) continue  # part of a longer name (a path, a file.ext-like word)
+          t = d; sub(/\.[a-z_0-9]+$/, "", t); k = substr(d, length(t) + 2)
+          check(t, k)
+        }
+      }
+    }' "$doc"
+done >"$work/doc-keys.bad"
+# docs/hardware.md's fixes are settings: a bare `snake_case` name there is a configuration key
+# or a name gyrod prints (a counter, a reason: a quoted string in daemon/, driver/, protocol/).
+cut -f2 "$work/toml.prog" | sort -u >"$work/key-names"
+grep -noE '`[a-z]+_[a-z0-9_]+`' "$1/docs/hardware.md" | while IFS=: read -r line name; do
+  name=${name//\`/}
+  grep -qxF "$name" "$work/key-names" && continue
+  grep -rqF "\"$name\"" "$1/daemon" "$1/driver" "$1/protocol" && continue
+  echo "docs/hardware.md:$line: \`$name\` is neither a configuration key nor a name gyrod prints"
+done >>"$work/doc-keys.bad"
+if [ -s "$work/doc-keys.bad" ]; then
+  echo "FAIL: README.md and docs/ name configuration keys gyrod does not have:"; sed 's/^/  /' "$work/doc-keys.bad"
+  failures=$((failures + 1))
+else
+  echo "ok: configuration keys named in README.md and docs/"
+fi
+# Every key gyrod accepts is documented in the configuration shipped with it (config/gyrod.toml,
+# set or commented out under its table), besides gyrod.toml(5) above.
+awk -v names="$work/toml.prog" '
+  BEGIN { while ((getline n <names) > 0) { split(n, f, "\t"); want[f[1] "\t" f[2]] = 1 } }
+  /^#? ?\[\[?[a-z_.]+\]\]?/ {  # a table, or a sub-table that shows its key of the table above
+    t = $0; sub(/^# ?/, "", t); sub(/[ \t].*$/, "", t); gsub(/[][]/, "", t)
+    if (t ~ /\./) { p = t; sub(/\.[^.]*$/, "", p); have["[" p "]\t" substr(t, length(p) + 2)] = 1 }
+    if ($0 !~ /^#/) tbl = "[" t "]"
+    next
+  }
+  /^#? ?[a-z_0-9]+ *=/ {
+    k = $0; sub(/^# ?/, "", k); sub(/ *=.*/, "", k); have[tbl "\t" k] = 1
+    # An inline table (or an array of them) shows the keys of the sub-table: k = [{ a = 1, b = 2 }].
+    rest = $0; sub(/^[^=]*=/, "", rest)
+    if (rest ~ /\{/) {
+      subtable = tbl; sub(/\]$/, "." k "]", subtable)
+      while (match(rest, /[{,] *[a-z_0-9]+ *=/)) {
+        inner = substr(rest, RSTART + 1, RLENGTH - 1); rest = substr(rest, RSTART + RLENGTH)
+        gsub(/[ =]/, "", inner); have[subtable "\t" inner] = 1
+      }
+    }
+  }
+  END { for (w in want) if (!(w in have)) { split(w, f, "\t"); print f[1] " " f[2] } }' "$1/config/gyrod.toml" |
+  sort >"$work/config-keys.missing"
+if [ -s "$work/config-keys.missing" ]; then
+  echo "FAIL: config/gyrod.toml does not show these keys:"; sed 's/^/  /' "$work/config-keys.missing"
+  failures=$((failures + 1))
+else
+  echo "ok: config/gyrod.toml shows every configuration key"
+fi
 
 [ "$failures" -eq 0 ] || { echo "check-man-pages: $failures mismatch(es)"; exit 1; }

@@ -2,6 +2,7 @@
 // on files whose truth is known (a seeded model) and on the shipped real recording.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -109,8 +110,10 @@ TEST(GyroctlAnalyzeAccel, AMissingAccelColumnIsNamed) {
   ScratchDir d;
   const auto rec = d.write("g.csv", "t,gx\n0,1\n0.02,2\n");
   const auto r = runGyroctl("analyze " + rec.string() + " --axis az", d.path());
-  EXPECT_EQ(r.exit_status, 65);  // EX_DATAERR
-  EXPECT_NE(r.err.find(rec.string() + ": no column 'az' (the file has gx)"), std::string::npos) << r.err;
+  EXPECT_EQ(r.exit_status, 64);  // EX_USAGE: a bad --axis value
+  EXPECT_NE(r.err.find("--axis 'az': " + rec.string() + " has no column 'az' (the file has gx; or all)"),
+            std::string::npos)
+      << r.err;
 }
 
 // The shipped real recording: imu.yaml holds the means of the JSON's SI values per sensor.
@@ -137,6 +140,23 @@ TEST(GyroctlKalibr, RealRecordingGivesTheMeanOfTheAxesInSi) {
   EXPECT_EQ(imu.update_rate_hz, 100.0);
   EXPECT_EQ(imu.rostopic, "/imu0");
   EXPECT_NE(text.find("NOT inflated"), std::string::npos) << text;
+  // 100 s never reach the gyro's +1/2 slope: gyroscope_random_walk is a number all the same,
+  // the upper bound min over tau of oadev * sqrt(3 / tau), the largest of the three axes, in
+  // rad/s^2/sqrt(Hz), said so in its comment and on stderr (Kalibr cannot read a missing key).
+  ASSERT_TRUE(imu.gyroscope_random_walk.value) << text;
+  double bound = 0.0;
+  for (const char* axis : {"gx", "gy", "gz"}) {
+    EXPECT_EQ(doc["axes"][axis]["noise"]["rrw_rad_per_s2_sqrt_hz"].get<double>(), 0.0) << axis;
+    double axis_bound = 1e300;
+    for (const auto& p : doc["axes"][axis]["allan"])
+      axis_bound = std::min(axis_bound, p["oadev"].get<double>() * std::sqrt(3.0 / p["tau_s"].get<double>()));
+    bound = std::max(bound, axis_bound);
+  }
+  EXPECT_NEAR(*imu.gyroscope_random_walk.value, bound * std::numbers::pi / 180.0, 1e-5 * bound * 0.0175);
+  EXPECT_NE(text.find("gyroscope_random_walk: "), std::string::npos) << text;
+  EXPECT_EQ(text.find("# gyroscope_random_walk"), std::string::npos) << text;
+  EXPECT_NE(text.find("upper bound, not a fit"), std::string::npos) << text;
+  EXPECT_NE(r.err.find("gyroscope_random_walk: upper bound, not a fit"), std::string::npos) << r.err;
 }
 
 TEST(GyroctlKalibr, AGyroOnlyRecordingSaysTheAccelIsMissingAndWritesNoNumberForIt) {

@@ -11,6 +11,8 @@
 #include <tuple>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "tools/run_command.hpp"
 
 using gyrod::test::runGyroctl;
@@ -132,11 +134,28 @@ TEST(GyroctlErrors, ValuesTheAnalysisCannotCarryAreRefusedBeforeAnyOutput) {
   EXPECT_EQ(c.err.find("Test:"), std::string::npos) << c.err;
 }
 
+// A misspelt option or axis: one line in gyroctl's style, with the nearest name, exit 64;
+// the columns listed are every gyro and accelerometer column the file has.
+TEST(GyroctlErrors, MisspeltOptionsAndAxesSuggestTheNearestName) {
+  ScratchDir d;
+  const auto f = d.write("a.csv", "t,gx,gy,gz,ax,ay,az\n0,1,2,3,0,0,1\n0.02,1,2,3,0,0,1\n");
+  expectOneLineError(runGyroctl("analyze " + f.string() + " --axsi gx", d.path()),
+                     "gyroctl: analyze: unknown option '--axsi'; did you mean '--axis'? (gyroctl analyze --help", 64);
+  expectOneLineError(runGyroctl("filter " + f.string() + " -o x.csv --mean-windw 5", d.path()),
+                     "gyroctl: filter: unknown option '--mean-windw'; did you mean '--mean-window'?", 64);
+  expectOneLineError(runGyroctl("analyze " + f.string() + " --axis gq", d.path()),
+                     "gyroctl: --axis 'gq': " + f.string() +
+                         " has no column 'gq'; did you mean 'gx'? (the file has gx,gy,gz,ax,ay,az; or all)",
+                     64);
+  expectOneLineError(runGyroctl("analyze " + f.string() + " --rate abc", d.path()), "gyroctl: analyze: ", 64);
+}
+
 TEST(GyroctlErrors, MissingColumn) {
   ScratchDir d;
   const auto f = d.write("w.csv", whiteNoiseCsv(500, 50.0, 1));
+  // A column the file lacks is a bad --axis value (64), named with what the file has.
   expectOneLineError(runGyroctl("analyze " + f.string() + " --axis gz", d.path()),
-                     f.string() + ": no column 'gz' (the file has gx,gy)");
+                     "--axis 'gz': " + f.string() + " has no column 'gz'", 64);
   const auto no_gyro = d.write("ng.csv", "t,temp\n0,25\n");
   expectOneLineError(runGyroctl("analyze " + no_gyro.string(), d.path()), ":1: no gyro column");
 }
@@ -176,14 +195,39 @@ TEST(GyroctlErrors, TooFewSamples) {
   expectOneLineError(runGyroctl("analyze " + f.string(), d.path()), "20 samples are too few");
 }
 
-TEST(GyroctlErrors, TauThatIsNotAWholeNumberOfSamples) {
+// A τ between two whole numbers of samples is taken at the nearest one and said on stderr;
+// only a τ nearer to no sample at all than to one is refused.
+TEST(GyroctlErrors, TauBetweenWholeSamplesIsRoundedAndSaid) {
   ScratchDir d;
   const auto f = d.write("w.csv", whiteNoiseCsv(2000, 50.0, 4));
-  const auto r = runGyroctl("analyze " + f.string() + " --taus 0.1,0.03", d.path());
-  expectOneLineError(r, "--taus", 64);
-  EXPECT_NE(r.err.find("0.03"), std::string::npos) << r.err;
+  const auto r = runGyroctl("analyze " + f.string() + " --taus 0.1,0.026 --json", d.path());
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.err.find("--taus 0.026 s is 1.3 samples at 50 Hz: using the nearest whole number, m = 1, tau = 0.02 s"),
+            std::string::npos)
+      << r.err;
+  const auto allan = nlohmann::json::parse(r.out)["axes"]["gx"]["allan"];
+  ASSERT_EQ(allan.size(), 2u);
+  EXPECT_EQ(allan[1]["m"].get<int>(), 1);
+  expectOneLineError(runGyroctl("analyze " + f.string() + " --taus 0.005", d.path()), "--taus", 64);
   expectOneLineError(runGyroctl("analyze " + f.string() + " --taus 1,x", d.path()),
                      "--taus: 'x' is not a positive number", 64);
+}
+
+// The real record's rate, 100.31 Hz, puts every round τ between two whole numbers of samples.
+TEST(GyroctlErrors, RoundTausAtARealRecordsRateAreTakenAtTheNearestSample) {
+  ScratchDir d;
+  const std::string real =
+      std::string(GYROD_TEST_DATA_DIR) + "/mpu6050-sensor-fusion-set1/unmoved-x-pointing-forward.csv";
+  const auto r = runGyroctl("analyze " + real + " --axis gx --taus 1,10 --json", d.path());
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const auto doc = nlohmann::json::parse(r.out);
+  const double rate = doc["rate_hz"].get<double>();
+  const auto allan = doc["axes"]["gx"]["allan"];
+  ASSERT_EQ(allan.size(), 2u);
+  EXPECT_EQ(allan[0]["m"].get<double>(), std::round(1.0 * rate));
+  EXPECT_EQ(allan[1]["m"].get<double>(), std::round(10.0 * rate));
+  EXPECT_NEAR(allan[1]["tau_s"].get<double>(), std::round(10.0 * rate) / rate, 1e-12);
+  EXPECT_NE(r.err.find("--taus 10 s is"), std::string::npos) << r.err;
 }
 
 TEST(GyroctlErrors, BadOptionValuesExitWithUsage64) {

@@ -141,9 +141,23 @@ std::vector<double> parseTauList(const std::string& text) {
 std::vector<std::size_t> clusterSizesFor(const std::string& spec, double rate_hz, std::size_t n) {
   if (spec == "octave") return octaveClusterSizes(n);
   if (spec == "dense") return denseClusterSizes(n);
-  const auto taus = parseTauList(spec);
+  auto taus = parseTauList(spec);
+  // A τ between two whole numbers of samples (a rate such as 100.31 Hz puts every round τ
+  // there) is taken at the nearest one, and the τ used is said: the tables show it too.
+  const double tau0 = 1.0 / rate_hz;
+  for (double& tau : taus) {
+    const double samples = tau / tau0;
+    const double whole = std::round(samples);
+    if (whole < 1.0 || std::abs(samples - whole) <= 1e-9 * samples) continue;
+    const double used = whole * tau0;
+    std::fprintf(
+        stderr,
+        "gyroctl analyze: --taus %g s is %.6g samples at %g Hz: using the nearest whole number, m = %.0f, tau = %.6g s\n",
+        tau, samples, rate_hz, whole, used);
+    tau = used;
+  }
   try {
-    return clusterSizesForTaus(taus, 1.0 / rate_hz, n);
+    return clusterSizesForTaus(taus, tau0, n);
   } catch (const std::invalid_argument& e) {
     std::ostringstream s;
     s << "--taus: " << e.what() << " (sample rate " << rate_hz << " Hz)";

@@ -7,6 +7,7 @@
 
 #include "formats/recording_csv.hpp"
 #include "processing/base/noise_units.hpp"
+#include "processing/base/units.hpp"
 
 namespace gyrod::gyroctl {
 namespace {
@@ -54,6 +55,39 @@ formats::KalibrValue kalibrValue(const std::vector<std::string>& columns,
   return v;
 }
 
+// A random walk the fit did not see (a record too short for the +1/2 slope to rise above the
+// other terms) still has a ceiling: σ(τ) ≥ K·√(τ/3) at every τ, so K ≤ min over τ of
+// σ(τ)·√(3/τ), usually at the longest τ. Kalibr needs a number, and this bound is what
+// imu_utils and allan_variance_ros users take there; the note says it is one. The largest
+// bound over the axes, in SI. Returns whether it filled `v`.
+bool boundUnseenRandomWalk(formats::KalibrValue& v, const std::vector<std::string>& columns,
+                           const std::vector<processing::AxisAnalysis>& analyses, SensorKind sensor, double inflate) {
+  if (v.value) return false;
+  const double to_si = sensor == SensorKind::Accel ? units::kStandardGravity : units::kRadPerDeg;
+  double bound = 0.0;
+  double bound_tau = 0.0;
+  std::string axes;
+  for (std::size_t k = 0; k < columns.size(); ++k) {
+    if (processing::sensorOfColumn(columns[k]) != sensor) continue;
+    double axis_bound = HUGE_VAL;
+    double axis_tau = 0.0;
+    for (const auto& p : analyses[k].allan) {
+      const double b = p.oadev * std::sqrt(3.0 / p.tau_s);
+      if (std::isfinite(b) && b > 0.0 && b < axis_bound) axis_bound = b, axis_tau = p.tau_s;
+    }
+    if (!std::isfinite(axis_bound)) continue;
+    axes += (axes.empty() ? "" : ", ") + columns[k];
+    if (axis_bound > bound) bound = axis_bound, bound_tau = axis_tau;
+  }
+  if (bound <= 0.0) return false;
+  v.value = inflate * bound * to_si;
+  v.note = "upper bound, not a fit: no random walk in the Allan curve of " + axes +
+           formatted(", so min over tau of oadev * sqrt(3 / tau) (at tau = %.4g s), the largest of the axes", bound_tau,
+                     0.0);
+  if (inflate != 1.0) v.note += formatted("; x %.3g (--kalibr-inflate)", inflate, 0.0);
+  return true;
+}
+
 }  // namespace
 
 bool isAccelColumn(const std::string& name) {
@@ -73,9 +107,7 @@ void selectAccelColumns(LoadedInput& in, const std::string& axis) {
       rec.axes.push_back(std::move(column));
       in.axis_indices.push_back(rec.axes.size() - 1);
     } else if (axis == name) {
-      std::string have;
-      for (const auto& n : rec.axis_names) have += (have.empty() ? "" : ",") + n;
-      throw recording::RecordingError(in.recording.path + ": no column '" + axis + "' (the file has " + have + ")");
+      throwNoSuchAxis(rec, axis);
     }
     column = std::vector<double>();
   }
@@ -96,6 +128,10 @@ formats::KalibrImu kalibrImuFromAnalyses(const std::vector<std::string>& columns
       kalibrValue(columns, analyses, SensorKind::Gyro, processing::noiseDensitySi, options.inflate);
   imu.gyroscope_random_walk =
       kalibrValue(columns, analyses, SensorKind::Gyro, processing::biasRandomWalkSi, options.inflate);
+  if (boundUnseenRandomWalk(imu.accelerometer_random_walk, columns, analyses, SensorKind::Accel, options.inflate))
+    missing.push_back("accelerometer_random_walk: " + imu.accelerometer_random_walk.note);
+  if (boundUnseenRandomWalk(imu.gyroscope_random_walk, columns, analyses, SensorKind::Gyro, options.inflate))
+    missing.push_back("gyroscope_random_walk: " + imu.gyroscope_random_walk.note);
   const std::pair<const char*, const formats::KalibrValue*> entries[] = {
       {"accelerometer_noise_density", &imu.accelerometer_noise_density},
       {"accelerometer_random_walk", &imu.accelerometer_random_walk},

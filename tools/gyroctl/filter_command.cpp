@@ -15,6 +15,7 @@
 #include "formats/output_file.hpp"
 #include "processing/base/detrend.hpp"
 #include "processing/motion/rate_estimator.hpp"
+#include "processing/motion/still_detector.hpp"
 #include "processing/paper/filter_chain.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
@@ -112,6 +113,66 @@ class RateColumns {
   std::optional<RateEstimator> estimator_;
 };
 
+// The share of samples the still detector (processing/motion/still_detector.hpp) judges moving,
+// calibrated on the record itself, for a warning: A, Q and R identified from a record that is
+// mostly motion describe the motion, not the sensor's noise. Each axis' white-noise level comes
+// from the median absolute second difference of its samples (smooth motion hardly moves it; for
+// white noise the second difference has variance 6σ²), the bias from the median. The mean test
+// is widened to about 1 °/s (P below), so that a bias that drifts with temperature is not taken
+// for motion; the difference test sees anything that changes from sample to sample.
+double movingShare(const recording::Recording& rec, double rate_hz) {
+  StillDetectorParameters params;
+  params.window_samples = std::max<std::size_t>(3, static_cast<std::size_t>(std::lround(0.5 * rate_hz)));
+  const std::size_t n = rec.size();
+  if (n < params.window_samples + 2) return 0.0;
+  std::array<StillNoiseLevel, kMotionAxes> levels;
+  levels.fill({1.0, 1.0});  // an axis the file lacks is fed zeros: it always passes
+  std::array<const std::vector<double>*, kMotionAxes> columns{};
+  AngularRate bias{};
+  for (std::size_t i = 0; i < rec.axis_names.size(); ++i) {
+    const auto axis = recording::axisOfColumn(rec.axis_names[i]);
+    if (!axis) continue;
+    const auto& x = rec.axes[i];
+    std::vector<double> work(n - 2);
+    double mean_square = 0.0;
+    for (std::size_t k = 1; k + 1 < n; ++k) {
+      const double d2 = x[k + 1] - 2.0 * x[k] + x[k - 1];
+      work[k - 1] = std::abs(d2);
+      mean_square += d2 * d2 / static_cast<double>(n - 2);
+    }
+    const auto middle = work.begin() + static_cast<std::ptrdiff_t>(work.size() / 2);
+    std::nth_element(work.begin(), middle, work.end());
+    const double robust_sigma = 1.4826 * *middle;
+    // A coarsely quantised still axis can have a median of 0: the mean square then.
+    const double variance = robust_sigma > 0.0 ? robust_sigma * robust_sigma / 6.0 : mean_square / 6.0;
+    if (!(variance > 0.0) || !std::isfinite(variance)) continue;  // a constant axis: nothing moves
+    levels[*axis] = {variance / static_cast<double>(params.window_samples), variance};
+    work.assign(x.begin(), x.end());
+    const auto half = work.begin() + static_cast<std::ptrdiff_t>(n / 2);
+    std::nth_element(work.begin(), half, work.end());
+    bias[*axis] = *half;
+    columns[*axis] = &x;
+  }
+  StillDetector detector(params, levels);
+  constexpr double kBiasDriftVariance = 1.0 / 9.0;  // z·√P = 1 °/s at z = 3
+  const AngularRate expected{};
+  const AngularRate expected_variance{kBiasDriftVariance, kBiasDriftVariance, kBiasDriftVariance};
+  std::size_t judged = 0, moving = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    AngularRate c{};
+    for (std::size_t a = 0; a < kMotionAxes; ++a)
+      if (columns[a]) c[a] = (*columns[a])[k] - bias[a];
+    const bool still = detector.update(c, expected, expected_variance);
+    if (k + 1 < params.window_samples) continue;  // no verdict before the first full window
+    ++judged;
+    if (!still) ++moving;
+  }
+  return judged == 0 ? 0.0 : static_cast<double>(moving) / static_cast<double>(judged);
+}
+
+// Above this share of moving samples, filter warns that the identified Kalman is meaningless.
+constexpr double kMostlyMovingShare = 0.5;
+
 int runFilter(const FilterOptions& opt) {
   if (opt.kalman_q && !(*opt.kalman_q >= 0.0)) throw std::invalid_argument("--kalman-q must be >= 0");
   if (opt.kalman_r && !(*opt.kalman_r >= 0.0)) throw std::invalid_argument("--kalman-r must be >= 0");
@@ -192,6 +253,16 @@ int runFilter(const FilterOptions& opt) {
                  params[axis].mean_window, params[axis].mean_threshold_dps, k.a, k.q, k.r,
                  opt.ar_phi || opt.kalman_q || opt.kalman_r ? " (some given on the command line)"
                                                             : " (identified from the file)");
+  }
+  if (identifies) {
+    const double share = movingShare(rec, in.rate_hz);
+    if (share > kMostlyMovingShare)
+      std::fprintf(stderr,
+                   "gyroctl filter: warning: %s: the still detector finds the record moving in %.0f %% of its "
+                   "samples; A, Q and R identified from it describe the motion, not the sensor's noise. Identify "
+                   "them on a still record (gyroctl analyze --write-model sensor.toml) and use the rate column of "
+                   "--model sensor.toml, or give --ar-phi, --kalman-q and --kalman-r\n",
+                   opt.file.c_str(), 100.0 * share);
   }
   if (rate_columns)
     std::fprintf(stderr, "rate stream from %s: %zu of %zu samples still (they updated the residual bias); %s\n",

@@ -1,10 +1,12 @@
 #include "tools/gyroctl/input.hpp"
 
+#include "formats/edit_distance.hpp"
 #include "tools/gyroctl/exit_codes.hpp"
 
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -51,13 +53,27 @@ LoadedInput loadInput(const std::string& path, std::optional<double> rate_hz, co
         in.axis_indices.push_back(i);
         found = true;
       }
-    if (!found) {
-      std::string have;
-      for (const auto& n : rec.axis_names) have += (have.empty() ? "" : ",") + n;
-      throw recording::RecordingError(path + ": no column '" + axis + "' (the file has " + have + ")");
-    }
+    if (!found) throwNoSuchAxis(rec, axis);
   }
   return in;
+}
+
+void throwNoSuchAxis(const recording::Recording& rec, const std::string& axis) {
+  std::vector<std::string> have = rec.axis_names;
+  for (std::size_t a = 0; a < recording::kAccelColumns.size(); ++a) {
+    const std::string name(recording::kAccelColumns[a]);
+    if (!rec.accel_g[a].empty() && std::find(have.begin(), have.end(), name) == have.end()) have.push_back(name);
+  }
+  std::string message = "--axis '" + axis + "': " + rec.path + " has no column '" + axis + "'";
+  const auto nearest = std::min_element(have.begin(), have.end(), [&](const auto& x, const auto& y) {
+    return formats::editDistance(axis, x) < formats::editDistance(axis, y);
+  });
+  // Only a near miss is a suggestion, as for an unknown command (main.cpp).
+  if (nearest != have.end() && formats::editDistance(axis, *nearest) <= std::max<std::size_t>(1, axis.size() / 3))
+    message += "; did you mean '" + *nearest + "'?";
+  std::string list;
+  for (const auto& n : have) list += (list.empty() ? "" : ",") + n;
+  throw ExitError(ExitCode::Usage, message + " (the file has " + list + "; or all)");
 }
 
 bool stderrIsTerminal() { return ::isatty(STDERR_FILENO) == 1; }

@@ -23,6 +23,10 @@ struct LoadedInput {
 LoadedInput loadInput(const std::string& path, std::optional<double> rate_hz, const std::string& axis,
                       const recording::ReadOptions& read = {});
 
+// The --axis value names no column of `rec`: ExitError(Usage) naming the value, the file,
+// the nearest column when it is a near miss, and every gyro and accelerometer column it has.
+[[noreturn]] void throwNoSuchAxis(const recording::Recording& rec, const std::string& axis);
+
 // Progress on stderr for long inputs, only when stderr is a terminal (a log or a pipe gets
 // nothing): from kProgressSamples samples on, as the reading and the analysis go.
 inline constexpr std::size_t kProgressSamples = std::size_t{1} << 20;

@@ -1,6 +1,7 @@
 // gyroctl: offline analysis of gyro recordings and the gyrod client.
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cctype>
 #include <exception>
 #include <iostream>
 #include <optional>
@@ -48,6 +49,42 @@ std::optional<std::string> unknownCommandMessage(CLI::App& app, int argc, char**
     return message + " (commands: " + all + ")";
   }
   return std::nullopt;
+}
+
+// CLI11's errors in gyroctl's style: one line "gyroctl: ...", and for an option the command
+// does not have, its name and the nearest one when it is a near miss (CLI11 would print
+// "The following arguments were not expected" and a second line). Returns the exit status.
+int reportParseError(CLI::App& app, const CLI::ParseError& e, int argc, char** argv) {
+  if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);  // --help, --version
+  const auto parsed = app.get_subcommands();
+  const CLI::App* command = parsed.empty() ? &app : parsed.front();
+  const std::string where = parsed.empty() ? "" : command->get_name() + ": ";
+  std::vector<std::string> known;
+  for (const CLI::Option* opt : command->get_options()) {
+    for (const auto& n : opt->get_lnames()) known.push_back("--" + n);
+    for (const auto& n : opt->get_snames()) known.push_back("-" + n);
+  }
+  if (dynamic_cast<const CLI::ExtrasError*>(&e) != nullptr) {
+    for (int i = 1; i < argc; ++i) {
+      std::string word = argv[i];
+      // An option word: "--name", "--name=value" or "-x"; "-0.5" is a value.
+      if (word.size() < 2 || word[0] != '-' || !(std::isalpha(static_cast<unsigned char>(word[1])) || word[1] == '-'))
+        continue;
+      word = word.substr(0, word.find('='));
+      if (word == "--" || std::find(known.begin(), known.end(), word) != known.end()) continue;
+      std::string message = "gyroctl: " + where + "unknown option '" + word + "'";
+      const auto nearest = std::min_element(known.begin(), known.end(), [&](const auto& x, const auto& y) {
+        return editDistance(word, x) < editDistance(word, y);
+      });
+      if (nearest != known.end() && editDistance(word, *nearest) <= std::max<std::size_t>(2, word.size() / 3))
+        message += "; did you mean '" + *nearest + "'?";
+      std::cerr << message << " (gyroctl " << (parsed.empty() ? "" : command->get_name() + " ")
+                << "--help lists them)\n";
+      return kExitUsage;
+    }
+  }
+  std::cerr << "gyroctl: " << where << e.what() << '\n';
+  return kExitUsage;
 }
 
 // Prints the error in flight and returns its exit status (tools/gyroctl/exit_codes.hpp).
@@ -99,7 +136,7 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? kExitOk : kExitUsage;
+    return reportParseError(app, e, argc, argv);
   }
   try {
     return run ? run() : kExitUsage;
