@@ -150,24 +150,35 @@ char parseDelimiter(const std::string& text) {
   throw std::invalid_argument("--delimiter " + formats::quotedValue(text) + ": known delimiters are ',', ';', tab");
 }
 
-MappedConversion convertMappedColumns(std::istream& in, const std::string& path, const ColumnMapping& mapping) {
-  if (mapping.time_column.has_value() == mapping.rate_hz.has_value())
-    throw std::invalid_argument("import --columns needs exactly one of --time COLUMN and --rate HZ");
-  if (mapping.rate_hz && !(std::isfinite(*mapping.rate_hz) && *mapping.rate_hz > 0.0))
-    throw std::invalid_argument("--rate: the sample rate must be a positive number of Hz");
-  BoundedLineReader reader(in);
-  std::string_view line;
-  std::size_t line_no = 0;
-  auto next = [&]() -> bool {
-    const auto result = reader.next();
-    if (result == BoundedLineReader::Result::End) return false;
-    ++line_no;
-    if (result == BoundedLineReader::Result::TooLong) failAt(path, line_no, lineTooLongCause(reader.maxBytes()));
-    line = reader.line();
-    return true;
-  };
+namespace {
 
-  // The columns the header must name: the mapped ones and the time column.
+// The lines of a mapped file, numbered from 1; a line longer than the reader's limit stops
+// the import with its line number.
+class NumberedLines {
+ public:
+  NumberedLines(std::istream& in, const std::string& path) : reader_(in), path_(path) {}
+  bool next() {
+    const auto result = reader_.next();
+    if (result == BoundedLineReader::Result::End) return false;
+    ++number_;
+    if (result == BoundedLineReader::Result::TooLong) failAt(path_, number_, lineTooLongCause(reader_.maxBytes()));
+    line_ = reader_.line();
+    return true;
+  }
+  std::string_view line() const { return line_; }
+  std::size_t number() const { return number_; }
+
+ private:
+  BoundedLineReader reader_;
+  const std::string& path_;
+  std::string_view line_;
+  std::size_t number_ = 0;
+};
+
+// The header: the first line within kMaxPreambleLines that names every mapped column and the
+// time column (a logger's preamble comes before it). Its names, copied out of the reader's
+// buffer; `lines` is left on it.
+std::vector<std::string> findMappedHeader(NumberedLines& lines, const std::string& path, const ColumnMapping& mapping) {
   std::vector<std::string> wanted;
   for (const auto& c : mapping.columns) wanted.push_back(c.second);
   if (mapping.time_column) wanted.push_back(*mapping.time_column);
@@ -176,11 +187,10 @@ MappedConversion convertMappedColumns(std::istream& in, const std::string& path,
       return std::find(fields.begin(), fields.end(), w) != fields.end();
     });
   };
-  std::vector<std::string_view> header;
   std::vector<std::string> first_fields;  // of the first non-empty line, for the message
   std::size_t first_line = 0;
-  while (header.empty()) {
-    if (!next() || line_no > kMaxPreambleLines) {
+  for (;;) {
+    if (!lines.next() || lines.number() > kMaxPreambleLines) {
       if (first_line == 0) throw RecordingError(path + ": empty file");
       const std::vector<std::string_view> have(first_fields.begin(), first_fields.end());
       for (const auto& w : wanted)
@@ -190,18 +200,39 @@ MappedConversion convertMappedColumns(std::istream& in, const std::string& path,
                      formats::quotedValue(joined(have)) + ")");
       failAt(path, first_line, "no header line names all of the mapped columns");
     }
-    if (trimField(line).empty()) continue;
-    auto fields = splitAt(line, mapping.delimiter);
+    if (trimField(lines.line()).empty()) continue;
+    const auto fields = splitAt(lines.line(), mapping.delimiter);
     if (first_line == 0) {
-      first_line = line_no;
+      first_line = lines.number();
       first_fields.assign(fields.begin(), fields.end());
     }
-    if (names_all(fields)) header = std::move(fields);
+    if (names_all(fields)) return {fields.begin(), fields.end()};
   }
-  // The header's names live in the reader's buffer: keep copies before the next read.
-  const std::vector<std::string> header_names(header.begin(), header.end());
+}
+
+// The rate of a time column: one over the median spacing of its times (0 when it is not
+// positive).
+double rateFromTimes(const std::vector<double>& times) {
+  if (times.size() < 2) return 0.0;
+  std::vector<double> spacing;
+  spacing.reserve(times.size() - 1);
+  for (std::size_t i = 1; i < times.size(); ++i) spacing.push_back(times[i] - times[i - 1]);
+  std::nth_element(spacing.begin(), spacing.begin() + static_cast<std::ptrdiff_t>(spacing.size() / 2), spacing.end());
+  const double median = spacing[spacing.size() / 2];
+  return median > 0.0 ? 1.0 / median : 0.0;
+}
+
+}  // namespace
+
+MappedConversion convertMappedColumns(std::istream& in, const std::string& path, const ColumnMapping& mapping) {
+  if (mapping.time_column.has_value() == mapping.rate_hz.has_value())
+    throw std::invalid_argument("import --columns needs exactly one of --time COLUMN and --rate HZ");
+  if (mapping.rate_hz && !(std::isfinite(*mapping.rate_hz) && *mapping.rate_hz > 0.0))
+    throw std::invalid_argument("--rate: the sample rate must be a positive number of Hz");
+  NumberedLines lines(in, path);
+  const std::vector<std::string> header_names = findMappedHeader(lines, path, mapping);
   MappedConversion result;
-  result.header_line = line_no;
+  result.header_line = lines.number();
   const auto field_of = [&](const std::string& name) -> std::size_t {
     const auto first = std::find(header_names.begin(), header_names.end(), name);
     // A name given twice in the header: no reader could tell which is the sensor's.
@@ -218,48 +249,48 @@ MappedConversion convertMappedColumns(std::istream& in, const std::string& path,
         c.divisor = divisorFor(t, mapping, c.counts);
         outputs.push_back(c);
       }
-  const std::optional<std::size_t> time_field =
-      mapping.time_column ? std::optional<std::size_t>(field_of(*mapping.time_column)) : std::nullopt;
+  // A plain index (not an optional: gcc 12 takes an optional's value here for uninitialised).
+  const std::size_t time_field = mapping.time_column ? field_of(*mapping.time_column) : 0;
 
   std::string& out = result.csv;
   out = "t";
   for (const auto& c : outputs) out += "," + c.target;
   out += '\n';
   std::vector<double> times;
-  while (next()) {
-    if (trimField(line).empty()) continue;
-    const auto fields = splitAt(line, mapping.delimiter);
+  while (lines.next()) {
+    if (trimField(lines.line()).empty()) continue;
+    const auto fields = splitAt(lines.line(), mapping.delimiter);
     if (fields.size() != header_names.size()) {
       std::ostringstream s;
       s << "expected " << header_names.size() << " fields (as the header on line " << result.header_line << "), found "
         << fields.size();
-      failAt(path, line_no, s.str());
+      failAt(path, lines.number(), s.str());
     }
     const auto number = [&](std::size_t field, const std::string& column) {
       const auto value = parseNumber(fields[field]);
       if (!value)
         failAt(
-            path, line_no,
+            path, lines.number(),
             "column " + formats::quotedValue(column) + ": " + formats::quotedValue(fields[field]) + " is not a number");
       if (!std::isfinite(*value))
-        failAt(path, line_no,
+        failAt(path, lines.number(),
                "column " + formats::quotedValue(column) + ": " + formats::quotedValue(fields[field]) +
                    " is not a finite number");
       return *value;
     };
     double t = 0.0;
-    if (time_field) {
-      t = number(*time_field, *mapping.time_column);
+    if (mapping.time_column) {
+      t = number(time_field, *mapping.time_column);
       times.push_back(t);
     } else {
       t = static_cast<double>(result.samples) / *mapping.rate_hz;
-      if (!std::isfinite(t)) failAt(path, line_no, "--rate is too small: t is not a finite number");
+      if (!std::isfinite(t)) failAt(path, lines.number(), "--rate is too small: t is not a finite number");
     }
     appendNumber(out, t);
     for (const auto& c : outputs) {
       const double value = number(c.field, c.source);
       if (c.counts && (value != std::floor(value) || value < -32768.0 || value > 32767.0))
-        failAt(path, line_no,
+        failAt(path, lines.number(),
                "column " + formats::quotedValue(c.source) + ": " + formats::quotedValue(fields[c.field]) +
                    " is not a 16-bit count (the unit is lsb)");
       out += ',';
@@ -268,17 +299,8 @@ MappedConversion convertMappedColumns(std::istream& in, const std::string& path,
     out += '\n';
     ++result.samples;
   }
-  if (result.samples == 0) failAt(path, line_no, "no samples after the header");
-  if (mapping.rate_hz) {
-    result.rate_hz = *mapping.rate_hz;
-  } else if (times.size() >= 2) {
-    std::vector<double> spacing;
-    spacing.reserve(times.size() - 1);
-    for (std::size_t i = 1; i < times.size(); ++i) spacing.push_back(times[i] - times[i - 1]);
-    std::nth_element(spacing.begin(), spacing.begin() + static_cast<std::ptrdiff_t>(spacing.size() / 2), spacing.end());
-    const double median = spacing[spacing.size() / 2];
-    result.rate_hz = median > 0.0 ? 1.0 / median : 0.0;
-  }
+  if (result.samples == 0) failAt(path, lines.number(), "no samples after the header");
+  result.rate_hz = mapping.rate_hz ? *mapping.rate_hz : rateFromTimes(times);
   return result;
 }
 
