@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 
@@ -179,12 +180,15 @@ std::size_t EventLoop::runOnce(std::chrono::milliseconds timeout) {
     throw errnoError("epoll_wait");
   }
   const auto turn_start = std::chrono::steady_clock::now();
+  std::unique_lock<PriorityInheritanceMutex> state;
+  if (turn_mutex_ != nullptr) state = std::unique_lock(*turn_mutex_);
   // Taken before the events are dispatched: what they defer waits for the next turn.
   running_deferred_.swap(deferred_);
   for (int i = 0; i < n; ++i)
     dispatch(events_[static_cast<std::size_t>(i)].data.u64, events_[static_cast<std::size_t>(i)].events);
   for (auto& callback : running_deferred_) callback();
   running_deferred_.clear();
+  if (state.owns_lock()) state.unlock();
   longest_turn_ =
       std::max(longest_turn_,
                std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - turn_start));

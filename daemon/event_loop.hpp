@@ -24,6 +24,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "daemon/priority_inheritance_mutex.hpp"
 #include "protocol/fd.hpp"
 
 namespace gyrod::daemon {
@@ -76,6 +77,12 @@ class EventLoop {
   // block). What is deferred during a turn never runs in that same turn.
   void defer(std::function<void()> callback);
 
+  // ---- shared state ------------------------------------------------------------------
+  // Holds `mutex` while each turn dispatches (never while it waits for events), so that
+  // another thread that takes it sees the state the callbacks own between two turns. Set
+  // before run(); nullptr (the default): no lock.
+  void guardTurnsWith(PriorityInheritanceMutex* mutex) noexcept { turn_mutex_ = mutex; }
+
   // ---- running -----------------------------------------------------------------------
   // Dispatches events until stop() is called (by a callback). EINTR is retried.
   void run();
@@ -84,8 +91,8 @@ class EventLoop {
   std::size_t runOnce(std::chrono::milliseconds timeout);
   void stop() noexcept { stopped_ = true; }
   bool stopped() const noexcept { return stopped_; }
-  // The longest time one turn spent dispatching (events and deferred work, not the wait):
-  // how long a sample could have waited for the loop.
+  // The longest time one turn spent dispatching (events and deferred work, and the wait for
+  // the turn's mutex, not the wait for events): how long a sample could have waited for the loop.
   std::chrono::nanoseconds longestTurn() const noexcept { return longest_turn_; }
 
  private:
@@ -113,6 +120,7 @@ class EventLoop {
   std::vector<epoll_event> events_;
   std::vector<std::function<void()>> deferred_, running_deferred_;
   std::chrono::nanoseconds longest_turn_{0};
+  PriorityInheritanceMutex* turn_mutex_ = nullptr;
 };
 
 }  // namespace gyrod::daemon

@@ -1,16 +1,21 @@
 #include "daemon/gyrod.hpp"
 
+#include <pthread.h>
 #include <sched.h>
 #include <spdlog/spdlog.h>
+#include <sys/eventfd.h>
 #include <sys/timerfd.h>
 #include <systemd/sd-daemon.h>
 #include <time.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstring>
 #include <limits>
+#include <mutex>
 #include <sstream>
 #include <system_error>
 
@@ -35,6 +40,20 @@ constexpr auto kPumpPeriod = std::chrono::milliseconds(10);
 constexpr std::int64_t kMaxVirtualStepNs = 200'000'000;
 // Real time one pump may spend before returning to the loop.
 constexpr std::int64_t kMaxPumpWorkNs = 20'000'000;
+// What all clients' requests may take of one CPU (daemon/unix_socket_server.hpp): the client
+// thread runs real-time when gyrod does, and must leave the kernel's real-time throttling
+// (95 % of a CPU) far away, whatever is asked of it.
+constexpr double kRequestCpuShare = 0.5;
+LineForClients gapLine(std::uint64_t first_seq, std::uint64_t count, std::string_view reason) {
+  LineForClients line;
+  line.kind = LineForClients::Kind::Gap;
+  line.gap_first_seq = first_seq;
+  line.gap_count = count;
+  const std::size_t n = std::min(reason.size(), protocol::kMaxGapReasonBytes);
+  std::memcpy(line.gap_reason.data(), reason.data(), n);
+  line.gap_reason[n] = '\0';
+  return line;
+}
 
 std::int64_t monotonicNowNs() {
   timespec ts{};
@@ -167,13 +186,19 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
       rate_model_(loadRateModel(config)),
       device_(makeDeviceParts(config)),
       pipeline_(pipelineSettings(config, rate_model_)),
-      noise_refit_(loop_, pipeline_, config.device.rate_hz, [this] { allan_reply_.invalidate(); }),
+      noise_refit_(loop_, pipeline_, config.device.rate_hz,
+                   [this] { refit_cycles_.fetch_add(1, std::memory_order_release); }),
       allan_reply_([this] { return allanReport(); }),
       reload_(
           loop_, kReloadTimeLimit,
           [file = config_file_, rate_hz = config.device.rate_hz] { return loadReload(file, rate_hz); },
           [this](ReloadedFilter&& reloaded) { applyReload(std::move(reloaded)); },
-          [](const std::string& why) { spdlog::error("SIGHUP: keeping the running filter: {}", why); }) {
+          [](const std::string& why) { spdlog::error("SIGHUP: keeping the running filter: {}", why); }),
+      to_clients_(clientQueueLines(recordedSamplesPerSecond(config))),
+      to_clients_fd_(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)),
+      stop_clients_fd_(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)) {
+  if (!to_clients_fd_ || !stop_clients_fd_) throw errnoError("eventfd for the client thread");
+  loop_.guardTurnsWith(&state_mutex_);
   if (!rate_model_.warning.empty()) spdlog::warn("{}", rate_model_.warning);
   start_real_ns_ = monotonicNowNs();
   last_pump_real_ns_ = start_real_ns_;
@@ -186,7 +211,12 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
   ServerOptions server_options;
   server_options.client_buffer_bytes = config_.socket.client_buffer_kib * 1024;
   server_options.max_clients = kMaxSocketClients;  // as the memory budget counts them
-  server_ = std::make_unique<UnixSocketServer>(loop_, openListeningSocket(socket_options), *this, server_options);
+  server_options.request_cpu_share = kRequestCpuShare;
+  server_ =
+      std::make_unique<UnixSocketServer>(client_loop_, openListeningSocket(socket_options), *this, server_options);
+  client_loop_.addFd(to_clients_fd_.get(), EPOLLIN, [this](std::uint32_t) { publishQueuedLines(); });
+  server_->runBetweenClients([this] { publishQueuedLines(); });
+  client_loop_.addFd(stop_clients_fd_.get(), EPOLLIN, [this](std::uint32_t) { client_loop_.stop(); });
 
   if (config_.record.enabled()) {
     // Sized for the samples per second it really receives: the accelerated mock's included.
@@ -225,11 +255,15 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
   });
 
   if (device_.virtual_clock) {
-    loop_.addPeriodicTimer(kPumpPeriod, [this](std::uint64_t) { pumpVirtualClock(); });
+    loop_.addPeriodicTimer(kPumpPeriod, [this](std::uint64_t) {
+      pumpVirtualClock();
+      wakeClientThread();
+    });
   } else {
     loop_.addFd(driver_->pollFd(), EPOLLIN, [this](std::uint32_t) {
       driver_->onDataReady();
       rearmDriverTimer();
+      wakeClientThread();
     });
     driver_timer_ = Fd(::timerfd_create(CLOCK_MONOTONIC, TFD_NONBLOCK | TFD_CLOEXEC));
     if (!driver_timer_) throw std::system_error(errno, std::generic_category(), "timerfd_create");
@@ -238,6 +272,7 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
       [[maybe_unused]] const ssize_t n = ::read(driver_timer_.get(), &expirations, sizeof expirations);
       driver_->onTimer(monotonicNowNs());
       rearmDriverTimer();
+      wakeClientThread();
     });
   }
 
@@ -261,7 +296,11 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
     spdlog::info("configuration: no file (no --config, and no {}): running on the defaults", kDefaultConfigPath);
   else
     spdlog::info("configuration: loaded from {}", config_file_);
-  if (!device_.virtual_clock) spdlog::info("event loop scheduling: {}", loopSchedulingNote());
+  if (!device_.virtual_clock)
+    spdlog::info(
+        "event loop scheduling: {}; the clients' loop runs beside it (one priority below when real-time), "
+        "its requests at most {:.0f} % of a CPU",
+        loopSchedulingNote(), kRequestCpuShare * 100.0);
   spdlog::info("rate stream: {}", pipeline_.rateModel() == RateModel::SensorModel
                                       ? "raw - the bias of the sensor model " + config_.filter.model
                                       : std::string("raw - the bias of [bias] (no filter.model: no temperature term)"));
@@ -273,10 +312,12 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
   if (!device_.virtual_clock) rearmDriverTimer();
 }
 
-Gyrod::~Gyrod() = default;
+Gyrod::~Gyrod() { stopClientThread(); }
 
 int Gyrod::run() {
+  client_thread_ = std::thread([this] { clientThreadMain(); });
   loop_.run();
+  stopClientThread();
   ::sd_notify(0, "STOPPING=1");
   std::string recording;
   if (recorder_) {
@@ -292,9 +333,15 @@ int Gyrod::run() {
         s.written, s.dropped, s.lost_to_errors, s.write_errors,
         last_error.empty() ? std::string() : ", last: " + last_error, stop_ms);
   }
-  spdlog::info("stopped after {} samples, {} gaps ({} samples lost by the device){}; longest loop turn {} us",
-               samples_published_, gaps_, missing_samples_, recording,
-               std::chrono::duration_cast<std::chrono::microseconds>(loop_.longestTurn()).count());
+  const std::string behind = behind_total_ == 0
+                                 ? std::string()
+                                 : fmt::format("; {} lines not delivered to clients (delivery_behind)", behind_total_);
+  spdlog::info(
+      "stopped after {} samples, {} gaps ({} samples lost by the device){}{}; longest loop turn {} us (clients' "
+      "loop: {} us)",
+      samples_published_, gaps_, missing_samples_, behind, recording,
+      std::chrono::duration_cast<std::chrono::microseconds>(loop_.longestTurn()).count(),
+      std::chrono::duration_cast<std::chrono::microseconds>(client_loop_.longestTurn()).count());
   return 0;
 }
 
@@ -325,6 +372,9 @@ void Gyrod::pumpVirtualClock() {
   }
   while (budget > 0) {
     if (monotonicNowNs() - now > kMaxPumpWorkNs) break;  // the rest of this slice is dropped
+    // Sensor time can wait for the clients, a real chip's FIFO cannot: the mock runs no further
+    // ahead of the client thread than half of the hand-over holds.
+    if (to_clients_.sizeSeenByProducer() > to_clients_.capacity() / 2) break;
     const std::int64_t step = std::min(budget, max_virtual_step_ns_);
     device_.virtual_clock->advanceNs(step);
     budget -= step;
@@ -371,7 +421,9 @@ void Gyrod::onSample(const driver::GyroSample& s) {
   r.still = out.still;
   r.time_s = s.wall_ns != 0 ? static_cast<double>(s.wall_ns) * 1e-9 : kNaN;
   r.accel_g = s.accel_g;
-  server_->publishRate(r);
+  LineForClients line;
+  line.rate = r;
+  queueForClients(line);
   if (recorder_) recorder_->pushSample(recordedSample(r, s.wall_ns));
   ++samples_published_;
   last_temp_c_ = r.temp_c;
@@ -383,12 +435,77 @@ void Gyrod::onGap(const driver::SampleGap& gap) {
   ++gaps_;
   missing_samples_ += gap.count;
   const std::string_view reason = driver::gapCauseName(gap.cause);  // a [a-z0-9_] token (docs/protocol.md)
-  server_->publishGap({gap.first_seq, gap.count, reason});
+  queueForClients(gapLine(gap.first_seq, gap.count, reason));
   if (recorder_) {
     const double t = last_t_s_ ? *last_t_s_ + 1.0 / config_.device.rate_hz : 0.0;
     recorder_->pushGap(gap.first_seq, t, static_cast<std::uint32_t>(std::min<std::uint64_t>(gap.count, UINT32_MAX)),
                        reason);
   }
+}
+
+void Gyrod::queueForClients(const LineForClients& line) {
+  clients_to_wake_ = true;
+  if (behind_count_ > 0) {  // lines the ring could not take before: one GAP for them first
+    if (!to_clients_.tryPush(gapLine(behind_first_seq_, behind_count_, protocol::kDeliveryBehindGapReason))) {
+      behind_count_ += line.kind == LineForClients::Kind::Rate ? 1 : line.gap_count;
+      behind_total_ += line.kind == LineForClients::Kind::Rate ? 1 : 0;
+      return;
+    }
+    behind_count_ = 0;
+  }
+  if (to_clients_.tryPush(line)) return;
+  const bool rate = line.kind == LineForClients::Kind::Rate;
+  behind_first_seq_ = rate ? line.rate.seq : line.gap_first_seq;
+  behind_count_ = rate ? 1 : line.gap_count;
+  if (rate) ++behind_total_;
+  spdlog::warn("the client thread is {} lines behind the samples: the next lines are sent as a GAP delivery_behind",
+               to_clients_.capacity());
+}
+
+void Gyrod::wakeClientThread() {
+  if (!clients_to_wake_) return;
+  clients_to_wake_ = false;
+  const std::uint64_t one = 1;
+  [[maybe_unused]] const ssize_t n = ::write(to_clients_fd_.get(), &one, sizeof one);
+}
+
+void Gyrod::publishQueuedLines() {
+  std::uint64_t count = 0;
+  [[maybe_unused]] const ssize_t n = ::read(to_clients_fd_.get(), &count, sizeof count);
+  LineForClients line;
+  while (to_clients_.tryPop(line)) {
+    if (line.kind == LineForClients::Kind::Rate)
+      server_->publishRate(line.rate);
+    else
+      server_->publishGap({line.gap_first_seq, line.gap_count, std::string_view(line.gap_reason.data())});
+  }
+}
+
+void Gyrod::clientThreadMain() {
+  // One real-time priority below the samples when gyrod runs real-time, so that a sample's line
+  // reaches its clients at once on a busy machine; the requests' CPU share (kRequestCpuShare)
+  // keeps a flood of them from making this a real-time task that takes a whole CPU.
+  int policy = SCHED_OTHER;
+  sched_param param{};
+  if (::pthread_getschedparam(::pthread_self(), &policy, &param) == 0 && (policy == SCHED_FIFO || policy == SCHED_RR)) {
+    param.sched_priority = std::max(::sched_get_priority_min(policy), param.sched_priority - 1);
+    ::pthread_setschedparam(::pthread_self(), policy, &param);
+  }
+  try {
+    client_loop_.run();
+  } catch (const std::exception& e) {
+    // The server handles every client's errors itself: this is a fault of the daemon. Stop it
+    // (SIGTERM's path, so that the recording is closed) rather than stream to nobody.
+    spdlog::critical("the client thread failed: {}; stopping", e.what());
+    ::kill(::getpid(), SIGTERM);
+  }
+}
+
+void Gyrod::stopClientThread() {
+  if (!client_thread_.joinable()) return;
+  const std::uint64_t one = 1;
+  [[maybe_unused]] const ssize_t n = ::write(stop_clients_fd_.get(), &one, sizeof one);
+  client_thread_.join();
 }
 
 void Gyrod::onStatus(const driver::DeviceStatus& status) {
@@ -493,7 +610,17 @@ void Gyrod::logStillPeriodVerdict() {
   }
 }
 
+std::string Gyrod::allanReplyLine() {
+  const std::uint64_t cycles = refit_cycles_.load(std::memory_order_acquire);
+  if (cycles != allan_cycle_served_) {  // a refit has completed since the line was built
+    allan_reply_.invalidate();
+    allan_cycle_served_ = cycles;
+  }
+  return allan_reply_.line();
+}
+
 AllanReport Gyrod::allanReport() {
+  std::unique_lock state(state_mutex_);
   AllanWindowDeviations d = pipeline_.allanWindowDeviations();
   AllanReport report;
   report.tau0_s = d.tau0_s;
@@ -518,6 +645,7 @@ AllanReport Gyrod::allanReport() {
 }
 
 StatusReport Gyrod::statusReport() {
+  const std::lock_guard state(state_mutex_);
   StatusReport r;
   r.uptime_s = static_cast<double>(monotonicNowNs() - start_real_ns_) * 1e-9;
   r.samples = samples_published_;

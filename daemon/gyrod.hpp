@@ -1,24 +1,38 @@
 #pragma once
-// gyrod wired together: device → driver → pipeline → socket clients and recorder, all in
-// one epoll loop (daemon/event_loop.hpp). Data flows one way:
+// gyrod wired together: device → driver → pipeline → socket clients and recorder. Data flows
+// one way:
 //   FIFO bytes → samples (driver/) → filters and statistics (daemon/sample_pipeline) →
 //   RATE/GAP lines (daemon/unix_socket_server) and the recording (daemon/recorder).
+// Two threads, each with its own epoll loop (daemon/event_loop.hpp):
+//  - the sample thread (the process's main thread, SCHED_FIFO under the systemd unit): the
+//    device, the pipeline, the refit and reload results, signals and the watchdog. It hands
+//    each sample to the client thread through a lock-free ring and never touches a client;
+//  - the client thread (SCHED_OTHER): the socket, every client's requests and buffers, the
+//    RATE lines' formatting. However many clients flood it, it only ever competes with the
+//    sample thread for the state mutex, which it holds for the copy of one STATUS or ALLAN
+//    report (priority inheritance: daemon/priority_inheritance_mutex.hpp).
 // Nothing on the per-sample path allocates or blocks: the recorder is a lock-free ring
-// drained by its own thread, every client has a bounded buffer.
+// drained by its own thread, so is the hand-over to the clients, and every client has a
+// bounded buffer.
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 
 #include "daemon/allan_reply_cache.hpp"
+#include "daemon/client_handover.hpp"
 #include "daemon/config.hpp"
 #include "daemon/device_backend.hpp"
 #include "daemon/event_loop.hpp"
 #include "daemon/memory_budget.hpp"
 #include "daemon/noise_refit_worker.hpp"
+#include "daemon/priority_inheritance_mutex.hpp"
 #include "daemon/recorder.hpp"
 #include "daemon/reload_worker.hpp"
 #include "daemon/sample_pipeline.hpp"
+#include "daemon/spsc_ring.hpp"
 #include "daemon/unix_socket_server.hpp"
 #include "driver/mpu6050_driver.hpp"
 
@@ -57,9 +71,9 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   void onSample(const driver::GyroSample& sample) override;
   void onGap(const driver::SampleGap& gap) override;
   void onStatus(const driver::DeviceStatus& status) override;
-  // ServerContent
+  // ServerContent: called on the client thread; each takes the state mutex for its copy.
   AllanReport allanReport() override;
-  std::string allanReplyLine() override { return allan_reply_.line(); }
+  std::string allanReplyLine() override;
   StatusReport statusReport() override;
 
  private:
@@ -74,10 +88,19 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   void applyReload(ReloadedFilter&& reloaded);
   void petWatchdog();
   void notifyReadyOnce();
+  // The hand-over to the client thread (sample thread: queue and wake; client thread: take).
+  void queueForClients(const LineForClients& line);
+  void wakeClientThread();
+  void publishQueuedLines();
+  void clientThreadMain();
+  void stopClientThread();
 
   GyrodConfig config_;
   std::string config_file_;
-  EventLoop loop_;
+  // Held by the sample loop while it dispatches, by the client thread while it copies a report.
+  PriorityInheritanceMutex state_mutex_;
+  EventLoop loop_;              // the sample thread's
+  EventLoop client_loop_;       // the client thread's
   LoadedRateModel rate_model_;  // first: a bad model file is a configuration error (exit 78)
   DeviceParts device_;
   std::unique_ptr<driver::Mpu6050Driver> driver_;
@@ -88,6 +111,16 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   std::unique_ptr<Recorder> recorder_;
   ReloadWorker<ReloadedFilter> reload_;
   Fd driver_timer_;  // absolute CLOCK_MONOTONIC deadline of the driver (real-time clocks)
+  SpscRing<LineForClients> to_clients_;
+  Fd to_clients_fd_;                    // eventfd: lines wait in to_clients_
+  Fd stop_clients_fd_;                  // eventfd: the client thread's loop stops
+  bool clients_to_wake_ = false;        // sample thread: lines queued since the last wake-up
+  std::uint64_t behind_first_seq_ = 0;  // sample thread: lines the ring could not take,
+  std::uint64_t behind_count_ = 0;      //   sent as one GAP delivery_behind when it can
+  std::uint64_t behind_total_ = 0;
+  std::atomic<std::uint64_t> refit_cycles_{0};            // completed by the sample thread
+  std::uint64_t allan_cycle_served_ = ~std::uint64_t{0};  // client thread: the cached line's cycle
+  std::thread client_thread_;
 
   std::int64_t start_real_ns_ = 0;
   std::int64_t last_pump_real_ns_ = 0;

@@ -18,13 +18,14 @@ namespace {
 
 // Under systemd (JOURNAL_STREAM set) log straight to the journal with priorities and
 // without our own timestamps (journald adds them); otherwise timestamped lines on stderr.
+// Thread-safe sinks: the sample thread, the client thread and the workers all log.
 void setUpLogging(spdlog::level::level_enum level) {
   std::shared_ptr<spdlog::logger> logger;
   if (std::getenv("JOURNAL_STREAM") != nullptr) {
-    logger = std::make_shared<spdlog::logger>("gyrod", std::make_shared<spdlog::sinks::systemd_sink_st>("gyrod"));
+    logger = std::make_shared<spdlog::logger>("gyrod", std::make_shared<spdlog::sinks::systemd_sink_mt>("gyrod"));
     logger->set_pattern("%v");
   } else {
-    logger = spdlog::stderr_color_st("gyrod");
+    logger = spdlog::stderr_color_mt("gyrod");
     logger->set_pattern("%Y-%m-%d %H:%M:%S.%e %^%l%$ %v");
   }
   logger->set_level(level);

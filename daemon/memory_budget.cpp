@@ -10,6 +10,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include "daemon/client_handover.hpp"
 #include "daemon/recorder.hpp"
 #include "formats/toml_document.hpp"
 #include "processing/allan/rolling_allan.hpp"
@@ -136,6 +137,11 @@ MemoryNeed memoryNeeded(const GyrodConfig& c) {
            std::to_string(c.socket.client_buffer_kib) + " KiB",
        "socket.client_buffer_kib", std::to_string(c.socket.client_buffer_kib),
        static_cast<double>(kMaxSocketClients) * static_cast<double>(c.socket.client_buffer_kib) * 1024.0});
+  const auto handover = static_cast<double>(clientQueueLines(recordedSamplesPerSecond(c)));
+  need.items.push_back({"hand-over to the client thread: " + count(handover) + " lines x " +
+                            std::to_string(sizeof(LineForClients)) + " B",
+                        "device.rate_hz", formats::shortest(c.device.rate_hz),
+                        handover * static_cast<double>(sizeof(LineForClients))});
   if (c.record.enabled()) {
     const auto ring = static_cast<double>(recorderOptions(c.record, recordedSamplesPerSecond(c)).ring_capacity);
     need.items.push_back(

@@ -60,9 +60,27 @@ bool NoiseRefitWorker::startCycle() {
 void NoiseRefitWorker::startJob(std::size_t job) {
   job_ = job;
   const auto stream = static_cast<AllanStream>(job % kStreams);
+  // The worker does not touch copy while work is unset: no lock for the copy itself.
+  shared_->copy.beginCopyFrom(pipeline_.allanStream(job / kStreams, stream));
+  copyStep();
+}
+
+void NoiseRefitWorker::copyStep() {
+  if (!job_) return;
+  const auto stream = static_cast<AllanStream>(*job_ % kStreams);
+  const auto& source = pipeline_.allanStream(*job_ / kStreams, stream);
+  switch (shared_->copy.continueCopyFrom(source, kCopyPointsPerTurn)) {
+    case processing::RollingOverlappingAllan::CopyStep::Overrun: shared_->copy.beginCopyFrom(source); [[fallthrough]];
+    case processing::RollingOverlappingAllan::CopyStep::Copying:
+      // The rest after the next turn's events: the samples never wait for more than one step.
+      loop_.defer([this, alive = std::weak_ptr<bool>(alive_)] {
+        if (!alive.expired()) copyStep();
+      });
+      return;
+    case processing::RollingOverlappingAllan::CopyStep::Done: break;
+  }
   {
     const std::lock_guard lock(shared_->mutex);
-    shared_->copy = pipeline_.allanStream(job / kStreams, stream);  // same sizes: reuses copy's memory
     shared_->fit_terms = stream == AllanStream::Raw;
     shared_->work = true;
   }

@@ -2,13 +2,15 @@
 // The noise refit off the event loop. refitNoiseTerms takes seconds at a 1 h window at
 // 1 kHz (it identifies the noise type on the whole window at every τ: about 1 s per axis
 // for 3.6 M samples on an x86-64 core, several on a Pi), far longer than the chip's FIFO
-// lasts (~128 ms at 1 kHz); on the loop it made gyrod lose samples. Here the loop only
-// copies one stream's state into a buffer allocated once (~20 ms for 3.6 M samples), and a
-// worker thread refits the copy. The axes are refitted one after the other, each raw stream
+// lasts (~73 ms at 1 kHz); on the loop it made gyrod lose samples. Here the loop only
+// copies one stream's state into a buffer allocated once, in steps of kCopyPointsPerTurn
+// phase points between which the loop serves its samples (all at once, 58 MB at 3.6 M
+// samples, it took a 10-20 ms turn), and a worker thread refits the copy. The axes are refitted one after the other, each raw stream
 // (the noise terms and types) then its mean and Kalman streams (their noise types, for the
 // ALLAN reply's intervals); the result of each is applied on the loop, so the pipeline is
 // only ever touched by the loop thread. The numbers are exactly those of
-// SamplePipeline::refitNoiseTerms on the state at the moment of the copy.
+// SamplePipeline::refitNoiseTerms on the state at the moment the copy began
+// (RollingOverlappingAllan::beginCopyFrom).
 // Stopping does not wait for a refit in progress (see ~NoiseRefitWorker): gyrod's exit on
 // SIGTERM must not wait seconds for a result nobody will read.
 #include <condition_variable>
@@ -26,6 +28,9 @@ namespace gyrod::daemon {
 
 class NoiseRefitWorker {
  public:
+  // Phase points copied per loop turn (16 B each: 1 MB, a fraction of a millisecond).
+  static constexpr std::size_t kCopyPointsPerTurn = std::size_t{1} << 16;
+
   // What refits one axis on the worker thread: refitNoiseTerms, or a stand-in in tests.
   using RefitFunction =
       std::function<NoiseRefit(const processing::RollingOverlappingAllan&, double tau0_s, bool fit_terms)>;
@@ -65,6 +70,7 @@ class NoiseRefitWorker {
   };
 
   void startJob(std::size_t job);  // job = axis·kStreams + stream
+  void copyStep();
   void onAxisDone();
   static void threadMain(const std::shared_ptr<Shared>& shared);
 
@@ -74,6 +80,8 @@ class NoiseRefitWorker {
   std::optional<std::size_t> job_;  // the (axis, stream) being refitted (loop thread only)
   std::shared_ptr<Shared> shared_;
   std::thread thread_;
+  // Deferred copy steps may outlive the worker in the loop: they check this first.
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
 
 }  // namespace gyrod::daemon

@@ -56,6 +56,10 @@ class SpscRing {
   }
 
   std::size_t capacity() const noexcept { return capacity_; }
+  // Producer only: how many values wait, at least (the consumer may have taken some since).
+  std::size_t sizeSeenByProducer() const noexcept {
+    return tail_.load(std::memory_order_relaxed) - head_.load(std::memory_order_acquire);
+  }
 
  private:
   // Each side's counter and its cached copy of the other side's counter share a cache

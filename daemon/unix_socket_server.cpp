@@ -67,6 +67,9 @@ UnixSocketServer::UnixSocketServer(EventLoop& loop, ListeningSocket listening, S
                                 " bytes is below the minimum of " + std::to_string(kMinClientBufferBytes) + " bytes");
   if (options_.max_clients == 0)
     throw std::invalid_argument("the socket server needs room for at least 1 client, got 0");
+  if (!(options_.request_cpu_share > 0.0 && options_.request_cpu_share <= 1.0))
+    throw std::invalid_argument("the socket server's request CPU share must be in (0, 1], got " +
+                                std::to_string(options_.request_cpu_share));
   if (options_.max_requests_per_turn == 0)
     throw std::invalid_argument("the socket server needs at least 1 request per client per turn, got 0");
   // Reserved once, so that adding and removing clients never reallocates the list.
@@ -152,7 +155,27 @@ void UnixSocketServer::onClientEvents(Client& c, std::uint32_t events) {
   reapDeadClients();
 }
 
+bool UnixSocketServer::requestTimeLeft() {
+  if (options_.request_cpu_share >= 1.0) return true;
+  const auto now = std::chrono::steady_clock::now();
+  const auto earned = std::chrono::duration_cast<std::chrono::nanoseconds>(now - request_time_refilled_);
+  request_time_refilled_ = now;
+  request_time_left_ = std::min(
+      kMaxRequestTimeBanked,
+      request_time_left_ + std::chrono::duration_cast<std::chrono::nanoseconds>(earned * options_.request_cpu_share));
+  return request_time_left_ > std::chrono::nanoseconds::zero();
+}
+
 void UnixSocketServer::serveRequests(Client& c) {
+  if (!requestTimeLeft()) return deferRequests(c);
+  const auto start = std::chrono::steady_clock::now();
+  answerRequests(c);
+  if (options_.request_cpu_share < 1.0)
+    request_time_left_ -=
+        std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start);
+}
+
+void UnixSocketServer::answerRequests(Client& c) {
   std::size_t budget = options_.max_requests_per_turn;
   int reads = 0;
   while (!c.closing && !c.dead && c.held_reply.empty()) {
@@ -201,16 +224,30 @@ void UnixSocketServer::deferRequests(Client& c) {
   updateInterest(c);  // its input is served from the deferred pass, not from epoll, meanwhile
   if (deferred_requests_pending_) return;
   deferred_requests_pending_ = true;
-  loop_.defer([this, alive = std::weak_ptr<bool>(alive_)] {
+  auto serve = [this, alive = std::weak_ptr<bool>(alive_)] {
     if (!alive.expired()) serveDeferredRequests();
-  });
+  };
+  if (request_time_left_ > std::chrono::nanoseconds::zero()) {
+    loop_.defer(std::move(serve));
+    return;
+  }
+  // The requests' share of the CPU is spent: wait until it is earned back (at least 1 ms).
+  const auto wait = std::max<std::chrono::nanoseconds>(
+      std::chrono::milliseconds(1),
+      std::chrono::duration_cast<std::chrono::nanoseconds>(-request_time_left_ / options_.request_cpu_share));
+  loop_.addOneShotTimer(wait, [serve](std::uint64_t) { serve(); });
 }
 
 void UnixSocketServer::serveDeferredRequests() {
   deferred_requests_pending_ = false;
-  // By index: serving never adds or removes clients (reaping waits until the end).
-  for (std::size_t i = 0; i < clients_.size(); ++i) {
-    Client& c = *clients_[i];
+  // By index: serving never adds or removes clients (reaping waits until the end). Each pass
+  // starts after the client served first last time: when the requests' CPU share runs out
+  // within a pass, the clients late in the list are not always the ones left waiting.
+  const std::size_t n = clients_.size();
+  const std::size_t start = n == 0 ? 0 : deferred_pass_start_ % n;
+  deferred_pass_start_ = start + 1;
+  for (std::size_t k = 0; k < n; ++k) {
+    Client& c = *clients_[(start + k) % n];
     if (!c.deferred || c.dead) continue;
     c.deferred = false;
     if (c.held_reply.empty() && !c.closing) serveRequests(c);

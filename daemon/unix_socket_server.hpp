@@ -16,6 +16,11 @@
 //  - The event loop never waits on a client: each turn a client gets at most
 //    ServerOptions::max_requests_per_turn requests answered; the rest of its input is read
 //    and answered on later turns (EventLoop::defer).
+//  - Requests together take at most ServerOptions::request_cpu_share of a CPU over time
+//    (a token bucket of request time, at most kMaxRequestTimeBanked banked): past it, they
+//    wait for a timer while RATE and GAP lines go on. gyrod's client thread may run
+//    SCHED_FIFO for prompt delivery of the samples; a flood of requests then cannot make it
+//    a real-time task that takes a whole CPU (and the kernel's real-time throttling with it).
 // A dropped client has received a prefix of its stream; its last line may be incomplete if
 // the kernel had taken part of it (docs/protocol.md: a line without its newline at EOF is
 // to be discarded).
@@ -23,6 +28,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -100,6 +106,7 @@ struct ServerOptions {
   std::size_t client_buffer_bytes = 256 * 1024;  // per client, preallocated
   std::size_t max_clients = 32;                  // more are refused with ERROR too_many_clients
   std::size_t max_requests_per_turn = 16;        // per client per loop turn; the rest waits
+  double request_cpu_share = 1.0;                // of one CPU, for all requests; 1: no limit
   // A client whose reply has waited this long for room, with none of its output read
   // meanwhile, is dropped as not reading.
   std::chrono::milliseconds stalled_reply_timeout = std::chrono::seconds(10);
@@ -123,6 +130,10 @@ class UnixSocketServer {
   // std::invalid_argument for a malformed gap (see formatGapLine).
   void publishGap(const GapEvent& gap);
 
+  // Runs after each client's requests are served: gyrod publishes the samples that came
+  // meanwhile, so that a turn over many flooding clients does not hold the RATE lines back.
+  void runBetweenClients(std::function<void()> callback) { between_clients_ = std::move(callback); }
+
   ServerStatus serverStatus() const;
   std::size_t clientCount() const noexcept { return clients_.size(); }
   std::size_t watcherCount() const noexcept;
@@ -134,8 +145,12 @@ class UnixSocketServer {
   void onListenerReadable();
   void acceptClient(Fd fd);
   void onClientEvents(Client& c, std::uint32_t events);
-  // Answers at most max_requests_per_turn requests of c, reading its socket as needed.
+  // Answers at most max_requests_per_turn requests of c, reading its socket as needed,
+  // when the requests' CPU share allows; otherwise defers c.
   void serveRequests(Client& c);
+  void answerRequests(Client& c);
+  // Earns request time since the last call; true when some is left.
+  bool requestTimeLeft();
   void deferRequests(Client& c);
   void serveDeferredRequests();
   void handleLine(Client& c, std::string_view line);
@@ -165,6 +180,11 @@ class UnixSocketServer {
   std::optional<EventLoop::SourceId> accept_pause_timer_;
   std::optional<EventLoop::SourceId> stall_check_timer_;
   bool deferred_requests_pending_ = false;
+  std::size_t deferred_pass_start_ = 0;
+  std::function<void()> between_clients_;
+  static constexpr std::chrono::nanoseconds kMaxRequestTimeBanked = std::chrono::milliseconds(2);
+  std::chrono::nanoseconds request_time_left_ = kMaxRequestTimeBanked;
+  std::chrono::steady_clock::time_point request_time_refilled_ = std::chrono::steady_clock::now();
   // Deferred callbacks may outlive the server in the loop: they check this first.
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };

@@ -62,6 +62,9 @@ struct GapEvent {
   std::string_view reason;
 };
 inline constexpr std::size_t kMaxGapReasonBytes = 48;
+// The one gap reason that is not the driver's (driver::gapCauseName): the samples were read
+// and recorded, but the daemon's delivery to its clients fell behind and could not keep them.
+inline constexpr std::string_view kDeliveryBehindGapReason = "delivery_behind";
 
 // Longest possible RATE line: 23 doubles of ≤ 24 characters in shortest round-trip form
 // (552), "time" (≤ 24: fixed with 6 decimals below 1e15, else shortest), a 20-digit seq,

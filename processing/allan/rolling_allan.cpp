@@ -1,5 +1,6 @@
 #include "processing/allan/rolling_allan.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <iomanip>
@@ -156,6 +157,43 @@ void RollingOverlappingAllan::reset() {
   head_ = 0;
   total_count_ = 0;
   reference_ = 0.0;
+  ++resets_;
+}
+
+void RollingOverlappingAllan::beginCopyFrom(const RollingOverlappingAllan& source) {
+  if (source.window_capacity_ != window_capacity_ || source.cluster_sizes_ != cluster_sizes_)
+    throw std::invalid_argument("a rolling Allan window can be copied in steps only from one of the same window (" +
+                                std::to_string(window_capacity_) + " samples) and cluster sizes; the source has " +
+                                std::to_string(source.window_capacity_) + " samples");
+  window_sums_ = source.window_sums_;  // same sizes: no allocation
+  since_start_sums_ = source.since_start_sums_;
+  head_ = source.head_;
+  total_count_ = source.total_count_;
+  reference_ = source.reference_;
+  copy_source_resets_ = source.resets_;
+  copy_next_ = 0;
+}
+
+RollingOverlappingAllan::CopyStep RollingOverlappingAllan::continueCopyFrom(const RollingOverlappingAllan& source,
+                                                                            std::size_t points) {
+  if (!copy_source_resets_ || source.window_capacity_ != window_capacity_)
+    throw std::logic_error("continueCopyFrom without a beginCopyFrom from the same window");
+  if (source.resets_ != *copy_source_resets_ || source.total_count_ < total_count_) return CopyStep::Overrun;
+  // Push k after the beginning overwrote the point k − 1 places after the oldest one.
+  if (source.total_count_ - total_count_ > copy_next_) return CopyStep::Overrun;
+  const std::size_t size = ring_.size();
+  const std::size_t end = std::min(size, copy_next_ + points);
+  for (std::size_t offset = copy_next_; offset < end;) {  // at most two contiguous runs
+    const std::size_t slot = (head_ + 1 + offset) % size;
+    const std::size_t run = std::min(end - offset, size - slot);
+    const auto from = source.ring_.begin() + static_cast<std::ptrdiff_t>(slot);
+    std::copy(from, from + static_cast<std::ptrdiff_t>(run), ring_.begin() + static_cast<std::ptrdiff_t>(slot));
+    offset += run;
+  }
+  copy_next_ = end;
+  if (copy_next_ < size) return CopyStep::Copying;
+  copy_source_resets_.reset();
+  return CopyStep::Done;
 }
 
 std::size_t RollingOverlappingAllan::windowCount() const {

@@ -41,6 +41,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -152,6 +153,19 @@ class RollingOverlappingAllan {
   // Throws std::invalid_argument for τ₀ not finite and > 0 or confidence outside (0, 1).
   Snapshot snapshot(double tau0_s, const AllanOptions& options = {}) const;
 
+  // Copying in steps: this object becomes `source` as it was at beginCopyFrom, copied over
+  // several calls while `source` goes on taking samples, so that no single call copies the
+  // whole window (58 MB at one hour of 1 kHz). beginCopyFrom takes the small state (sums,
+  // counts, the newest point's slot); each continueCopyFrom copies at most `points` phase
+  // points of the ring, oldest first. A push overwrites the source's oldest point, which the
+  // copy has taken by then while it stays ahead of the pushes; the result is then bit for bit
+  // the source at beginCopyFrom. Overrun: the source overwrote a point not yet copied, or was
+  // reset; begin again. Throws std::invalid_argument when `source` has another window or
+  // other cluster sizes, and std::logic_error when no copy was begun from it.
+  enum class CopyStep { Copying, Done, Overrun };
+  void beginCopyFrom(const RollingOverlappingAllan& source);
+  CopyStep continueCopyFrom(const RollingOverlappingAllan& source, std::size_t points);
+
  private:
   struct PhasePoint {  // x = hi + lo, unevaluated
     double hi = 0.0;
@@ -173,6 +187,11 @@ class RollingOverlappingAllan {
   std::size_t head_ = 0;          // slot of the newest phase point, x_total
   std::uint64_t total_count_ = 0;
   double reference_ = 0.0;  // the first sample, subtracted from every sample
+  std::uint64_t resets_ = 0;
+  // A copy in steps: the source's resets_ at its beginning, and the ring points copied so far
+  // (counted from the oldest at the beginning).
+  std::optional<std::uint64_t> copy_source_resets_;
+  std::size_t copy_next_ = 0;
 };
 
 }  // namespace gyrod::processing

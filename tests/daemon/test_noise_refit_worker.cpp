@@ -140,3 +140,38 @@ TEST(NoiseRefitWorker, AnIdleWorkerStopsAndAnEmptyRefitFunctionIsRefused) {
   { NoiseRefitWorker idle(loop, p, 50.0, {}); }
   EXPECT_THROW(NoiseRefitWorker(loop, p, 50.0, {}, NoiseRefitWorker::RefitFunction{}), std::invalid_argument);
 }
+
+// A window larger than one turn's copy: the copy runs over several loop turns while samples keep
+// coming between them, and the refit is still exactly that of the state when the cycle began.
+TEST(NoiseRefitWorker, ACopyOverSeveralTurnsIsTheStateWhenTheCycleBegan) {
+  PipelineSettings big = settings();
+  big.allan_window_samples = 3 * NoiseRefitWorker::kCopyPointsPerTurn + 1000;
+  SamplePipeline on_loop(big), off_loop(big);
+  const std::uint64_t filled = big.allan_window_samples + 5000;
+  feed(on_loop, 0, filled, 3);
+  feed(off_loop, 0, filled, 3);
+  on_loop.refitNoiseTerms();
+
+  EventLoop loop;
+  int cycles = 0, turns = 0;
+  NoiseRefitWorker worker(loop, off_loop, 50.0, [&] { ++cycles; });
+  ASSERT_TRUE(worker.startCycle());
+  std::uint64_t next = filled;
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
+  while (cycles == 0 && std::chrono::steady_clock::now() < deadline) {
+    feed(off_loop, next, 20, static_cast<unsigned>(next));  // samples between the turns
+    next += 20;
+    loop.runOnce(10ms);
+    ++turns;
+  }
+  ASSERT_EQ(cycles, 1);
+  EXPECT_GE(turns, 4);
+  const auto& expected = on_loop.noiseTerms()[0];
+  const auto& got = off_loop.noiseTerms()[0];
+  ASSERT_TRUE(expected.has_value());
+  ASSERT_TRUE(got.has_value());
+  for (const auto term : gyrod::processing::kAllNoiseTerms) {
+    EXPECT_EQ(got->value.get(term), expected->value.get(term));
+    EXPECT_EQ(got->uncertainty.get(term), expected->uncertainty.get(term));
+  }
+}

@@ -1,10 +1,12 @@
-// Issue 16: the event loop never waits on a client. gyrod on the real-time mock at 1 kHz
-// with a 1 h Allan window (3.6 M samples per stream, the goal of the issue) and a refit
-// every second, while clients flood it: ALLAN and STATUS requests in batches of 50 per
-// write, a client pipelining 10,000 requests per write, one that never reads its replies
-// and one that watches but never reads. The chip's FIFO lasts ~73 ms at 1 kHz (1024 bytes of
-// 14-byte accel + gyro frames): any loop turn longer than that loses samples, which a watching client
-// sees as a GAP line. Asserts none, and contiguous sequence numbers.
+// The samples never wait on a client. gyrod on the real-time mock while clients flood it:
+// ALLAN and STATUS requests in batches of 50 per write, a client pipelining 10,000 requests per
+// write, one that never reads its replies and one that watches but never reads.
+//  - 1 kHz with a 1 h Allan window (3.6 M samples per stream) and a refit every second: the
+//    chip's FIFO lasts ~73 ms (1024 bytes of 14-byte accel + gyro frames);
+//  - 8 kHz (DLPF 0) with a 60 s window: the FIFO lasts ~9 ms.
+// Any sample-loop turn longer than that loses samples, which a watching client sees as a GAP
+// line. Asserts none, contiguous sequence numbers, a loop turn far inside the FIFO, and the
+// watcher's edge → line latency.
 //
 // Real time (mock speed 1), because the accelerated mock slows its virtual clock down when
 // the loop is late instead of overflowing the FIFO. The window cannot fill in the test's
@@ -35,13 +37,19 @@ namespace {
 
 constexpr auto kFloodTime = 12s;
 
-std::string floodConfig(const std::filesystem::path& dir) {
+struct FloodSetup {
+  int rate_hz = 1000;
+  int dlpf = 1;
+  int window_s = 3600;
+};
+
+std::string floodConfig(const std::filesystem::path& dir, const FloodSetup& setup) {
   std::ostringstream c;
-  c << "[device]\nbackend = \"mock\"\nrate_hz = 1000\n"
+  c << "[device]\nbackend = \"mock\"\nrate_hz = " << setup.rate_hz << "\ndlpf = " << setup.dlpf << "\n"
     << "[bias]\nsource = \"config\"\nvalues = [-3.34, 1.09, -0.5]\n"
     << "[filter]\nmean_window = 20\nmean_threshold_dps = 0.3\n"
     << "[filter.kalman]\na = 0.9\nq = 0.0001\nr = 0.01\n"
-    << "[allan]\nwindow_s = 3600\nrefit_interval_s = 1\n"
+    << "[allan]\nwindow_s = " << setup.window_s << "\nrefit_interval_s = 1\n"
     << "[socket]\npath = \"" << (dir / "gyrod.sock").string() << "\"\n"
     << "[mock]\nspeed = 1\nseed = 5\n";
   return c.str();
@@ -69,20 +77,30 @@ void requestInBatches(const std::string& socket, const std::string& request, std
   }
 }
 
-}  // namespace
+double monotonicSeconds() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+}
 
-TEST(GyrodFlood, NoSampleLostAt1kHzWithAOneHourWindowWhileClientsFloodIt) {
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0.0;
+  const auto k = static_cast<std::size_t>(p * static_cast<double>(v.size() - 1));
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
+void floodAndCheck(const FloodSetup& setup) {
   ScratchDir d;
-  const auto cfg = d.write("gyrod.toml", floodConfig(d.path()));
+  const auto cfg = d.write("gyrod.toml", floodConfig(d.path(), setup));
   const auto log = d.path() / "log.txt";
   // gyrod runs SCHED_FIFO as its systemd unit runs it (CPUSchedulingPolicy=fifo): what is
   // measured is then the loop's own turns, not how long a loaded test machine leaves it
-  // unscheduled (SCHED_OTHER at load 6: one 235 ms turn, 235 samples lost). Flooded, gyrod is
-  // busy all the time, and the kernel's real-time throttling (sched_rt_runtime_us 950000 of
-  // 1000000) then stops it for up to 50 ms a second: the longest turn is ~57 ms under FIFO
-  // (18-30 ms under SCHED_OTHER on a quiet machine), inside the 73 ms the FIFO holds. Where
-  // real-time scheduling is refused (no CAP_SYS_NICE, no RLIMIT_RTPRIO) it runs as it can, and
-  // the test says so.
+  // unscheduled (SCHED_OTHER at load 6: one 235 ms turn, 235 samples lost). Its client thread
+  // runs one priority below with at most half a CPU for requests, so however hard it is
+  // flooded, the real-time threads stay far from the kernel's throttling (95 % of a CPU).
+  // Where real-time scheduling is refused (no CAP_SYS_NICE, no RLIMIT_RTPRIO) it runs as it
+  // can, and the test says so.
   GyrodProcess gyrod({"--config", cfg.string()}, log, [] {
     sched_param fifo{};
     fifo.sched_priority = 10;
@@ -108,13 +126,21 @@ TEST(GyrodFlood, NoSampleLostAt1kHzWithAOneHourWindowWhileClientsFloodIt) {
   LineClient deaf(socket), deaf_watcher(socket);
   std::thread deaf_sender([&] { deaf.send(repeated("{\"cmd\":\"allan\"}\n", 10'000)); });
   deaf_watcher.send("{\"cmd\":\"watch\",\"enable\":true}\n");
+  // The watcher itself real-time too (after the flooders are started: they must not inherit
+  // it), as a latency-sensitive client runs: its lateness is then gyrod's, not its own.
+  sched_param watcher_priority{};
+  watcher_priority.sched_priority = 10;
+  const bool watcher_real_time = ::pthread_setschedparam(::pthread_self(), SCHED_FIFO, &watcher_priority) == 0;
 
   std::uint64_t rates = 0, gaps = 0;
   std::optional<std::uint64_t> first_seq, last_seq;
   std::string first_problem;
+  std::vector<double> latency_ms;
+  latency_ms.reserve(static_cast<std::size_t>(setup.rate_hz) * 13);
   const auto until = std::chrono::steady_clock::now() + kFloodTime;
   while (std::chrono::steady_clock::now() < until) {
     const auto line = watcher.readLine(2s);
+    const double arrived_s = monotonicSeconds();
     if (!line) {
       first_problem = first_problem.empty() ? "the watcher got no line for 2 s" : first_problem;
       break;
@@ -129,9 +155,12 @@ TEST(GyrodFlood, NoSampleLostAt1kHzWithAOneHourWindowWhileClientsFloodIt) {
         first_problem = "seq " + std::to_string(seq) + " after " + std::to_string(*last_seq);
       if (!first_seq) first_seq = seq;
       last_seq = seq;
+      latency_ms.push_back((arrived_s - j["t"].get<double>()) * 1e3);
       ++rates;
     }
   }
+  const sched_param normal{};
+  ::pthread_setschedparam(::pthread_self(), SCHED_OTHER, &normal);
   stop = true;
   gyrod.signal(SIGTERM);
   for (auto& t : clients) t.join();
@@ -148,41 +177,59 @@ TEST(GyrodFlood, NoSampleLostAt1kHzWithAOneHourWindowWhileClientsFloodIt) {
       << text;
   ASSERT_TRUE(std::regex_search(text, turn, std::regex(R"(longest loop turn (\d+) us)"))) << text;
   const bool real_time = text.find("event loop scheduling: SCHED_FIFO") != std::string::npos;
-  std::cout << "1 kHz flood, " << std::chrono::duration_cast<std::chrono::seconds>(kFloodTime).count()
-            << " s: watcher got " << rates << " RATE lines, " << gaps << " GAP lines; gyrod published " << m[1]
-            << " samples, " << m[2] << " gaps, " << m[3] << " samples lost, longest loop turn " << turn[1] << " us; "
-            << allan_replies << " ALLAN, " << status_replies << " STATUS, " << pipelined_replies
-            << " pipelined replies; gyrod " << (real_time ? "SCHED_FIFO" : "not real-time (refused)") << "\n";
-  RecordProperty("samples_published", m[1].str());
-  RecordProperty("samples_lost", m[3].str());
-  RecordProperty("longest_loop_turn_us", turn[1].str());
+  const double p50 = percentile(latency_ms, 0.5), p99 = percentile(latency_ms, 0.99);
+  std::cout << setup.rate_hz << " Hz flood, " << std::chrono::duration_cast<std::chrono::seconds>(kFloodTime).count()
+            << " s: watcher got " << rates << " RATE lines, " << gaps << " GAP lines, edge -> watcher p50 " << p50
+            << " ms, p99 " << p99 << " ms; gyrod published " << m[1] << " samples, " << m[2] << " gaps, " << m[3]
+            << " samples lost, longest loop turn " << turn[1] << " us; " << allan_replies << " ALLAN, "
+            << status_replies << " STATUS, " << pipelined_replies << " pipelined replies; gyrod "
+            << (real_time ? "SCHED_FIFO" : "not real-time (refused)") << ", watcher "
+            << (watcher_real_time ? "SCHED_FIFO" : "not real-time") << "\n";
+  ::testing::Test::RecordProperty("samples_published", m[1].str());
+  ::testing::Test::RecordProperty("samples_lost", m[3].str());
+  ::testing::Test::RecordProperty("longest_loop_turn_us", turn[1].str());
+  ::testing::Test::RecordProperty("latency_p99_ms", std::to_string(p99));
 #if defined(__SANITIZE_ADDRESS__)
-  // Under ASan + UBSan every instruction of gyrod is instrumented (2 to 5 times slower): a 14-byte
-  // accel + gyro frame fills the 1024-byte FIFO in 73 ms at 1 kHz, and CI's sanitized run saw an
-  // 89 ms loop turn while flooded (1664 samples lost in 9 gaps, each reported). Like the emulator,
-  // that measures the instrumentation: losses and counts are checked in the optimised build.
+  // Under ASan + UBSan every instruction of gyrod is instrumented (2 to 5 times slower): CI's
+  // sanitized run saw an 89 ms loop turn while flooded at 1 kHz (1664 samples lost in 9 gaps,
+  // each reported). Like the emulator, that measures the instrumentation: losses and counts are
+  // checked in the optimised build.
   constexpr bool kSlowedDown = true;
 #else
   constexpr bool kSlowedDown = false;
 #endif
   if (gyrod::test::underEmulator() || kSlowedDown) {
     // Under qemu-user gyrod and the seven clients run every instruction emulated (5 to 20 times
-    // slower, docs/testing.md): whether 1 kHz keeps up while flooded, and how many replies fit in 12
-    // real seconds, measure the emulator and the host's load, not the target (qemu-aarch64: no loss,
-    // 7696 of the 10000 pipelined; qemu-arm on a host at load 8: 2122 samples lost in 8 gaps). Under
-    // the emulator gyrod must still survive the flood, stop cleanly and account for what it lost
+    // slower, docs/testing.md): whether the rate keeps up while flooded, and how many replies fit
+    // in 12 real seconds, measure the emulator and the host's load, not the target. Under the
+    // emulator gyrod must still survive the flood, stop cleanly and account for what it lost
     // (above); losses and counts are checked natively.
-    GTEST_SKIP() << (kSlowedDown ? "sanitizer speed" : "emulator speed") << ": at 1 kHz gyrod lost " << m[3]
-                 << " samples in " << m[2] << " gaps (first seen: " << (first_problem.empty() ? "none" : first_problem)
-                 << "); the watcher got " << rates << " RATE lines; " << allan_replies << " ALLAN, " << status_replies
-                 << " STATUS, " << pipelined_replies << " pipelined in 12 s";
+    GTEST_SKIP() << (kSlowedDown ? "sanitizer speed" : "emulator speed") << ": at " << setup.rate_hz
+                 << " Hz gyrod lost " << m[3] << " samples in " << m[2]
+                 << " gaps (first seen: " << (first_problem.empty() ? "none" : first_problem) << "); the watcher got "
+                 << rates << " RATE lines; " << allan_replies << " ALLAN, " << status_replies << " STATUS, "
+                 << pipelined_replies << " pipelined in 12 s";
   }
   EXPECT_TRUE(first_problem.empty()) << first_problem << "\n" << text;
   EXPECT_EQ(gaps, 0u);
   EXPECT_EQ(m[2].str(), "0") << text;
   EXPECT_EQ(m[3].str(), "0") << text;
-  EXPECT_GT(rates, 1000u * 8);  // the watcher was served: at least 8 of the 12 s of samples
+  EXPECT_GT(rates, static_cast<std::uint64_t>(setup.rate_hz) * 8);  // the watcher was served: 8 of the 12 s
   EXPECT_GT(allan_replies.load(), 1000u);
   EXPECT_GT(status_replies.load(), 1000u);
   EXPECT_GE(pipelined_replies.load(), 10'000u);  // one whole pipelined write at least
+  if (real_time && watcher_real_time) {
+    // The targets are a 10 ms turn and a 2 ms p99 (measured by hand: docs/driver.md "Latency");
+    // the test shares its machine with other tests, hence the margin. What the FIFO holds is the
+    // limit that matters: past it a turn loses samples.
+    const double fifo_ms = 1024.0 / 14.0 / setup.rate_hz * 1e3;
+    EXPECT_LT(std::stod(turn[1].str()) * 1e-3, std::min(20.0, fifo_ms)) << text;
+    EXPECT_LT(p99, 10.0);
+  }
 }
+
+}  // namespace
+
+TEST(GyrodFlood, NoSampleLostAt1kHzWithAOneHourWindowWhileClientsFloodIt) { floodAndCheck({1000, 4, 3600}); }
+
+TEST(GyrodFlood, NoSampleLostAt8kHzWhileClientsFloodIt) { floodAndCheck({8000, 0, 60}); }

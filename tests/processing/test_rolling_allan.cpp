@@ -508,3 +508,79 @@ TEST(RollingOverlappingAllan, SnapshotOfAFewSamplesHasNoConfidenceYet) {
   EXPECT_THROW(rolling.snapshot(std::nan("")), std::invalid_argument);
   EXPECT_THROW(rolling.snapshot(0.02, AllanOptions{1.0}), std::invalid_argument);
 }
+
+namespace {
+
+// Every accumulator of `a` and `b`, exactly equal (window and since start).
+void expectSameState(const RollingOverlappingAllan& a, const RollingOverlappingAllan& b) {
+  ASSERT_EQ(a.totalCount(), b.totalCount());
+  for (std::size_t i = 0; i < a.clusterSizes().size(); ++i) {
+    const double wa = a.windowVariance(i), wb = b.windowVariance(i);
+    EXPECT_TRUE(wa == wb || (std::isnan(wa) && std::isnan(wb))) << "window m=" << a.clusterSizes()[i];
+    const double sa = a.sinceStartVariance(i), sb = b.sinceStartVariance(i);
+    EXPECT_TRUE(sa == sb || (std::isnan(sa) && std::isnan(sb))) << "since start m=" << a.clusterSizes()[i];
+  }
+}
+
+// Copies `source` in steps of `points`, pushing `pushes_per_step` samples into it after each
+// step; returns the last step's result and leaves `copy` as the steps made it.
+RollingOverlappingAllan::CopyStep copyWhilePushing(RollingOverlappingAllan& source, RollingOverlappingAllan& copy,
+                                                   std::size_t points, std::size_t pushes_per_step,
+                                                   const std::vector<double>& more, std::size_t& next) {
+  copy.beginCopyFrom(source);
+  while (true) {
+    const auto step = copy.continueCopyFrom(source, points);
+    if (step != RollingOverlappingAllan::CopyStep::Copying) return step;
+    for (std::size_t k = 0; k < pushes_per_step && next < more.size(); ++k) source.push(more[next++]);
+  }
+}
+
+}  // namespace
+
+// The copy in steps is the source as it was when the copy began, bit for bit: its statistics
+// now, and every statistic after the same further samples (which reads the whole phase ring).
+TEST(RollingOverlappingAllan, CopyInStepsIsTheSourceAtItsBeginningWhileTheSourceGoesOn) {
+  const std::size_t window = 1000;
+  for (const std::size_t filled : {std::size_t{300}, std::size_t{1000}, std::size_t{3777}}) {
+    SCOPED_TRACE("samples before the copy: " + std::to_string(filled));
+    const auto x = generate(Model::kRandomWalk, filled + 4000, 17 + filled);
+    RollingOverlappingAllan source(window), copy(window);
+    for (std::size_t i = 0; i < filled; ++i) source.push(x[i]);
+    const RollingOverlappingAllan at_beginning = source;
+    std::size_t next = filled;
+    ASSERT_EQ(copyWhilePushing(source, copy, 64, 7, x, next), RollingOverlappingAllan::CopyStep::Done);
+    EXPECT_GT(next, filled + 100);  // the source took samples while it was copied
+    expectSameState(copy, at_beginning);
+    RollingOverlappingAllan reference = at_beginning;
+    for (std::size_t i = filled; i < filled + 2500; ++i) {
+      copy.push(x[i]);
+      reference.push(x[i]);
+    }
+    expectSameState(copy, reference);
+  }
+}
+
+TEST(RollingOverlappingAllan, CopyInStepsOverrunWhenThePushesOvertakeItOrTheSourceIsReset) {
+  const std::size_t window = 500;
+  const auto x = generate(Model::kWhite, 5000, 5);
+  RollingOverlappingAllan source(window), copy(window);
+  for (std::size_t i = 0; i < 2000; ++i) source.push(x[i]);
+  std::size_t next = 2000;
+  // 20 samples pushed for every 10 points copied: the pushes reach points not yet copied.
+  EXPECT_EQ(copyWhilePushing(source, copy, 10, 20, x, next), RollingOverlappingAllan::CopyStep::Overrun);
+
+  copy.beginCopyFrom(source);
+  source.reset();
+  source.push(1.0);
+  EXPECT_EQ(copy.continueCopyFrom(source, 1000), RollingOverlappingAllan::CopyStep::Overrun);
+
+  // Begun again, it completes.
+  const RollingOverlappingAllan at_beginning = source;
+  copy.beginCopyFrom(source);
+  EXPECT_EQ(copy.continueCopyFrom(source, 1000), RollingOverlappingAllan::CopyStep::Done);
+  expectSameState(copy, at_beginning);
+
+  RollingOverlappingAllan other_window(400);
+  EXPECT_THROW(other_window.beginCopyFrom(source), std::invalid_argument);
+  EXPECT_THROW(other_window.continueCopyFrom(source, 10), std::logic_error);
+}

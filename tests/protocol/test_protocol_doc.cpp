@@ -142,9 +142,10 @@ TEST(ProtocolDoc, DeviceStatesAreTheDriverStates) {
   EXPECT_EQ(documented, enumNames<driver::DeviceState>([](auto s) { return driver::deviceStateName(s); }));
 }
 
-TEST(ProtocolDoc, GapReasonsAreTheDriverCauses) {
+TEST(ProtocolDoc, GapReasonsAreTheDriverCausesAndTheDaemons) {
   const auto documented = firstColumnNames(section(readDoc(), "#### Gap reasons"));
-  const auto causes = enumNames<driver::GapCause>([](auto c) { return std::string(driver::gapCauseName(c)); });
+  auto causes = enumNames<driver::GapCause>([](auto c) { return std::string(driver::gapCauseName(c)); });
+  causes.insert(std::string(protocol::kDeliveryBehindGapReason));
   EXPECT_EQ(documented, causes);
 }
 
