@@ -28,6 +28,7 @@
 #include "formats/model_toml.hpp"
 #include "formats/recording_header.hpp"
 #include "formats/toml_document.hpp"
+#include "processing/simulation/sensor_model.hpp"
 
 namespace gyrod::daemon {
 namespace {
@@ -170,6 +171,8 @@ PipelineSettings Gyrod::pipelineSettings(const GyrodConfig& c, const LoadedRateM
     case BiasSource::Estimate: s.bias_origin = BiasOrigin::Estimate; break;
   }
   s.still_seconds = c.bias.still_seconds;
+  s.low_pass_bandwidth_hz = processing::dlpfSetting(c.device.dlpf).bandwidth_hz;
+  s.still_window_off_loop = true;  // tens of ms at 8 kHz: not in one turn of the sample loop
   s.mean_window = c.filter.mean_window;
   s.mean_threshold_dps = c.filter.mean_threshold_dps;
   s.kalman = {c.filter.kalman.a, c.filter.kalman.q, c.filter.kalman.r};
@@ -194,11 +197,19 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
           [file = config_file_, rate_hz = config.device.rate_hz] { return loadReload(file, rate_hz); },
           [this](ReloadedFilter&& reloaded) { applyReload(std::move(reloaded)); },
           [](const std::string& why) { spdlog::error("SIGHUP: keeping the running filter: {}", why); }),
+      still_window_(
+          loop_, [this](StillWindowOutcome&& outcome) { finishStillWindow(std::move(outcome)); },
+          [this](const std::string& why) {
+            StillWindowOutcome failed;  // collected again; the window's memory is gone with the job
+            failed.error = "the still period could not be evaluated: " + why;
+            finishStillWindow(std::move(failed));
+          }),
       to_clients_(clientQueueLines(recordedSamplesPerSecond(config))),
       to_clients_fd_(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)),
       stop_clients_fd_(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)) {
   if (!to_clients_fd_ || !stop_clients_fd_) throw errnoError("eventfd for the client thread");
   loop_.guardTurnsWith(&state_mutex_);
+  held_.reserve(static_cast<std::size_t>(std::ceil(0.5 * config.device.rate_hz)) + 16);  // as the pipeline's
   if (!rate_model_.warning.empty()) spdlog::warn("{}", rate_model_.warning);
   start_real_ns_ = monotonicNowNs();
   last_pump_real_ns_ = start_real_ns_;
@@ -398,6 +409,47 @@ void Gyrod::onSample(const driver::GyroSample& s) {
     spdlog::error("sample {} skipped: {}", s.seq, e.what());
     return;
   }
+  if (out.held) {  // a still window is evaluated off the loop: published when it is done
+    held_.push_back({false, s, {}});
+    return;
+  }
+  publish(s, out);
+  startStillWindowIfWaiting();  // this sample filled the window
+}
+
+void Gyrod::startStillWindowIfWaiting() {
+  if (!pipeline_.stillWindowWaiting()) return;
+  try {
+    still_window_.start(
+        [window = pipeline_.takeStillWindow()]() mutable { return evaluateStillWindow(std::move(window)); });
+  } catch (const std::exception& e) {  // no thread: evaluate here, once, rather than hold the samples for ever
+    spdlog::warn("the still period is evaluated on the sample loop ({})", e.what());
+    StillWindowOutcome failed;
+    failed.error = std::string("the still period could not be evaluated: ") + e.what();
+    finishStillWindow(std::move(failed));
+  }
+}
+
+void Gyrod::finishStillWindow(StillWindowOutcome&& outcome) {
+  const std::span<const ProcessedSample> released = pipeline_.finishStillWindow(std::move(outcome));
+  if (!pipeline_.lastStillWindowError().empty()) spdlog::error("{}", pipeline_.lastStillWindowError());
+  if (pipeline_.stillPeriod().verdicts != still_verdicts_logged_) logStillPeriodVerdict();
+  std::size_t next = 0, done = 0;
+  for (; done < held_.size(); ++done) {
+    const HeldEvent& e = held_[done];
+    if (e.is_gap) {
+      publishGap(e.gap);
+    } else if (next < released.size()) {
+      publish(e.sample, released[next++]);
+    } else {
+      break;  // held again: a new window filled from the held samples
+    }
+  }
+  held_.erase(held_.begin(), held_.begin() + static_cast<std::ptrdiff_t>(done));
+  startStillWindowIfWaiting();
+}
+
+void Gyrod::publish(const driver::GyroSample& s, const ProcessedSample& out) {
   if (pipeline_.stillPeriod().verdicts != still_verdicts_logged_) logStillPeriodVerdict();
   RateSample r;
   r.seq = out.seq;
@@ -432,6 +484,14 @@ void Gyrod::onSample(const driver::GyroSample& s) {
 
 void Gyrod::onGap(const driver::SampleGap& gap) {
   pipeline_.discontinuity();
+  if (!held_.empty()) {  // after samples that are held: in its place
+    held_.push_back({true, {}, gap});
+    return;
+  }
+  publishGap(gap);
+}
+
+void Gyrod::publishGap(const driver::SampleGap& gap) {
   ++gaps_;
   missing_samples_ += gap.count;
   const std::string_view reason = driver::gapCauseName(gap.cause);  // a [a-z0-9_] token (docs/protocol.md)
@@ -666,7 +726,7 @@ StatusReport Gyrod::statusReport() {
   r.temp_c = last_temp_c_;
   std::ostringstream bias;
   bias << toString(pipeline_.biasOrigin());
-  if (pipeline_.phase() == PipelinePhase::Estimating) {
+  if (pipeline_.phase() != PipelinePhase::Running) {
     bias << " (estimating)";
   } else {
     bias.precision(6);

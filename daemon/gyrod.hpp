@@ -28,6 +28,7 @@
 #include "daemon/event_loop.hpp"
 #include "daemon/memory_budget.hpp"
 #include "daemon/noise_refit_worker.hpp"
+#include "daemon/off_loop_job.hpp"
 #include "daemon/priority_inheritance_mutex.hpp"
 #include "daemon/recorder.hpp"
 #include "daemon/reload_worker.hpp"
@@ -88,6 +89,12 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   void applyReload(ReloadedFilter&& reloaded);
   void petWatchdog();
   void notifyReadyOnce();
+  // One processed sample to the clients and the recording.
+  void publish(const driver::GyroSample& s, const ProcessedSample& out);
+  void publishGap(const driver::SampleGap& gap);
+  // The start-up still window, evaluated off the loop (SamplePipeline::takeStillWindow).
+  void startStillWindowIfWaiting();
+  void finishStillWindow(StillWindowOutcome&& outcome);
   // The hand-over to the client thread (sample thread: queue and wake; client thread: take).
   void queueForClients(const LineForClients& line);
   void wakeClientThread();
@@ -110,6 +117,14 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   std::unique_ptr<UnixSocketServer> server_;
   std::unique_ptr<Recorder> recorder_;
   ReloadWorker<ReloadedFilter> reload_;
+  OffLoopJob<StillWindowOutcome> still_window_;
+  // While a still window is evaluated, the samples (and gaps) in the order they came.
+  struct HeldEvent {
+    bool is_gap = false;
+    driver::GyroSample sample;
+    driver::SampleGap gap;
+  };
+  std::vector<HeldEvent> held_;
   Fd driver_timer_;  // absolute CLOCK_MONOTONIC deadline of the driver (real-time clocks)
   SpscRing<LineForClients> to_clients_;
   Fd to_clients_fd_;                    // eventfd: lines wait in to_clients_

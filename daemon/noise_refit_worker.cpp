@@ -130,8 +130,11 @@ void NoiseRefitWorker::threadMain(const std::shared_ptr<Shared>& shared) {
     if (!error.empty()) spdlog::error("noise refit failed: {}", error);
     s.result = std::move(result);
     s.work = false;
+    // Woken once the lock is free: the loop takes it as soon as it reads the eventfd.
+    lock.unlock();
     const std::uint64_t one = 1;
     [[maybe_unused]] const ssize_t n = ::write(s.done_fd.get(), &one, sizeof one);
+    lock.lock();
   }
 }
 

@@ -22,6 +22,7 @@
 #include <thread>
 
 #include "daemon/event_loop.hpp"
+#include "daemon/priority_inheritance_mutex.hpp"
 #include "daemon/sample_pipeline.hpp"
 
 namespace gyrod::daemon {
@@ -60,8 +61,10 @@ class NoiseRefitWorker {
     double tau0_s;
     RefitFunction refit;
     Fd done_fd;  // eventfd: the worker's "result ready" to the loop
-    std::mutex mutex;
-    std::condition_variable wake;
+    // Shared by the loop (maybe SCHED_FIFO) and the worker (SCHED_OTHER): with priority
+    // inheritance, so that the loop never waits for a preempted worker holding it.
+    PriorityInheritanceMutex mutex;
+    std::condition_variable_any wake;
     bool work = false;      // copy holds a stream to refit
     bool fit_terms = true;  // copy is a raw stream: fit the noise terms too
     bool stop = false;

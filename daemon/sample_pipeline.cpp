@@ -4,6 +4,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 namespace gyrod::daemon {
 namespace {
@@ -69,6 +70,14 @@ SamplePipeline::SamplePipeline(const PipelineSettings& settings)
     if (still_samples_ == 0)
       throw std::invalid_argument("bias.still_seconds must give at least one sample to estimate the bias");
     for (auto& v : still_) v.reserve(still_samples_);
+    if (settings_.still_window_off_loop) {
+      // Half a second of samples held without allocating (the evaluation takes ~50 ms at 8 kHz);
+      // a slower one grows the buffers, once.
+      const auto held = static_cast<std::size_t>(std::ceil(0.5 * settings_.rate_hz)) + 16;
+      held_.reserve(held);
+      releasing_.reserve(held);
+      released_.reserve(held);
+    }
     phase_ = PipelinePhase::Estimating;
     still_period_.state = StillPeriodState::Collecting;
   } else {
@@ -96,61 +105,171 @@ void SamplePipeline::startFilters() {
   phase_ = PipelinePhase::Running;
 }
 
-bool SamplePipeline::stillWindowMoved() {
-  still_period_.verdict = processing::checkStillPeriod({still_[0], still_[1], still_[2]}, settings_.rate_hz);
+StillWindowOutcome evaluateStillWindow(StillWindow window) {
+  StillWindowOutcome outcome;
+  const PipelineSettings& s = window.settings;
+  auto& still = window.samples;
+  processing::StillPeriodCheckParameters check;
+  check.low_pass_bandwidth_hz = s.low_pass_bandwidth_hz;
+  outcome.verdict = processing::checkStillPeriod({still[0], still[1], still[2]}, s.rate_hz, check);
+  if (!outcome.verdict.moved || window.identify_even_if_moved) {
+    // Worked on copies: a still period that cannot identify the filter (a sensor whose output
+    // never changes gives zero variance) changes nothing and starts again, rather than being
+    // retried and refused at every following sample with the samples piling up.
+    Vec3 bias = window.bias;
+    std::array<processing::FilterChainParameters, kAxes> params = window.params;
+    const bool identify = !(s.kalman.a && s.kalman.q && s.kalman.r);
+    std::size_t axis = 0;  // named in the message when this axis cannot be identified
+    try {
+      for (axis = 0; axis < kAxes; ++axis) {
+        auto& x = still[axis];
+        if (s.bias_origin == BiasOrigin::Estimate) {
+          long double sum = 0.0L;
+          for (double v : x) sum += v;
+          bias[axis] = static_cast<double>(sum / static_cast<long double>(x.size()));
+        }
+        for (double& v : x) v -= bias[axis];
+        if (identify) {
+          params[axis] = processing::identifyFilterChain(x, s.mean_window, s.mean_threshold_dps, s.kalman);
+        } else {
+          params[axis].kalman = {*s.kalman.a, *s.kalman.q, *s.kalman.r, 0.0, {}};
+        }
+      }
+      outcome.identified = true;
+      outcome.bias = bias;
+      outcome.params = params;
+    } catch (const std::invalid_argument& e) {
+      std::ostringstream msg;
+      msg << "the still period cannot identify the filter on axis "
+          << "xyz"[axis] << " (" << e.what()
+          << "; a sensor whose output never changes?): estimating again over the next " << s.still_seconds << " s";
+      outcome.error = msg.str();
+    }
+  }
+  outcome.samples = std::move(still);
+  return outcome;
+}
+
+StillWindow SamplePipeline::stillWindowJob() {
+  StillWindow job;
+  job.samples = std::move(still_);
+  job.settings = settings_;
+  job.settings.rate_model.reset();  // not needed, and not copied off the loop
+  job.bias = bias_;
+  job.params = params_;
+  job.identify_even_if_moved = still_period_.attempts + 1 >= kMaxStillAttempts;
+  return job;
+}
+
+bool SamplePipeline::applyStillWindow(StillWindowOutcome&& outcome) {
+  still_period_.verdict = outcome.verdict;
   ++still_period_.attempts;
   ++still_period_.verdicts;
-  if (!still_period_.verdict.moved) {
-    still_period_.state = StillPeriodState::Still;
+  still_ = std::move(outcome.samples);
+  still_window_error_.clear();
+  if (outcome.verdict.moved && still_period_.attempts < kMaxStillAttempts) {
+    still_period_.state = StillPeriodState::MovedRetrying;
+    for (auto& x : still_) x.clear();  // capacity kept: the next window allocates nothing
+    phase_ = PipelinePhase::Estimating;
     return false;
   }
-  if (still_period_.attempts >= kMaxStillAttempts) {
-    still_period_.state = StillPeriodState::MovedKept;
+  if (!outcome.identified) {
+    for (auto& x : still_) x.clear();                    // capacity kept: the next still period allocates nothing
+    still_period_.state = StillPeriodState::Collecting;  // a fresh start, motion check included
+    still_period_.attempts = 0;
+    still_window_error_ = outcome.error;
+    phase_ = PipelinePhase::Estimating;
     return false;
   }
-  still_period_.state = StillPeriodState::MovedRetrying;
-  for (auto& x : still_) x.clear();  // capacity kept: the next window allocates nothing
+  still_period_.state = outcome.verdict.moved ? StillPeriodState::MovedKept : StillPeriodState::Still;
+  bias_ = outcome.bias;
+  params_ = outcome.params;
+  // A SIGHUP while the window was evaluated off the loop: its given values win, as they would
+  // have over an identification made before it.
+  for (auto& p : params_) {
+    p.mean_window = settings_.mean_window;
+    p.mean_threshold_dps = settings_.mean_threshold_dps;
+    if (settings_.kalman.a) p.kalman.a = *settings_.kalman.a;
+    if (settings_.kalman.q) p.kalman.q = *settings_.kalman.q;
+    if (settings_.kalman.r) p.kalman.r = *settings_.kalman.r;
+  }
+  for (auto& x : still_) std::vector<double>().swap(x);  // the still period is over: give the memory back
+  startFilters();
   return true;
 }
 
 void SamplePipeline::finishEstimation() {
-  if (stillWindowMoved()) return;  // collect the still period again
-  // Worked on copies: a still period that cannot identify the filter (a sensor whose output
-  // never changes gives zero variance) changes nothing and starts again, rather than being
-  // retried and refused at every following sample with the samples piling up.
-  Vec3 bias = bias_;
-  std::array<processing::FilterChainParameters, kAxes> params = params_;
-  std::size_t axis = 0;  // named in the message when this axis cannot be identified
-  try {
-    for (axis = 0; axis < kAxes; ++axis) {
-      auto& x = still_[axis];
-      if (settings_.bias_origin == BiasOrigin::Estimate) {
-        long double sum = 0.0L;
-        for (double v : x) sum += v;
-        bias[axis] = static_cast<double>(sum / static_cast<long double>(x.size()));
-      }
-      for (double& v : x) v -= bias[axis];
-      if (kalmanIdentified()) {
-        params[axis] =
-            processing::identifyFilterChain(x, settings_.mean_window, settings_.mean_threshold_dps, settings_.kalman);
-      } else {
-        params[axis].kalman = {*settings_.kalman.a, *settings_.kalman.q, *settings_.kalman.r, 0.0, {}};
-      }
+  if (!applyStillWindow(evaluateStillWindow(stillWindowJob())) && !still_window_error_.empty())
+    throw std::invalid_argument(still_window_error_);
+}
+
+StillWindow SamplePipeline::takeStillWindow() {
+  if (!stillWindowWaiting()) throw std::logic_error("the still window was asked for before it was full");
+  still_window_taken_ = true;
+  return stillWindowJob();
+}
+
+std::span<const ProcessedSample> SamplePipeline::finishStillWindow(StillWindowOutcome outcome) {
+  if (phase_ != PipelinePhase::Identifying || !still_window_taken_)
+    throw std::logic_error("a still window outcome came without a window handed off the loop");
+  still_window_taken_ = false;
+  applyStillWindow(std::move(outcome));
+  // The held samples, in order, as process() would have continued with them.
+  releasing_.swap(held_);
+  held_.clear();
+  released_.clear();
+  for (HeldSample& h : releasing_) {
+    if (phase_ == PipelinePhase::Identifying) {  // a new window filled from them: held again
+      held_.push_back(h);
+      continue;
     }
-  } catch (const std::invalid_argument& e) {
-    for (auto& x : still_) x.clear();                    // capacity kept: the next still period allocates nothing
-    still_period_.state = StillPeriodState::Collecting;  // a fresh start, motion check included
-    still_period_.attempts = 0;
-    std::ostringstream msg;
-    msg << "the still period cannot identify the filter on axis "
-        << "xyz"[axis] << " (" << e.what() << "; a sensor whose output never changes?): estimating again over the next "
-        << settings_.still_seconds << " s";
-    throw std::invalid_argument(msg.str());
+    advance(h.out, h.discontinuity_before);
+    if (h.out.held) {
+      held_.push_back(h);  // the window filled at this one; the next are held
+      continue;
+    }
+    released_.push_back(h.out);
   }
-  bias_ = bias;
-  params_ = params;
-  for (auto& x : still_) std::vector<double>().swap(x);  // the still period is over: give the memory back
-  startFilters();
+  releasing_.clear();
+  if (discontinuity_pending_ && phase_ != PipelinePhase::Identifying) {  // a gap after the last held sample
+    discontinuity_pending_ = false;
+    for (auto& c : chains_) c.reset();
+  }
+  return released_;
+}
+
+void SamplePipeline::advance(ProcessedSample& out, bool discontinuity_before) {
+  out.held = false;
+  if (phase_ == PipelinePhase::Identifying) {
+    held_.push_back({out, discontinuity_before || std::exchange(discontinuity_pending_, false)});
+    out.held = true;
+    return;
+  }
+  if (discontinuity_before)
+    for (auto& c : chains_) c.reset();
+  if (!rate_ && phase_ == PipelinePhase::Running) {
+    for (std::size_t axis = 0; axis < kAxes; ++axis) out.rate[axis] = out.raw[axis] - bias_[axis];
+    out.rate_bias = bias_;
+    out.has_rate = true;
+  }
+  if (phase_ == PipelinePhase::Estimating) {
+    for (std::size_t axis = 0; axis < kAxes; ++axis) still_[axis].push_back(out.raw[axis]);  // reserved: no allocation
+    if (still_[0].size() >= still_samples_) {
+      if (settings_.still_window_off_loop)
+        phase_ = PipelinePhase::Identifying;  // the samples after this one are held
+      else
+        finishEstimation();
+    }
+    return;
+  }
+  for (std::size_t axis = 0; axis < kAxes; ++axis) {
+    const processing::FilteredRate f = chains_[axis].update(out.raw[axis] - bias_[axis]);
+    out.mean[axis] = f.mean_dps;
+    out.kalman[axis] = f.kalman_dps;
+    allan_mean_[axis].push(f.mean_dps);
+    allan_kalman_[axis].push(f.kalman_dps);
+  }
+  out.filtered = true;
 }
 
 ProcessedSample SamplePipeline::process(std::uint64_t seq, double t_s, const Vec3& raw_dps, double temp_c,
@@ -171,28 +290,16 @@ ProcessedSample SamplePipeline::process(std::uint64_t seq, double t_s, const Vec
     out.rate_bias = r.bias_dps;
     out.still = r.still;
     out.has_rate = true;
-  } else if (phase_ == PipelinePhase::Running) {
-    for (std::size_t axis = 0; axis < kAxes; ++axis) out.rate[axis] = raw_dps[axis] - bias_[axis];
-    out.rate_bias = bias_;
-    out.has_rate = true;
   }
-  if (phase_ == PipelinePhase::Estimating) {
-    for (std::size_t axis = 0; axis < kAxes; ++axis) still_[axis].push_back(raw_dps[axis]);  // reserved: no allocation
-    if (still_[0].size() >= still_samples_) finishEstimation();
-    return out;
-  }
-  for (std::size_t axis = 0; axis < kAxes; ++axis) {
-    const processing::FilteredRate f = chains_[axis].update(raw_dps[axis] - bias_[axis]);
-    out.mean[axis] = f.mean_dps;
-    out.kalman[axis] = f.kalman_dps;
-    allan_mean_[axis].push(f.mean_dps);
-    allan_kalman_[axis].push(f.kalman_dps);
-  }
-  out.filtered = true;
+  advance(out, false);
   return out;
 }
 
 void SamplePipeline::discontinuity() {
+  if (phase_ == PipelinePhase::Identifying) {
+    discontinuity_pending_ = true;  // at its place among the held samples
+    return;
+  }
   for (auto& c : chains_) c.reset();
 }
 

@@ -12,6 +12,12 @@
 //    period, exactly as `gyroctl filter` identifies them from a file (identifyFilterChain).
 // While a still period is needed, samples are published raw only; the filters start on the
 // first sample after it.
+// The end of a still window (the motion check, the bias, the filter's identification: tens of
+// milliseconds at 8 kHz) runs in process() by default. With PipelineSettings::
+// still_window_off_loop, process() instead hands the window over (takeStillWindow), the
+// caller evaluates it elsewhere (evaluateStillWindow) and gives the outcome back
+// (finishStillWindow); the samples that come meanwhile are held (ProcessedSample::held) and
+// released then, with exactly the values process() would have given them in order.
 //
 // The `rate` stream (issue 11, docs/motion.md), beside the paper's chain and independent of it:
 //  - with a sensor model (`rate_model`, from filter.model): processing::RateEstimator on every
@@ -24,6 +30,7 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -50,8 +57,9 @@ std::string_view toString(RateModel model);
 struct PipelineSettings {
   double rate_hz = 50.0;
   BiasOrigin bias_origin = BiasOrigin::Estimate;
-  Vec3 bias_dps{};              // used unless bias_origin == Estimate
-  double still_seconds = 10.0;  // estimation period (bias and/or Kalman identification)
+  Vec3 bias_dps{};                     // used unless bias_origin == Estimate
+  double still_seconds = 10.0;         // estimation period (bias and/or Kalman identification)
+  double low_pass_bandwidth_hz = 0.0;  // the chip's DLPF bandwidth, for the still check; 0: none
   std::size_t mean_window = 20;
   double mean_threshold_dps = 0.3;
   processing::KalmanOverrides kalman;  // given values; the rest are identified
@@ -59,9 +67,15 @@ struct PipelineSettings {
   std::vector<std::size_t> allan_cluster_sizes;  // empty = octave up to half the window
   // The rate stream's model (RateModel::SensorModel); none = raw − bias (ConstantBias).
   std::optional<processing::RateEstimatorParameters> rate_model;
+  // The end of a still window is evaluated by the caller, off the loop (see above).
+  bool still_window_off_loop = false;
 };
 
-enum class PipelinePhase { Estimating, Running };
+enum class PipelinePhase {
+  Estimating,   // collecting the still window
+  Identifying,  // the full window is evaluated off the loop; samples are held
+  Running,      // the filters run
+};
 
 // The motion check of the start-up still period (processing/motion/still_period_check.hpp). A window
 // in which the board moved is discarded and collected again, up to kMaxStillAttempts windows;
@@ -94,7 +108,29 @@ struct ProcessedSample {
   Vec3 rate_bias{};           // b̂ subtracted from raw for rate
   bool has_rate = false;      // false while a constant bias is still being estimated
   std::optional<bool> still;  // the still detector's verdict (sensor model only)
+  bool held = false;          // off-loop still window: released later by finishStillWindow
 };
+
+// A full still window and what its evaluation needs, handed off the loop.
+struct StillWindow {
+  std::array<std::vector<double>, kAxes> samples;
+  PipelineSettings settings;
+  Vec3 bias{};
+  std::array<processing::FilterChainParameters, kAxes> params{};
+  bool identify_even_if_moved = false;  // the last window allowed: it is used whatever it shows
+};
+// Its evaluation: the motion verdict, and unless the window is to be collected again, the bias
+// and the filter's parameters, or why they cannot be identified.
+struct StillWindowOutcome {
+  processing::StillPeriodVerdict verdict;
+  bool identified = false;
+  Vec3 bias{};
+  std::array<processing::FilterChainParameters, kAxes> params{};
+  std::string error;                               // identification failed: the message (the window is collected again)
+  std::array<std::vector<double>, kAxes> samples;  // the window's memory, handed back
+};
+// Pure, may run on any thread.
+StillWindowOutcome evaluateStillWindow(StillWindow window);
 
 struct AllanStreams {
   double tau0_s = 0.0;
@@ -150,6 +186,17 @@ class SamplePipeline {
   // longer contiguous). The Allan statistics continue over the delivered samples.
   void discontinuity();
 
+  // Off-loop still windows (PipelineSettings::still_window_off_loop): a full window waits to be
+  // taken; the outcome of evaluateStillWindow on it ends the Identifying phase and releases the
+  // held samples, in order, completed (valid until the next call on the pipeline). Samples that
+  // end up held again (a new window filled from them) stay held. Throws std::logic_error when
+  // no window was taken.
+  bool stillWindowWaiting() const { return phase_ == PipelinePhase::Identifying && !still_window_taken_; }
+  StillWindow takeStillWindow();
+  std::span<const ProcessedSample> finishStillWindow(StillWindowOutcome outcome);
+  // The identification failed (finishStillWindow's outcome carried an error): its message.
+  const std::string& lastStillWindowError() const { return still_window_error_; }
+
   // New filter parameters (SIGHUP) without losing the stream: the bias and the identified
   // values are kept unless the new settings give them; the Allan statistics continue.
   void reloadFilter(std::size_t mean_window, double mean_threshold_dps, const processing::KalmanOverrides& kalman);
@@ -187,8 +234,12 @@ class SamplePipeline {
  private:
   bool needsStillPeriod() const;
   void finishEstimation();
-  // Checks the collected still window for motion; true: it moved and is being collected again.
-  bool stillWindowMoved();
+  // Applies a window's outcome; false: the window is being collected again (moved, or the
+  // identification failed: then still_window_error_ says why).
+  bool applyStillWindow(StillWindowOutcome&& outcome);
+  StillWindow stillWindowJob();
+  // The phase-dependent part of process() for a sample whose raw Allan and rate are done.
+  void advance(ProcessedSample& out, bool discontinuity_before);
   void startFilters();
 
   PipelineSettings settings_;
@@ -204,6 +255,16 @@ class SamplePipeline {
   std::array<std::optional<processing::NoiseTermFit>, kAxes> noise_terms_;
   std::array<std::array<std::vector<int>, kStreams>, kAxes> noise_alpha_;  // of the last refit, per τ
   std::uint64_t processed_ = 0;
+  // Off-loop still windows: the samples held while one is evaluated, and those released.
+  struct HeldSample {
+    ProcessedSample out;
+    bool discontinuity_before = false;
+  };
+  std::vector<HeldSample> held_, releasing_;
+  std::vector<ProcessedSample> released_;
+  bool still_window_taken_ = false;
+  bool discontinuity_pending_ = false;
+  std::string still_window_error_;
   std::optional<double> first_t_s_;  // of the first sample: the warm-up shape's origin
   double last_t_s_ = 0.0;
 };

@@ -14,7 +14,15 @@
 // A(m) ≈ σ0²/m. c = 8 allows the correlation the chip's low-pass filter puts between
 // neighbouring samples (AR(1) noise with φ gives A(m)/(σ0²/m) → (1 + φ)/(1 − φ)², 6 at
 // φ = 0.5); f = 0.01 °/s allows the bias instability of a real MPU6050 (its flat Allan
-// deviation is a few 10⁻³ °/s). The window has "moved" when some axis has A(m) > allowed(m)
+// deviation is a few 10⁻³ °/s).
+// The chip's low-pass (DLPF) correlates the noise over about T_c = 0.614 / bandwidth (six
+// time constants of each of the two first-order sections of the simulator's DLPF model,
+// processing/simulation/sensor_model.hpp: the autocorrelation is below 2 % after it). When
+// T_c spans m_c = ⌈T_c · rate⌉ > 1 samples (8 kHz at DLPF 0: 20; 1 kHz at DLPF 6: 123), σ0² is
+// no longer the noise level (the differences of neighbouring samples cancel most of it) and the
+// level is read at m_c instead: σ0² is replaced by m_c·A(m_c), and only m ≥ 2·m_c are tested.
+// At 50 Hz with the default DLPF (42 Hz) m_c = 1: the formula above, unchanged.
+// The window has "moved" when some axis has A(m) > allowed(m)
 // at some m: a turn, a step, a sway or a vibration slower than the sample rate shows up at the
 // τ of its time scale (a 1 °/s turn of 1 s in a 10 s window at 50 Hz, with the paper's ARW of
 // 0.95 °/√h, comes out at 2.7 times the allowed deviation; tests/processing measures it).
@@ -32,7 +40,11 @@ struct StillPeriodCheckParameters {
   double correlation_allowance = 8.0;  // c
   double floor_dps = 0.01;             // f, an Allan deviation [°/s]
   double false_alarm = 1e-6;           // α per axis and τ
+  double low_pass_bandwidth_hz = 0.0;  // the chip's DLPF −3 dB bandwidth; 0: samples uncorrelated
 };
+
+// T_c above, in seconds (0 for a bandwidth ≤ 0: no low-pass).
+double lowPassCorrelationSeconds(double bandwidth_hz);
 
 struct StillPeriodVerdict {
   bool moved = false;

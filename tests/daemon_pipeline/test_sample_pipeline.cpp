@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -421,6 +423,77 @@ TEST(SamplePipeline, WindowIntervalsAfterARefitAreTheSnapshots) {
         EXPECT_LT(got.oadev_lo, got.oadev);
         EXPECT_GT(got.oadev_hi, got.oadev);
       }
+    }
+  }
+}
+
+namespace {
+
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+void expectSameSample(const ProcessedSample& a, const ProcessedSample& b) {
+  ASSERT_EQ(a.seq, b.seq);
+  EXPECT_EQ(a.filtered, b.filtered) << a.seq;
+  EXPECT_EQ(a.has_rate, b.has_rate) << a.seq;
+  for (std::size_t axis = 0; axis < kAxes; ++axis) {
+    EXPECT_TRUE(sameBits(a.raw[axis], b.raw[axis])) << a.seq;
+    if (a.filtered) {
+      EXPECT_TRUE(sameBits(a.mean[axis], b.mean[axis])) << a.seq << " axis " << axis;
+      EXPECT_TRUE(sameBits(a.kalman[axis], b.kalman[axis])) << a.seq << " axis " << axis;
+    }
+    if (a.has_rate) {
+      EXPECT_TRUE(sameBits(a.rate[axis], b.rate[axis])) << a.seq << " axis " << axis;
+    }
+  }
+}
+
+}  // namespace
+
+// The still window evaluated off the loop (gyrod): the samples that come meanwhile are held and
+// released with exactly the values the pipeline gives when it evaluates the window in process(),
+// a gap among them included; and a window that moved is collected again from the held samples.
+TEST(SamplePipelineOffLoop, HeldSamplesAreReleasedExactlyAsTheInLoopPipelineGivesThem) {
+  for (const bool turn_in_first_window : {false, true}) {
+    SCOPED_TRACE(turn_in_first_window ? "a turn in the first window" : "at rest");
+    PipelineSettings settings = baseSettings();
+    settings.still_seconds = 4.0;  // 200 samples at 50 Hz
+    PipelineSettings off = settings;
+    off.still_window_off_loop = true;
+    SamplePipeline in_loop(settings), off_loop(off);
+    Stream s = noisyStream(900, 41, {0.5, -0.25, 1.0});
+    if (turn_in_first_window)
+      for (std::size_t i = 80; i < 130; ++i) s.x[0][i] += 5.0;  // 1 s at 5 deg/s
+    std::vector<ProcessedSample> expected, got;
+    std::optional<StillWindow> taken;
+    std::size_t held_since_taken = 0;
+    for (std::size_t i = 0; i < 900; ++i) {
+      const Vec3 raw = {s.x[0][i], s.x[1][i], s.x[2][i]};
+      if (i == 230) {  // a gap among the held samples
+        in_loop.discontinuity();
+        off_loop.discontinuity();
+      }
+      expected.push_back(in_loop.process(i, static_cast<double>(i) / 50.0, raw, 30.0));
+      const ProcessedSample out = off_loop.process(i, static_cast<double>(i) / 50.0, raw, 30.0);
+      if (!out.held) got.push_back(out);
+      if (off_loop.stillWindowWaiting()) {
+        taken = off_loop.takeStillWindow();
+        held_since_taken = 0;
+      } else if (taken && ++held_since_taken == 40) {  // the evaluation takes 40 samples' time
+        for (const auto& r : off_loop.finishStillWindow(evaluateStillWindow(std::move(*taken)))) got.push_back(r);
+        taken.reset();
+        if (off_loop.stillWindowWaiting()) {
+          taken = off_loop.takeStillWindow();
+          held_since_taken = 0;
+        }
+      }
+    }
+    ASSERT_EQ(off_loop.phase(), PipelinePhase::Running);
+    ASSERT_EQ(got.size(), expected.size());
+    for (std::size_t i = 0; i < got.size(); ++i) expectSameSample(got[i], expected[i]);
+    EXPECT_EQ(off_loop.stillPeriod().attempts, in_loop.stillPeriod().attempts);
+    EXPECT_EQ(off_loop.stillPeriod().state, in_loop.stillPeriod().state);
+    if (turn_in_first_window) {
+      EXPECT_EQ(in_loop.stillPeriod().attempts, 2u);
     }
   }
 }

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "processing/motion/still_period_check.hpp"
+#include "processing/simulation/sensor_model.hpp"
 
 using namespace gyrod::processing;
 
@@ -90,4 +91,65 @@ TEST(StillPeriodCheck, RefusesBadInputAndSaysNothingOnTooFewSamples) {
                                                 std::span<const double>(w.axes[1]).first(5),
                                                 std::span<const double>(w.axes[2]).first(5)};
   EXPECT_FALSE(checkStillPeriod(few, kStillRateHz).moved);
+}
+
+namespace {
+
+// A still (or turning) window as the chip makes it: white noise at the DLPF's internal rate,
+// the DLPF (the simulator's model), decimated to `rate_hz`; 10 s. The paper's angle random
+// walk; `turn_dps` for one second in the middle of the window on axis x.
+Window throughTheChip(int cfg, double rate_hz, unsigned seed, double turn_dps = 0.0) {
+  const DlpfSetting& dlpf = dlpfSetting(cfg);
+  const auto divider = static_cast<std::size_t>(std::lround(dlpf.internal_rate_hz / rate_hz));
+  const auto samples = static_cast<std::size_t>(10.0 * rate_hz);
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, 0.95 / 60.0 * std::sqrt(dlpf.internal_rate_hz));
+  Window w;
+  for (std::size_t a = 0; a < 3; ++a) {
+    DigitalLowPassFilter filter(cfg);
+    for (std::size_t k = 0; k < samples * divider; ++k) {
+      const double t = static_cast<double>(k) / dlpf.internal_rate_hz;
+      const double turn = (a == 0 && t >= 4.5 && t < 5.5) ? turn_dps : 0.0;
+      const double y = filter.update(turn + noise(rng));
+      if (k % divider == divider - 1) w.axes[a].push_back(y);
+    }
+  }
+  return w;
+}
+
+}  // namespace
+
+// Every DLPF setting at every rate from its internal rate down to 50 Hz: the chip's own noise at
+// rest passes (the low-pass makes neighbouring samples alike, most at 8 kHz with DLPF 0 and at
+// 1 kHz with DLPF 6), and a turn of 1 °/s for 1 s is still seen (3 °/s where the bandwidth is
+// more than 4 times the rate).
+TEST(StillPeriodCheck, TheChipAtRestPassesAtEveryRateAndDlpfAndATurnIsSeen) {
+  for (int cfg = 0; cfg <= 6; ++cfg) {
+    const double internal = dlpfSetting(cfg).internal_rate_hz;
+    for (const double rate : {internal, 1000.0, 500.0, 200.0, 100.0, 50.0}) {
+      if (rate > internal || (rate == 1000.0 && internal == 1000.0 && rate != internal)) continue;
+      SCOPED_TRACE("DLPF_CFG " + std::to_string(cfg) + " at " + std::to_string(rate) + " Hz");
+      StillPeriodCheckParameters p;
+      p.low_pass_bandwidth_hz = dlpfSetting(cfg).bandwidth_hz;
+      int moved = 0;
+      for (unsigned seed = 0; seed < 8; ++seed)
+        moved +=
+            checkStillPeriod(throughTheChip(cfg, rate, 100 * static_cast<unsigned>(cfg) + seed).spans(), rate, p).moved
+                ? 1
+                : 0;
+      EXPECT_EQ(moved, 0);
+      // Where the bandwidth is far above the rate (256 Hz at 50 Hz), the chip's noise folds into
+      // the samples' band: 5 times the noise of DLPF 3 at 50 Hz, and a larger turn is needed.
+      const double turn_dps = dlpfSetting(cfg).bandwidth_hz > 4.0 * rate ? 3.0 : 1.0;
+      const StillPeriodVerdict turn = checkStillPeriod(throughTheChip(cfg, rate, 7, turn_dps).spans(), rate, p);
+      EXPECT_TRUE(turn.moved) << turn_dps << " deg/s";
+      EXPECT_EQ(turn.axis, 0u);
+    }
+  }
+}
+
+TEST(StillPeriodCheck, LowPassCorrelationIsSixTimeConstantsOfEachSection) {
+  EXPECT_EQ(lowPassCorrelationSeconds(0.0), 0.0);
+  EXPECT_NEAR(lowPassCorrelationSeconds(256.0) * 8000.0, 19.2, 0.1);  // m_c = 20 at 8 kHz, DLPF 0
+  EXPECT_NEAR(lowPassCorrelationSeconds(42.0) * 50.0, 0.73, 0.01);    // m_c = 1 at 50 Hz, DLPF 3
 }
