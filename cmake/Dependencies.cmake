@@ -44,6 +44,11 @@ gyrod_require(spdlog_FOUND libspdlog-dev "spdlog (daemon logging)")
 pkg_check_modules(LIBSYSTEMD QUIET IMPORTED_TARGET libsystemd)
 gyrod_require(LIBSYSTEMD_FOUND libsystemd-dev "libsystemd (socket activation, sd_notify)")
 
+# The MQTT publisher (daemon/mqtt_publisher.*): Eclipse Mosquitto's client library, whose own
+# thread does the network (connect, reconnect with backoff, send) off gyrod's sample loop.
+pkg_check_modules(LIBMOSQUITTO QUIET IMPORTED_TARGET libmosquitto>=2.0)
+gyrod_require(LIBMOSQUITTO_FOUND libmosquitto-dev "libmosquitto 2.0 (publishing to an MQTT broker)")
+
 # driver/: libi2c (i2c-tools' SMBus helpers) for /dev/i2c-N, libgpiod v1 for the INT line.
 find_path(I2C_INCLUDE_DIR i2c/smbus.h)
 find_library(I2C_LIBRARY i2c)

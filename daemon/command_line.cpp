@@ -40,11 +40,21 @@ void applyOverrides(GyrodConfig& config, const CommandLineOverrides& o) {
     config.mock.speed = *o.mock_speed;
   }
   if (o.log_level) config.log.level = *o.log_level;
+  if (o.mqtt_url) {
+    if (!o.mqtt_url->empty()) {
+      try {
+        parseMqttUrl(*o.mqtt_url);
+      } catch (const std::invalid_argument& e) {
+        throw ConfigError("--mqtt: " + std::string(e.what()) + " (got " + formats::quotedValue(*o.mqtt_url) + ")");
+      }
+    }
+    config.mqtt.url = *o.mqtt_url;
+  }
 }
 
 GyrodCommandLine parseGyrodCommandLine(int argc, const char* const* argv, const std::string& default_config_path) {
   CLI::App app{"gyrod: MPU-6050 gyroscope daemon (mean filter + Kalman, rolling Allan statistics)", "gyrod"};
-  std::string config_file, backend, socket_path, record_path, log_level;
+  std::string config_file, backend, socket_path, record_path, log_level, mqtt_url;
   double mock_speed = 0.0;
   app.add_option("--config", config_file, "Configuration file (default: " + default_config_path + " if it exists)");
   const auto strings = [](const std::vector<std::string_view>& v) {
@@ -55,6 +65,7 @@ GyrodCommandLine parseGyrodCommandLine(int argc, const char* const* argv, const 
   app.add_option("--record", record_path,
                  "Record raw samples to this file (record.path), or into this folder; \"\" = off");
   app.add_option("--mock-speed", mock_speed, "Mock device speed, 1 = real time (mock.speed)");
+  app.add_option("--mqtt", mqtt_url, "Publish to this MQTT broker, mqtt://HOST[:PORT] (mqtt.url); \"\" = off");
   app.add_option("--log-level", log_level, "Log level")->check(CLI::IsMember(strings(kLogLevelNames)));
   app.set_version_flag("--version", std::string("gyrod ") + GYROD_VERSION);
 
@@ -80,6 +91,7 @@ GyrodCommandLine parseGyrodCommandLine(int argc, const char* const* argv, const 
   if (app.count("--socket")) o.socket_path = socket_path;
   if (app.count("--record")) o.record_path = record_path;
   if (app.count("--mock-speed")) o.mock_speed = mock_speed;
+  if (app.count("--mqtt")) o.mqtt_url = mqtt_url;
   if (app.count("--log-level")) {
     const auto it = std::find(kLogLevelNames.begin(), kLogLevelNames.end(), log_level);
     o.log_level = kLogLevels[static_cast<std::size_t>(it - kLogLevelNames.begin())];

@@ -30,6 +30,7 @@ struct CommandLineOverrides {
   std::optional<DeviceBackend> backend;
   std::optional<std::string> socket_path;
   std::optional<std::string> record_path;
+  std::optional<std::string> mqtt_url;
   std::optional<double> mock_speed;
   std::optional<spdlog::level::level_enum> log_level;
 };
@@ -44,7 +45,7 @@ struct GyrodCommandLine {
 };
 
 // gyrod's command line:  gyrod [--config FILE] [--backend mock|i2c] [--socket PATH]
-//   [--record PATH] [--mock-speed X] [--log-level L] [--help] [--version]
+//   [--record PATH] [--mock-speed X] [--mqtt URL] [--log-level L] [--help] [--version]
 // Loads --config FILE, or else default_config_path when that file exists, or else the
 // compiled-in defaults, then applies the flags. Throws ConfigError for a bad config file.
 GyrodCommandLine parseGyrodCommandLine(int argc, const char* const* argv,

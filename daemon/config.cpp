@@ -30,8 +30,8 @@ namespace {
 using Section = formats::TomlSection;
 using formats::shortest;
 
-const std::vector<std::string_view> kSections = {"device", "gpio",   "bias", "filter", "allan",
-                                                 "socket", "record", "log",  "mock",   "limits"};
+const std::vector<std::string_view> kSections = {"device", "gpio", "bias", "filter", "allan", "socket",
+                                                 "record", "log",  "mock", "limits", "mqtt"};
 const std::vector<std::string_view> kBiasSourceNames = {"estimate", "model", "config"};
 const std::vector<std::string_view> kMockSourceNames = {"simulator", "replay"};
 
@@ -243,6 +243,55 @@ void readSocket(const Section& s, SocketConfig& c) {
     if (*v < 4 || *v > 65536) s.failValue("client_buffer_kib", "must be 4..65536 KiB");
     c.client_buffer_kib = static_cast<std::size_t>(*v);
   }
+}
+
+// A topic level of our own: printable, no MQTT wildcard, no empty level.
+bool validTopicPrefix(std::string_view p) {
+  if (p.empty() || p.size() > 200 || p.front() == '/' || p.back() == '/' || hasControlCharacter(p)) return false;
+  if (p.find_first_of("+#") != std::string_view::npos || p.find("//") != std::string_view::npos) return false;
+  return true;
+}
+
+void readMqtt(const Section& s, MqttConfig& m) {
+  if (auto v = s.string("url")) {
+    try {
+      parseMqttUrl(*v);
+    } catch (const std::invalid_argument& e) {
+      s.failValue("url", e.what());
+    }
+    m.url = *v;
+  }
+  if (auto v = s.string("prefix")) {
+    if (!validTopicPrefix(*v))
+      s.failValue("prefix",
+                  "must be topic levels like \"gyrod/bench-3\": no '+', '#', control characters, "
+                  "empty levels or leading/trailing '/'");
+    m.prefix = *v;
+  }
+  if (auto v = s.integer("qos")) {
+    if (*v != 0 && *v != 1) s.failValue("qos", "must be 0 or 1");
+    m.qos = static_cast<int>(*v);
+  }
+  if (auto v = s.string("client_id")) {
+    if (v->empty() || v->size() > 64 || hasControlCharacter(*v))
+      s.failValue("client_id", "must be 1..64 printable characters");
+    m.client_id = *v;
+  }
+  if (auto v = s.integer("rate_every")) {
+    if (*v < 1 || *v > 1'000'000) s.failValue("rate_every", "must be 1..1000000 (1: every RATE line)");
+    m.rate_every = static_cast<std::size_t>(*v);
+  }
+  if (auto v = s.string("username")) {
+    if (hasControlCharacter(*v)) s.failValue("username", "must not contain control characters");
+    m.username = *v;
+  }
+  if (auto v = s.string("password_file")) {
+    if (v->empty() || hasControlCharacter(*v))
+      s.failValue("password_file", "must be a path without control characters");
+    m.password_file = *v;
+  }
+  if (!m.password_file.empty() && m.username.empty())
+    s.failValue("password_file", "needs mqtt.username (the broker checks the pair)");
 }
 
 void readRecord(const Section& s, RecordConfig& r) {
@@ -539,12 +588,40 @@ GyrodConfig readConfig(const formats::TomlDocument& doc, ReferenceChecks checks)
                                      "temperature_coefficient_dps_per_c", "faults"});
   readMock(mock, config.mock);
   readLimits(section("limits", {"memory_mb"}), config.limits);
+  readMqtt(section("mqtt", {"url", "prefix", "qos", "client_id", "rate_every", "username", "password_file"}),
+           config.mqtt);
   if (checks == ReferenceChecks::On) checkReferences(filter, socket, mock, config);
   checkMemory(doc, config, checks);
   return config;
 }
 
 }  // namespace
+
+MqttEndpoint parseMqttUrl(std::string_view url) {
+  constexpr std::string_view scheme = "mqtt://";
+  if (url.rfind("mqtts://", 0) == 0)
+    throw std::invalid_argument("mqtts:// (TLS) is not supported by this gyrod; use mqtt:// on a trusted network");
+  if (url.rfind(scheme, 0) != 0) throw std::invalid_argument("must be mqtt://HOST or mqtt://HOST:PORT");
+  std::string_view rest = url.substr(scheme.size());
+  if (!rest.empty() && rest.back() == '/') rest.remove_suffix(1);
+  MqttEndpoint e;
+  const auto colon = rest.rfind(':');
+  const bool bracketed = !rest.empty() && rest.front() == '[';  // [IPv6]:port
+  if (colon != std::string_view::npos && (!bracketed || rest.find(']') < colon)) {
+    const std::string_view port = rest.substr(colon + 1);
+    int value = 0;
+    const auto [end, ec] = std::from_chars(port.data(), port.data() + port.size(), value);
+    if (port.empty() || ec != std::errc() || end != port.data() + port.size() || value < 1 || value > 65535)
+      throw std::invalid_argument("the port must be 1..65535");
+    e.port = value;
+    rest = rest.substr(0, colon);
+  }
+  if (bracketed && rest.size() >= 2 && rest.back() == ']') rest = rest.substr(1, rest.size() - 2);
+  if (rest.empty() || hasControlCharacter(rest) || rest.find_first_of("/@ ") != std::string_view::npos)
+    throw std::invalid_argument("must name a host: mqtt://HOST or mqtt://HOST:PORT");
+  e.host = std::string(rest);
+  return e;
+}
 
 bool hasControlCharacter(std::string_view text) {
   return std::any_of(text.begin(), text.end(), [](char c) {

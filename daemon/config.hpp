@@ -89,6 +89,26 @@ struct SocketConfig {
   bool operator==(const SocketConfig&) const = default;
 };
 
+// [mqtt]: publishing to a broker (docs/protocol.md "MQTT"); off unless url is set.
+struct MqttConfig {
+  std::string url;             // mqtt://host[:port] (port 1883 by default)
+  std::string prefix;          // topics' prefix; empty: gyrod/<hostname>
+  int qos = 0;                 // 0 or 1, for rate and gap (status is always QoS 1, retained)
+  std::string client_id;       // empty: gyrod-<hostname>
+  std::size_t rate_every = 1;  // publish every N-th RATE line
+  std::string username;        // empty: no credentials
+  std::string password_file;   // the password, read at start (systemd: LoadCredential=)
+  bool enabled() const { return !url.empty(); }
+  bool operator==(const MqttConfig&) const = default;
+};
+
+// The host and port of an mqtt:// URL. Throws std::invalid_argument saying what is wrong.
+struct MqttEndpoint {
+  std::string host;
+  int port = 1883;
+};
+MqttEndpoint parseMqttUrl(std::string_view url);
+
 struct RecordConfig {
   std::string path;               // base file name, e.g. /var/lib/gyrod/gyro.csv; empty = off
   double rotate_mb = 64.0;        // start a new file past this size (10^6 bytes); 0 = never
@@ -178,6 +198,7 @@ struct GyrodConfig {
   LogConfig log;
   MockConfig mock;
   LimitsConfig limits;
+  MqttConfig mqtt;
   bool operator==(const GyrodConfig&) const = default;
 };
 

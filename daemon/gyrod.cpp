@@ -9,6 +9,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -25,6 +26,7 @@
 #include "driver/fifo_frame.hpp"
 #include "driver/mpu6050_config.hpp"
 #include "formats/calibration.hpp"
+#include "formats/input_file.hpp"
 #include "formats/model_toml.hpp"
 #include "formats/recording_header.hpp"
 #include "formats/toml_document.hpp"
@@ -45,6 +47,39 @@ constexpr std::int64_t kMaxPumpWorkNs = 20'000'000;
 // thread runs real-time when gyrod does, and must leave the kernel's real-time throttling
 // (95 % of a CPU) far away, whatever is asked of it.
 constexpr double kRequestCpuShare = 0.5;
+std::string hostName() {
+  std::array<char, 256> name{};
+  if (::gethostname(name.data(), name.size() - 1) != 0 || name[0] == '\0') return "localhost";
+  std::string host(name.data());
+  std::replace_if(
+      host.begin(), host.end(), [](char c) { return c == '/' || c == '+' || c == '#'; }, '_');
+  return host;
+}
+
+MqttSettings mqttSettings(const GyrodConfig& c, const std::string& device) {
+  const MqttEndpoint endpoint = parseMqttUrl(c.mqtt.url);
+  MqttSettings s;
+  s.host = endpoint.host;
+  s.port = endpoint.port;
+  s.prefix = c.mqtt.prefix.empty() ? "gyrod/" + hostName() : c.mqtt.prefix;
+  s.client_id = c.mqtt.client_id.empty() ? "gyrod-" + hostName() : c.mqtt.client_id;
+  s.qos = c.mqtt.qos;
+  s.rate_every = c.mqtt.rate_every;
+  s.username = c.mqtt.username;
+  if (!c.mqtt.password_file.empty()) {
+    try {
+      s.password = formats::readInputFile(c.mqtt.password_file, formats::kCredentialInput);
+    } catch (const std::exception& e) {
+      throw ConfigError(std::string(e.what()) + " (mqtt.password_file)");
+    }
+    while (!s.password.empty() && (s.password.back() == '\n' || s.password.back() == '\r')) s.password.pop_back();
+  }
+  s.device = device;
+  s.rate_hz = c.device.rate_hz;
+  s.queue_lines = clientQueueLines(recordedSamplesPerSecond(c));
+  return s;
+}
+
 LineForClients gapLine(std::uint64_t first_seq, std::uint64_t count, std::string_view reason) {
   LineForClients line;
   line.kind = LineForClients::Kind::Gap;
@@ -249,6 +284,8 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
     recorder_ = std::make_unique<Recorder>(options);
   }
 
+  if (config_.mqtt.enabled()) mqtt_ = std::make_unique<MqttPublisher>(mqttSettings(config_, device_.description));
+
   auto log = [](driver::LogLevel level, std::string_view message) { spdlog::log(spdlogLevel(level), "{}", message); };
   driver_ = std::make_unique<driver::Mpu6050Driver>(*device_.bus, *device_.data_ready, *device_.clock, *this,
                                                     device_.driver_config, log);
@@ -344,13 +381,19 @@ int Gyrod::run() {
         s.written, s.dropped, s.lost_to_errors, s.write_errors,
         last_error.empty() ? std::string() : ", last: " + last_error, stop_ms);
   }
+  std::string mqtt;
+  if (mqtt_) {
+    const std::uint64_t dropped = mqtt_->stats().dropped;
+    mqtt_.reset();  // publishes "offline" (retained) and disconnects
+    mqtt = fmt::format("; MQTT: {} lines dropped (the publisher fell behind)", dropped);
+  }
   const std::string behind = behind_total_ == 0
                                  ? std::string()
                                  : fmt::format("; {} lines not delivered to clients (delivery_behind)", behind_total_);
   spdlog::info(
-      "stopped after {} samples, {} gaps ({} samples lost by the device){}{}; longest loop turn {} us (clients' "
+      "stopped after {} samples, {} gaps ({} samples lost by the device){}{}{}; longest loop turn {} us (clients' "
       "loop: {} us)",
-      samples_published_, gaps_, missing_samples_, behind, recording,
+      samples_published_, gaps_, missing_samples_, behind, recording, mqtt,
       std::chrono::duration_cast<std::chrono::microseconds>(loop_.longestTurn()).count(),
       std::chrono::duration_cast<std::chrono::microseconds>(client_loop_.longestTurn()).count());
   return 0;
@@ -504,6 +547,7 @@ void Gyrod::publishGap(const driver::SampleGap& gap) {
 }
 
 void Gyrod::queueForClients(const LineForClients& line) {
+  if (mqtt_) mqtt_->push(line);  // its own ring: never waits
   clients_to_wake_ = true;
   if (behind_count_ > 0) {  // lines the ring could not take before: one GAP for them first
     if (!to_clients_.tryPush(gapLine(behind_first_seq_, behind_count_, protocol::kDeliveryBehindGapReason))) {

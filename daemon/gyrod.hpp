@@ -27,6 +27,7 @@
 #include "daemon/device_backend.hpp"
 #include "daemon/event_loop.hpp"
 #include "daemon/memory_budget.hpp"
+#include "daemon/mqtt_publisher.hpp"
 #include "daemon/noise_refit_worker.hpp"
 #include "daemon/off_loop_job.hpp"
 #include "daemon/priority_inheritance_mutex.hpp"
@@ -116,6 +117,7 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   AllanReplyCache allan_reply_;
   std::unique_ptr<UnixSocketServer> server_;
   std::unique_ptr<Recorder> recorder_;
+  std::unique_ptr<MqttPublisher> mqtt_;
   ReloadWorker<ReloadedFilter> reload_;
   OffLoopJob<StillWindowOutcome> still_window_;
   // While a still window is evaluated, the samples (and gaps) in the order they came.

@@ -39,6 +39,8 @@ inline constexpr InputKind kReplayInput{"replay file", 256 * kMiB};
 // A recording gyroctl reads (analyze, filter, model-check, ...): a day at 8 kHz with the rate
 // columns stays below this.
 inline constexpr InputKind kRecordingInput{"recording", 256 * kGiB};
+// A password (gyrod's mqtt.password_file; systemd's LoadCredential=): one line.
+inline constexpr InputKind kCredentialInput{"credential file", 64 * 1024};
 // A foreign recording `gyroctl import` converts (read whole into memory).
 inline constexpr InputKind kImportInput{"recording to import", 4 * kGiB};
 

@@ -66,6 +66,11 @@ inline constexpr std::size_t kMaxGapReasonBytes = 48;
 // and recorded, but the daemon's delivery to its clients fell behind and could not keep them.
 inline constexpr std::string_view kDeliveryBehindGapReason = "delivery_behind";
 
+// gyrod's MQTT topics, each under the configured prefix: <prefix>/<name> (docs/protocol.md "MQTT").
+inline constexpr std::string_view kMqttStatusTopic = "status";
+inline constexpr std::string_view kMqttRateTopic = "rate";
+inline constexpr std::string_view kMqttGapTopic = "gap";
+
 // Longest possible RATE line: 23 doubles of ≤ 24 characters in shortest round-trip form
 // (552), "time" (≤ 24: fixed with 6 decimals below 1e15, else shortest), a 20-digit seq,
 // the keys and punctuation (about 220) and the newline, rounded up.

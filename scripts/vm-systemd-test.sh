@@ -37,7 +37,7 @@ if [ ! -x "$base/lib/systemd/systemd" ]; then
   log "debootstrap bookworm (minbase + systemd and gyrod's libraries) into $base"
   rm -rf "$base"
   debootstrap --variant=minbase \
-    --include=systemd,systemd-sysv,udev,libtomlplusplus3,libspdlog1.10,libfmt9,libi2c0,libgpiod2 \
+    --include=systemd,systemd-sysv,udev,libtomlplusplus3,libspdlog1.10,libfmt9,libi2c0,libgpiod2,libmosquitto1 \
     bookworm "$base" http://deb.debian.org/debian >"$sd/debootstrap.log" 2>&1 ||
     { tail -n 20 "$sd/debootstrap.log" >&2; exit 1; }
 fi

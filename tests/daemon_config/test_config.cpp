@@ -300,10 +300,10 @@ TEST(ConfigErrors, UnknownKeyNamesFileLineKeyAndTheValidKeys) {
 TEST(ConfigErrors, UnknownSectionAndTopLevelKey) {
   EXPECT_EQ(errorOf("[log]\nlevel = \"info\"\n\n[devise]\nbackend = \"mock\"\n"),
             "x.toml:4: unknown section [devise] (valid sections: device, gpio, bias, filter, allan, socket, record, "
-            "log, mock, limits); did you mean 'device'?");
+            "log, mock, limits, mqtt); did you mean 'device'?");
   EXPECT_EQ(errorOf("rate_hz = 50\n"),
             "x.toml:1: unknown key 'rate_hz' at top level (keys belong in a section: device, gpio, bias, filter, "
-            "allan, socket, record, log, mock, limits)");
+            "allan, socket, record, log, mock, limits, mqtt)");
   EXPECT_EQ(errorOf("device = 5\n"), "x.toml:1: key 'device': must be a section [device] (got integer 5)");
 }
 
@@ -590,4 +590,35 @@ TEST(ConfigValues, TheDefaultStillPeriodGrowsToTheSamplesItNeedsBelowTenHertz) {
   EXPECT_EQ(parseConfig("[device]\nrate_hz = 50\n", "x.toml").bias.still_seconds, 10.0);
   // 1000 / 256 Hz: 100 samples take 25.6 s.
   EXPECT_EQ(parseConfig("[device]\nrate_hz = 3.90625\n", "x.toml").bias.still_seconds, 26.0);
+}
+
+TEST(ConfigMqtt, ValuesAreReadAndBadOnesNameFileLineAndKey) {
+  const GyrodConfig c = parseConfig(
+      "[mqtt]\nurl = \"mqtt://broker.lan:1884\"\nprefix = \"lab/bench-3\"\nqos = 1\nclient_id = \"b3\"\n"
+      "rate_every = 50\nusername = \"gyrod\"\npassword_file = \"/run/credentials/p\"\n",
+      "x.toml");
+  EXPECT_TRUE(c.mqtt.enabled());
+  EXPECT_EQ(c.mqtt.prefix, "lab/bench-3");
+  EXPECT_EQ(c.mqtt.qos, 1);
+  EXPECT_EQ(c.mqtt.rate_every, 50u);
+  const MqttEndpoint e = parseMqttUrl(c.mqtt.url);
+  EXPECT_EQ(e.host, "broker.lan");
+  EXPECT_EQ(e.port, 1884);
+  EXPECT_EQ(parseMqttUrl("mqtt://[::1]:1885").host, "::1");
+  EXPECT_EQ(parseMqttUrl("mqtt://10.0.0.2").port, 1883);
+  EXPECT_FALSE(parseConfig("[log]\nlevel = \"info\"\n", "x.toml").mqtt.enabled());
+
+  const auto error = [](const std::string& line) { return errorOf("[mqtt]\n" + line + "\n"); };
+  EXPECT_NE(error("url = \"mqtts://b:8883\"").find("x.toml:2: key 'mqtt.url'"), std::string::npos)
+      << error("url = \"mqtts://b:8883\"");
+  EXPECT_NE(error("url = \"mqtts://b:8883\"").find("TLS"), std::string::npos);
+  EXPECT_NE(error("url = \"http://b\"").find("mqtt://HOST"), std::string::npos);
+  EXPECT_NE(error("url = \"mqtt://b:0\"").find("port must be 1..65535"), std::string::npos);
+  EXPECT_NE(error("url = \"mqtt://\"").find("must name a host"), std::string::npos);
+  EXPECT_NE(error("qos = 2").find("x.toml:2: key 'mqtt.qos'"), std::string::npos);
+  EXPECT_NE(error("prefix = \"a/#\"").find("key 'mqtt.prefix'"), std::string::npos);
+  EXPECT_NE(error("prefix = \"/a\"").find("key 'mqtt.prefix'"), std::string::npos);
+  EXPECT_NE(error("rate_every = 0").find("key 'mqtt.rate_every'"), std::string::npos);
+  EXPECT_NE(error("password_file = \"/p\"").find("needs mqtt.username"), std::string::npos);
+  EXPECT_NE(error("colour = 1").find("unknown key"), std::string::npos);
 }

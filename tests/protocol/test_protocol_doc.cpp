@@ -224,3 +224,10 @@ TEST(ProtocolDoc, AllanFieldsAreTheOnesSent) {
   for (const auto& [key, v] : line["table"]["z"]["kalman"][0].items()) point_keys.insert(key);
   EXPECT_EQ(table_fields, point_keys);
 }
+
+TEST(ProtocolDoc, MqttTopicsAreTheOnesPublished) {
+  const auto documented = firstColumnNames(section(readDoc(), "#### MQTT topics"));
+  const std::set<std::string> published = {std::string(protocol::kMqttStatusTopic),
+                                           std::string(protocol::kMqttRateTopic), std::string(protocol::kMqttGapTopic)};
+  EXPECT_EQ(documented, published);
+}
