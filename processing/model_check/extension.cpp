@@ -164,15 +164,53 @@ std::vector<double> withoutDeterministic(const ExtensionInputs& in, const Contex
   return z;
 }
 
+// The held-out tail (outliers named): the samples of the held-back half whose innovation under
+// the extended model's Gaussian predictor (its AR part fitted on the cleaned first half) is
+// beyond the robust filter's 5√S, and the Poisson log-likelihood of that count under each
+// model. Both share the Gaussian part, whose tail is P(|N(0,1)| > 5) per sample; the extended
+// model adds the rate of named outliers in the first half (out of sample: the second half's
+// own outliers do not set it). The innovation variance barely sees a few spikes (their share
+// of it can be under its 0.2 % allowance); their count beyond 5 σ against the ~0.01 a Gaussian
+// predictor expects in 15 000 samples is what tells them apart.
+constexpr double kGaussianTailBeyond5Sigma = 5.733e-7;  // erfc(5/√2)
+constexpr std::size_t kInnovationBurnIn = 100;          // kalman_fit.cpp: no rejection before it
+
+double poissonLogLikelihood(std::size_t count, double expected) {
+  const double m = static_cast<double>(count);
+  return m * std::log(expected) - expected - std::lgamma(m + 1.0);
+}
+
+void heldOutTail(const ExtensionInputs& in, std::size_t half, std::size_t held, const InnovationFigures& ext_held,
+                 ModelCheckGain& g) {
+  g.tail_judged = true;
+  const double scored = static_cast<double>(held > kInnovationBurnIn ? held - kInnovationBurnIn : 0);
+  std::size_t first_half_named = 0;
+  for (std::size_t i : in.outliers.samples) first_half_named += i < half ? 1 : 0;
+  const double rate = half > 0 ? static_cast<double>(first_half_named) / static_cast<double>(half) : 0.0;
+  g.tail_count_held_out = ext_held.rejected.size();
+  g.tail_expected_base_held_out = scored * kGaussianTailBeyond5Sigma;
+  g.tail_expected_extended_held_out = g.tail_expected_base_held_out + rate * scored;
+  g.tail_log_likelihood_base_held_out = poissonLogLikelihood(g.tail_count_held_out, g.tail_expected_base_held_out);
+  g.tail_log_likelihood_extended_held_out =
+      poissonLogLikelihood(g.tail_count_held_out, g.tail_expected_extended_held_out);
+}
+
 // The acceptance rule. Noise allowances: the ADEV log error of a right model varies by up to
 // half between replica sets (measured on hidden outliers); the in-band fraction by two or
 // three points of ~20 (a step model that halved the ADEV error lost two); the held-out
 // innovation variance of two equally good models by well under 0.2 %; a Ljung–Box p-value
 // moves by a factor 10 between halves of one record (seen on hidden outliers), so only a
 // factor 100 with p < 0.001 on the worse side counts.
-ExtensionVerdict judgeExtension(const ModelCheckGain& g) {
+// The held-out tail counts only when outliers are named, with an allowance of 3 in the log
+// likelihood (a likelihood ratio of 20: one false outlier in the first half and none in the
+// second costs the extended model about 1). When outliers are the only effect named, the
+// extended model's Allan curve is the base model's by construction (spikesAsWhiteNoise): the
+// Allan measures cannot see them and only add the noise of two replica sets, so they are
+// reported but not counted.
+ExtensionVerdict judgeExtension(const ModelCheckGain& g, bool outliers_alone) {
   ExtensionVerdict v;
   v.judged = true;
+  v.allan_judged = !outliers_alone;
   v.adev_worse = g.adev_log_error_extended > 1.5 * g.adev_log_error_base + 0.002;
   v.adev_better = g.adev_log_error_extended < 0.8 * g.adev_log_error_base - 0.0005;
   v.band_worse = g.in_band_extended < g.in_band_base - 0.2;
@@ -183,11 +221,18 @@ ExtensionVerdict judgeExtension(const ModelCheckGain& g) {
       g.ljung_box_p_extended_held_out < 1e-3 && g.ljung_box_p_extended_held_out < 0.01 * g.ljung_box_p_base_held_out;
   v.ljung_box_better =
       g.ljung_box_p_base_held_out < 1e-3 && g.ljung_box_p_extended_held_out > 100.0 * g.ljung_box_p_base_held_out;
+  if (g.tail_judged) {
+    v.tail_worse = g.tail_log_likelihood_extended_held_out < g.tail_log_likelihood_base_held_out - 3.0;
+    v.tail_better = g.tail_log_likelihood_extended_held_out > g.tail_log_likelihood_base_held_out + 3.0;
+  }
+  if (!v.allan_judged) v.adev_worse = v.adev_better = v.band_worse = v.band_better = false;
   // More measures better than worse: one measure alone can move by chance (the in-band
   // fraction of 8 replicas' band is nearly their range), while the failed extension
   // was worse on two (ADEV error and in-band) and better on one.
-  const int worse = int{v.adev_worse} + int{v.band_worse} + int{v.innovation_worse} + int{v.ljung_box_worse};
-  const int better = int{v.adev_better} + int{v.band_better} + int{v.innovation_better} + int{v.ljung_box_better};
+  const int worse =
+      int{v.adev_worse} + int{v.band_worse} + int{v.innovation_worse} + int{v.ljung_box_worse} + int{v.tail_worse};
+  const int better =
+      int{v.adev_better} + int{v.band_better} + int{v.innovation_better} + int{v.ljung_box_better} + int{v.tail_better};
   v.accepted = better > worse;
   return v;
 }
@@ -249,7 +294,11 @@ void checkExtendedModel(const ExtensionInputs& in, const Context& c, const Model
   g.innovation_var_extended_held_out = ext_held.variance;
   g.ljung_box_p_extended_held_out = ext_held.ljung_box_p;
 
-  out.verdict = judgeExtension(g);
+  if (in.outliers.found) heldOutTail(in, half, zs.size() - half, ext_held, g);
+  const Removal& rm = *in.removal;
+  const bool outliers_alone = in.outliers.found && rm.sinusoids.empty() && rm.lines.empty() && !rm.temperature &&
+                              rm.step_samples.empty() && !in.gauss_markov->found;
+  out.verdict = judgeExtension(g, outliers_alone);
   if (out.verdict.accepted) {
     checkUnexplained(ext_allan, *in.measured_log_adev, true, c, o.replicas, out);
     out.misfit = judgeMisfit(in.xc, out.allan_extended, in.base_allan->whiteness_q, c.rate, out);

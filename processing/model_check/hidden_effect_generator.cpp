@@ -79,7 +79,7 @@ HiddenEffect HiddenEffectGenerator::drawEffect(ModelEffect e, double duration_s,
       break;
     }
     case ModelEffect::BiasSteps: {
-      h.count = integer(1, 3);
+      h.count = integer(step_count_lo, step_count_hi);
       // Sizes 10..20 × the smallest base Allan deviation over τ = 2..128 s (a step of D
       // shows as a Haar difference of D against a noise sd of about √2·σ(τ)).
       double floor_adev = 1e300;
@@ -88,7 +88,7 @@ HiddenEffect HiddenEffectGenerator::drawEffect(ModelEffect e, double duration_s,
       while (h.times_s.size() < h.count) {
         const double t = uniform(0.1, 0.9) * duration_s;
         bool apart = true;
-        for (double u : h.times_s) apart = apart && std::fabs(u - t) > 0.1 * duration_s;
+        for (double u : h.times_s) apart = apart && std::fabs(u - t) > step_min_gap * duration_s;
         if (apart) h.times_s.push_back(t);
       }
       std::sort(h.times_s.begin(), h.times_s.end());

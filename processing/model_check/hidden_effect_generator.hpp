@@ -56,6 +56,10 @@ class HiddenEffectGenerator {
   // detection stops being certain (docs/model-check.md, detection by size); a unit test that
   // asserts the exact count and times of *clear* steps asks for larger ones.
   double step_size_lo = 10.0, step_size_hi = 20.0;
+  // Number of hidden steps on the axis (inclusive range), each at a uniform time in 0.1–0.9 of
+  // the record, at least step_min_gap × the duration from the others.
+  std::size_t step_count_lo = 1, step_count_hi = 3;
+  double step_min_gap = 0.1;
   // A hidden Gauss–Markov process: T log-uniform from 1 s to duration × gm_tau_hi_fraction,
   // σ such that its Allan-deviation peak is gm_peak_lo..gm_peak_hi × the base model's there.
   double gm_tau_hi_fraction = 1.0 / 40.0;

@@ -164,6 +164,14 @@ struct ModelCheckGain {
   // first half of the record, its innovations scored on the second half.
   double innovation_var_base_held_out = 0.0, innovation_var_extended_held_out = 0.0;
   double ljung_box_p_base_held_out = 0.0, ljung_box_p_extended_held_out = 0.0;
+  // When outliers are named (tail_judged): the held-back half's samples beyond 5√S of the
+  // extended model's Gaussian predictor, the count each model expects there (the Gaussian tail;
+  // plus the first half's rate of named outliers for the extended model) and the Poisson log
+  // likelihood of the count under each (docs/model-check.md, "Outliers: the held-out tail").
+  bool tail_judged = false;
+  std::size_t tail_count_held_out = 0;
+  double tail_expected_base_held_out = 0.0, tail_expected_extended_held_out = 0.0;
+  double tail_log_likelihood_base_held_out = 0.0, tail_log_likelihood_extended_held_out = 0.0;
 };
 
 // The acceptance rule (docs/model-check.md): an extension is accepted only if it gains out of
@@ -173,8 +181,12 @@ struct ModelCheckGain {
 struct ExtensionVerdict {
   bool judged = false;  // a model effect was named (else there is no extension to judge)
   bool accepted = true;
+  // false when outliers are the only effect named: the Allan measures cannot see them (the
+  // extended model's curve is the base model's), so adev_log_error and in_band do not count.
+  bool allan_judged = true;
   bool adev_worse = false, band_worse = false, innovation_worse = false, ljung_box_worse = false;
   bool adev_better = false, band_better = false, innovation_better = false, ljung_box_better = false;
+  bool tail_worse = false, tail_better = false;  // the held-out tail (ModelCheckGain::tail_judged)
   bool operator==(const ExtensionVerdict&) const = default;
 };
 

@@ -35,6 +35,7 @@ OutliersFound checkOutliers(std::span<const double> xd, std::vector<double>& xc,
   }
   found.found = true;
   found.count = at.size();
+  found.samples = at;
   found.median_amplitude = medianOf(amplitudes);
   DetectedEffect e;
   e.effect = ModelEffect::Outliers;

@@ -175,6 +175,7 @@ struct OutliersFound {
   bool found = false;
   std::size_t count = 0;
   double median_amplitude = 0.0;
+  std::vector<std::size_t> samples;  // where the named outliers are (ascending)
 };
 // Samples of xc beyond the null of the largest robust z, each replaced in xc by the mean of
 // its neighbours in xd that are not outliers themselves.

@@ -3,6 +3,7 @@
 // and either can explain the other away, so they are tested together and told apart.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "processing/base/detrend.hpp"
 #include "processing/model_check/pipeline.hpp"
@@ -11,6 +12,8 @@ namespace gyrod::processing::model_check_detail {
 namespace {
 
 constexpr std::size_t kMaxSteps = 8;
+// Further looks at most (nullsAfterFurtherLooks).
+constexpr std::size_t kMaxLooks = 6;
 // The per-axis false-alarm budget (issue 13: at most 1 % of clean axes with any effect) is
 // spent where power is short: the step statistic gets 10 × the nominal α of a statistic
 // (1e-3 at the default 1e-4). Its null is the maximum over scales and positions of a Haar
@@ -24,23 +27,61 @@ constexpr double kStepAlphaFactor = 10.0;
 constexpr double kFurtherStepAlpha = 1e-2;
 
 struct BlockStep {
-  std::size_t block = 0;  // the step is between block−1 and block
+  std::size_t block = 0;  // the scan's boundary: the step is between block−1 and block
   std::size_t scale = 0;
   double size = 0.0;
+  double at = 0.0;  // where the step is, in blocks (within blocks block−1 and block: placeStep)
+  // The unit step's share of block i: a step inside a block leaves that block between the two
+  // levels, and a whole-block regressor leaves up to half the step there, which the scan's
+  // finest scales then take for a further step.
+  double regressor(std::size_t i) const { return std::clamp(static_cast<double>(i) + 1.0 - at, 0.0, 1.0); }
+  std::size_t sample(std::size_t block_length) const {
+    return static_cast<std::size_t>(std::lround(at * static_cast<double>(block_length)));
+  }
 };
 
-std::vector<double> blockRegression(const std::vector<double>& y, const std::vector<double>* temp,
-                                    const std::vector<BlockStep>& steps, double& rss);
+// Where within blocks b−1 .. b the step the scan found at boundary b is: the position (in
+// tenths of a block) whose unit step, with a constant, fits the W blocks on either side best.
+double placeStep(const std::vector<double>& r, const BlockStep& s) {
+  const std::size_t w = std::max<std::size_t>(s.scale, 2);
+  const std::size_t lo = s.block > w ? s.block - w : 0;
+  const std::size_t hi = std::min(r.size(), s.block + w);
+  BlockStep trial = s;
+  double best_at = static_cast<double>(s.block), best_rss = std::numeric_limits<double>::infinity();
+  for (int k = 0; k <= 20 && s.block >= 1; ++k) {
+    trial.at = static_cast<double>(s.block) - 1.0 + 0.1 * k;
+    double n = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, syy = 0.0;
+    for (std::size_t i = lo; i < hi; ++i) {
+      const double x = trial.regressor(i);
+      n += 1.0;
+      sx += x;
+      sy += r[i];
+      sxx += x * x;
+      sxy += x * r[i];
+      syy += r[i] * r[i];
+    }
+    const double vxx = sxx - sx * sx / n, vxy = sxy - sx * sy / n, vyy = syy - sy * sy / n;
+    const double rss = vxx > 0.0 ? vyy - vxy * vxy / vxx : vyy;
+    if (rss < best_rss) {
+      best_rss = rss;
+      best_at = trial.at;
+    }
+  }
+  return best_at;
+}
 
-// y minus the steps, their sizes fitted jointly (with a constant and a line) by least squares.
+std::vector<double> blockRegression(const std::vector<double>& y, const std::vector<double>* temp,
+                                    const std::vector<BlockStep>& steps, double& rss,
+                                    std::vector<double>* residual = nullptr);
+
+// y minus the steps and a line, all fitted jointly by least squares (the steps' sizes into
+// `steps`). The line goes too: y had its line removed with the steps in it, and what the steps
+// leave of that line would show at every position as a Haar difference of slope × W.
 std::vector<double> withoutSteps(const std::vector<double>& y, std::vector<BlockStep>& steps) {
   double rss = 0.0;
-  const std::vector<double> sizes = blockRegression(y, nullptr, steps, rss);
-  std::vector<double> r = y;
-  for (std::size_t j = 0; j < steps.size(); ++j) {
-    steps[j].size = sizes[j];
-    for (std::size_t i = steps[j].block; i < r.size(); ++i) r[i] -= sizes[j];
-  }
+  std::vector<double> r;
+  const std::vector<double> sizes = blockRegression(y, nullptr, steps, rss, &r);
+  for (std::size_t j = 0; j < steps.size(); ++j) steps[j].size = sizes[j];
   return r;
 }
 
@@ -74,21 +115,67 @@ double stepScanStatistic(const std::vector<double>& y, const Context& c, const s
   return best;
 }
 
+// The standardised Haar difference of a step at its own boundary, largest over the scales,
+// on the series without the other steps (their sizes fitted jointly with it): what the step
+// shows once the others are accounted for.
+double ownStepStatistic(const std::vector<double>& y, const Context& c, const std::vector<double>& sd,
+                        const std::vector<BlockStep>& steps, std::size_t which) {
+  std::vector<BlockStep> others;
+  for (std::size_t j = 0; j < steps.size(); ++j)
+    if (j != which) others.push_back(steps[j]);
+  const std::vector<double> r = others.empty() ? y : withoutSteps(y, others);
+  std::vector<double> prefix(r.size() + 1, 0.0);
+  for (std::size_t i = 0; i < r.size(); ++i) prefix[i + 1] = prefix[i] + r[i];
+  const std::size_t t = steps[which].block;
+  double best = 0.0;
+  for (std::size_t j = 0; j < c.scales.size() && j < sd.size(); ++j) {
+    const std::size_t w = c.scales[j];
+    if (t < w || t + w > r.size() || !(sd[j] > 0.0)) continue;
+    const double d = (prefix[t + w] - 2.0 * prefix[t] + prefix[t - w]) / (static_cast<double>(w) * sd[j]);
+    best = std::max(best, std::fabs(d));
+  }
+  return best;
+}
+
+// Backward elimination after the forward search: while the weakest step, given the others,
+// does not pass (`further`, or `null` when it is the only one), it is dropped and the sizes
+// refitted. A step found early can be the sum of two close ones, and a step found late can
+// be what a misfitted neighbour leaves; both then fail at their own boundary.
+void pruneBlockSteps(const std::vector<double>& y, const Context& c, const std::vector<double>& sd,
+                     const NullSummary& null, const NullSummary& further, std::vector<BlockStep>& steps) {
+  while (!steps.empty()) {
+    std::size_t weakest = 0;
+    double weakest_z = std::numeric_limits<double>::infinity();
+    for (std::size_t j = 0; j < steps.size(); ++j) {
+      const double z = ownStepStatistic(y, c, sd, steps, j);
+      if (z < weakest_z) {
+        weakest_z = z;
+        weakest = j;
+      }
+    }
+    if ((steps.size() == 1 ? null : further).fires(weakest_z)) break;
+    steps.erase(steps.begin() + static_cast<std::ptrdiff_t>(weakest));
+    if (!steps.empty()) withoutSteps(y, steps);
+  }
+}
+
 // Steps one at a time: the largest standardised Haar difference while it passes the null
 // (the first) or `further` (the others, away from those found), all sizes refitted jointly
 // and removed from y before looking for the next: a Haar difference alone misjudges a step
 // that has another within its window, and what it leaves behind looks like a further step.
 std::vector<BlockStep> findBlockSteps(const std::vector<double>& y, const Context& c, const std::vector<double>& sd,
-                                      const NullSummary& null, const NullSummary& further) {
-  std::vector<BlockStep> steps;
-  std::vector<double> r = y;
+                                      const NullSummary& null, const NullSummary& further,
+                                      std::vector<BlockStep> steps = {}) {
+  std::vector<double> r = steps.empty() ? y : withoutSteps(y, steps);
   while (steps.size() < kMaxSteps) {
     BlockStep next;
     const double s = stepScanStatistic(r, c, sd, steps, &next);
     if (!(steps.empty() ? null : further).fires(s)) break;
+    next.at = placeStep(r, next);
     steps.push_back(next);
     r = withoutSteps(y, steps);
   }
+  pruneBlockSteps(y, c, sd, null, further, steps);
   std::sort(steps.begin(), steps.end(), [](const BlockStep& a, const BlockStep& b) { return a.block < b.block; });
   return steps;
 }
@@ -96,7 +183,7 @@ std::vector<BlockStep> findBlockSteps(const std::vector<double>& y, const Contex
 // Least squares of y on [1, index, (temperature), (a unit step at each block)], returning
 // the coefficients after the first two and the residual sum of squares.
 std::vector<double> blockRegression(const std::vector<double>& y, const std::vector<double>* temp,
-                                    const std::vector<BlockStep>& steps, double& rss) {
+                                    const std::vector<BlockStep>& steps, double& rss, std::vector<double>* residual) {
   const auto n = static_cast<Eigen::Index>(y.size());
   const Eigen::Index cols = 2 + (temp ? 1 : 0) + static_cast<Eigen::Index>(steps.size());
   Eigen::MatrixXd a(n, cols);
@@ -107,11 +194,13 @@ std::vector<double> blockRegression(const std::vector<double>& y, const std::vec
     a(i, col++) = 1.0;
     a(i, col++) = static_cast<double>(i) / static_cast<double>(n);
     if (temp) a(i, col++) = (*temp)[u];
-    for (const BlockStep& s : steps) a(i, col++) = u >= s.block ? 1.0 : 0.0;
+    for (const BlockStep& s : steps) a(i, col++) = s.regressor(u);
     b(i) = y[u];
   }
   const Eigen::VectorXd x = a.colPivHouseholderQr().solve(b);
-  rss = (a * x - b).squaredNorm();
+  const Eigen::VectorXd e = b - a * x;
+  rss = e.squaredNorm();
+  if (residual) residual->assign(e.data(), e.data() + n);
   return std::vector<double>(x.data() + 2, x.data() + cols);
 }
 
@@ -179,6 +268,28 @@ std::size_t refineStepSample(std::span<const double> r, std::size_t block_start,
   return best;
 }
 
+// The suggestive candidates of one look: steps beyond 2 spreads of the step null, continuing
+// from those of the looks before (`kept`), found on the residual first (a temperature slope
+// fitted with steps in the record takes up part of them, most in a warm-up), then the
+// temperature slope of what the steps leave; when that slope is suggestive, further steps on
+// the residual without it. `k` is the slope.
+std::vector<BlockStep> suggestiveCandidates(const std::vector<double>& y, const Context& c, const LowFrequencyNulls& lf,
+                                            const std::vector<BlockStep>& kept, bool have_temp, double& k,
+                                            bool& temp_suggestive) {
+  NullSummary lowered = lf.steps;
+  lowered.threshold = lowered.median + 2.0 * lowered.spread;
+  const bool have_steps = !lf.step_sd.empty();
+  std::vector<BlockStep> candidates = have_steps ? findBlockSteps(y, c, lf.step_sd, lowered, lowered, kept) : kept;
+  if (!have_temp) return candidates;
+  std::vector<BlockStep> fitted = candidates;
+  k = temperatureSlope(candidates.empty() ? y : withoutSteps(y, fitted), c.temp_blocks);
+  temp_suggestive = lf.temp.excess(k) > 2.0;
+  if (!temp_suggestive || !have_steps) return candidates;
+  std::vector<double> r = y;
+  for (std::size_t i = 0; i < r.size(); ++i) r[i] -= k * c.temp_blocks[i];
+  return findBlockSteps(r, c, lf.step_sd, lowered, lowered, candidates);
+}
+
 // Further looks when a low-frequency statistic is suggestive (beyond 2 spreads of its
 // null): a temperature response or steps in the data inflate the fitted rate random walk
 // and ramp, and so widen the very null they are tested against. Refit the base model on
@@ -193,19 +304,12 @@ LowFrequencyNulls nullsAfterFurtherLooks(const std::vector<double>& xc, const Co
   const bool have_temp = !c.temp_blocks.empty();
   const bool have_steps = !c.scales.empty();
   std::size_t previous_signature = 0;
-  for (std::size_t look = 0; look < 3; ++look) {
-    const std::vector<double> y = lowPassedResidual(xc, c);
-    const double k = have_temp ? temperatureSlope(y, c.temp_blocks) : 0.0;
-    const bool temp_suggestive = have_temp && lf.temp.excess(k) > 2.0;
-    std::vector<BlockStep> candidates;
-    if (have_steps) {
-      NullSummary lowered = lf.steps;
-      lowered.threshold = lowered.median + 2.0 * lowered.spread;
-      std::vector<double> r = y;
-      if (temp_suggestive)
-        for (std::size_t i = 0; i < r.size(); ++i) r[i] -= k * c.temp_blocks[i];
-      candidates = findBlockSteps(r, c, lf.step_sd, lowered, lowered);
-    }
+  const std::vector<double> y = lowPassedResidual(xc, c);
+  std::vector<BlockStep> candidates;
+  for (std::size_t look = 0; look < kMaxLooks; ++look) {
+    double k = 0.0;
+    bool temp_suggestive = false;
+    candidates = suggestiveCandidates(y, c, lf, candidates, have_temp, k, temp_suggestive);
     const std::size_t signature = (temp_suggestive ? 1 : 0) + 2 * (candidates.size() + 1);
     if (!temp_suggestive && candidates.empty()) break;
     if (signature == previous_signature) break;
@@ -214,7 +318,7 @@ LowFrequencyNulls nullsAfterFurtherLooks(const std::vector<double>& xc, const Co
     if (temp_suggestive)
       for (std::size_t i = 0; i < alt.size(); ++i) alt[i] -= k * temp_smoothed[i];
     for (const BlockStep& st : candidates)
-      for (std::size_t i = st.block * c.block; i < alt.size(); ++i) alt[i] -= st.size;
+      for (std::size_t i = st.sample(c.block); i < alt.size(); ++i) alt[i] -= st.size;
     removeLinearTrend(alt, c.tau0);
     const NoiseTermFit alt_fit = fitNoiseTerms(allanDeviationTable(alt, c.tau0, c.ms));
     const std::vector<SeriesStats> reps = runReplicas(pureModel(c.rate, alt_fit.value), statisticalUncertainty(alt_fit),
@@ -244,13 +348,8 @@ struct LowFrequencyTests {
     for (std::size_t i = 0; i < r.size(); ++i) r[i] -= k * c.temp_blocks[i];
     return r;
   }
-  std::vector<double> minusSteps(const std::vector<double>& y, const std::vector<BlockStep>& steps) const {
-    double rss = 0.0;
-    const std::vector<double> sizes = blockRegression(y, nullptr, steps, rss);
-    std::vector<double> r = y;
-    for (std::size_t j = 0; j < steps.size(); ++j)
-      for (std::size_t i = steps[j].block; i < r.size(); ++i) r[i] -= sizes[j];
-    return r;
+  std::vector<double> minusSteps(const std::vector<double>& y, std::vector<BlockStep> steps) const {
+    return withoutSteps(y, steps);
   }
   std::vector<BlockStep> steps(const std::vector<double>& y) const {
     return findBlockSteps(y, c, nulls.step_sd, nulls.steps, nulls.further_steps);
@@ -338,10 +437,10 @@ void fitChosenEffects(const std::vector<double>& y0, const std::vector<double>& 
   if (ch.temperature)
     for (std::size_t i = 0; i < r.size(); ++i) r[i] -= removal.k * temp_smoothed[i];
   for (const BlockStep& s : ch.steps)
-    for (std::size_t i = s.block * c.block; i < r.size(); ++i) r[i] -= s.size;
+    for (std::size_t i = s.sample(c.block); i < r.size(); ++i) r[i] -= s.size;
   for (const BlockStep& s : ch.steps) {
-    for (std::size_t i = s.block * c.block; i < r.size(); ++i) r[i] += s.size;  // this one back
-    const std::size_t at = refineStepSample(r, s.block * c.block, c.block, s.scale * c.block);
+    for (std::size_t i = s.sample(c.block); i < r.size(); ++i) r[i] += s.size;  // this one back
+    const std::size_t at = refineStepSample(r, s.sample(c.block), c.block, s.scale * c.block);
     for (std::size_t i = at; i < r.size(); ++i) r[i] -= s.size;
     removal.step_samples.push_back(at);
     removal.step_sizes.push_back(s.size);

@@ -311,3 +311,39 @@ TEST(GyroctlModelCheckWriteModel, UnwritablePathFailsBeforeTheCheckAndKeepsAnExi
   EXPECT_EQ(r.exit_status, 65);
   EXPECT_EQ(readWholeFile(existing), "precious\n");
 }
+
+// Outliers are judged by a measure that sees them (docs/model-check.md, "Outliers are judged by
+// what sees them"): the JSON lists the measures counted (without the Allan ones when outliers
+// are the only effect named) and the held-out tail's figures; the text says the same.
+TEST(GyroctlModelCheck, OutliersAreJudgedByTheHeldOutTailAndSaySo) {
+  ScratchDir d;
+  gyrod::processing::HiddenEffectGenerator gen(1);
+  gen.outlier_count_lo = gen.outlier_count_hi = 50;
+  const auto g = gen.generate(600.0, 50.0, {gyrod::processing::ModelEffect::Outliers});
+  const auto csv = d.write("rec.csv", recordingCsv(g));
+  const char* names[3] = {"gx", "gy", "gz"};
+  const std::string axis_name = names[g.hidden[0].axis];
+  const std::string args = "model-check " + csv.string() + " --axis " + axis_name + " --seed 3 --threads 2";
+  const auto r = runGyroctl(args + " --json", d.path());
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const auto doc = nlohmann::json::parse(r.out);
+  const auto& axis = doc.at("axes").at(axis_name);
+  bool alone = !axis.at("effects").empty();
+  for (const auto& e : axis.at("effects")) alone = alone && e.at("effect") == "outliers";
+  const auto& judged_by = axis.at("extension").at("judged_by");
+  auto lists = [&](const char* m) { return std::find(judged_by.begin(), judged_by.end(), m) != judged_by.end(); };
+  EXPECT_TRUE(lists("innovation_tail_held_out")) << judged_by.dump();
+  EXPECT_TRUE(lists("innovation_var_held_out")) << judged_by.dump();
+  EXPECT_EQ(lists("adev_log_error"), !alone) << axis.at("effects").dump();
+  const auto& tail = axis.at("gain").at("innovation_tail_held_out");
+  EXPECT_GE(tail.at("count").get<double>(), 1.0) << tail.dump();
+  EXPECT_GT(tail.at("log_likelihood_extended").get<double>(), tail.at("log_likelihood_base").get<double>() + 3.0)
+      << tail.dump();
+  const auto& better = axis.at("extension").at("better");
+  EXPECT_NE(std::find(better.begin(), better.end(), "innovation_tail_held_out"), better.end()) << better.dump();
+  const auto text = runGyroctl(args, d.path());
+  ASSERT_EQ(text.exit_status, 0) << text.err;
+  EXPECT_NE(text.out.find("held out tail (innovations beyond 5 sigma): "), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("(judged by "), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("innovation_tail_held_out"), std::string::npos) << text.out;
+}

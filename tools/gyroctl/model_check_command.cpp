@@ -359,7 +359,7 @@ json axisJson(const AxisModelCheck& r) {
                      {"fired", s.fired}});
   return {{"effects", effects},
           {"gain", gainJson(r.gain)},
-          {"extension", verdictJson(r.verdict)},
+          {"extension", verdictJson(r.verdict, r.gain)},
           {"misfit", misfitJson(r.misfit)},
           {"samples", r.samples},
           {"base_terms", termsJson(r.base_fit.value)},
@@ -404,9 +404,18 @@ void printAxisText(std::ostream& o, const std::string& name, const AxisModelChec
                 g.innovation_var_base_held_out, g.innovation_var_extended_held_out, g.ljung_box_p_base_held_out,
                 g.ljung_box_p_extended_held_out);
   o << line;
+  if (g.tail_judged) {
+    std::snprintf(line, sizeof line,
+                  "  held out tail (innovations beyond 5 sigma): %zu, expected %.3g (base) / %.3g (extended), "
+                  "log likelihood %.4g -> %.4g\n",
+                  g.tail_count_held_out, g.tail_expected_base_held_out, g.tail_expected_extended_held_out,
+                  g.tail_log_likelihood_base_held_out, g.tail_log_likelihood_extended_held_out);
+    o << line;
+  }
   if (r.verdict.judged)
-    o << "  extension " << (r.verdict.accepted ? "accepted" : "not accepted")
-      << " (better: " << (betterMeasures(r.verdict).empty() ? "none" : joined(betterMeasures(r.verdict)))
+    o << "  extension " << (r.verdict.accepted ? "accepted" : "not accepted") << " (judged by "
+      << joined(judgedMeasures(r.verdict, r.gain))
+      << "; better: " << (betterMeasures(r.verdict).empty() ? "none" : joined(betterMeasures(r.verdict)))
       << "; worse: " << (worseMeasures(r.verdict).empty() ? "none" : joined(worseMeasures(r.verdict))) << ")\n";
 }
 
@@ -544,9 +553,15 @@ void writeReport(const std::string& dir_text, const ModelCheckCliOptions& opt, c
        << " | " << fmt("%.4g", g.innovation_var_extended_held_out) << " |\n"
        << "| held out: Ljung-Box p | " << fmt("%.3g", g.ljung_box_p_base_held_out) << " | "
        << fmt("%.3g", g.ljung_box_p_extended_held_out) << " |\n";
+    if (g.tail_judged)
+      md << "| held out: innovations beyond 5 sigma, " << g.tail_count_held_out
+         << " seen: expected count / Poisson log likelihood | " << fmt("%.3g", g.tail_expected_base_held_out) << " / "
+         << fmt("%.4g", g.tail_log_likelihood_base_held_out) << " | " << fmt("%.3g", g.tail_expected_extended_held_out)
+         << " / " << fmt("%.4g", g.tail_log_likelihood_extended_held_out) << " |\n";
     if (r.verdict.judged)
-      md << "\nExtension " << (r.verdict.accepted ? "**accepted**" : "**not accepted**")
-         << " (better: " << (betterMeasures(r.verdict).empty() ? "none" : joined(betterMeasures(r.verdict)))
+      md << "\nExtension " << (r.verdict.accepted ? "**accepted**" : "**not accepted**") << " (judged by "
+         << joined(judgedMeasures(r.verdict, r.gain))
+         << "; better: " << (betterMeasures(r.verdict).empty() ? "none" : joined(betterMeasures(r.verdict)))
          << "; worse: " << (worseMeasures(r.verdict).empty() ? "none" : joined(worseMeasures(r.verdict))) << ").\n";
     md << "\nStatistics (value, median of the null, threshold):\n\n";
     for (const CheckStatistic& s : r.statistics)

@@ -167,6 +167,7 @@ std::vector<std::string> worseMeasures(const ExtensionVerdict& v) {
   if (v.band_worse) w.push_back("in_band");
   if (v.innovation_worse) w.push_back("innovation_var_held_out");
   if (v.ljung_box_worse) w.push_back("ljung_box_p_held_out");
+  if (v.tail_worse) w.push_back("innovation_tail_held_out");
   return w;
 }
 
@@ -176,7 +177,20 @@ std::vector<std::string> betterMeasures(const ExtensionVerdict& v) {
   if (v.band_better) b.push_back("in_band");
   if (v.innovation_better) b.push_back("innovation_var_held_out");
   if (v.ljung_box_better) b.push_back("ljung_box_p_held_out");
+  if (v.tail_better) b.push_back("innovation_tail_held_out");
   return b;
+}
+
+std::vector<std::string> judgedMeasures(const ExtensionVerdict& v, const ModelCheckGain& g) {
+  std::vector<std::string> m;
+  if (v.allan_judged) {
+    m.emplace_back("adev_log_error");
+    m.emplace_back("in_band");
+  }
+  m.emplace_back("innovation_var_held_out");
+  m.emplace_back("ljung_box_p_held_out");
+  if (g.tail_judged) m.emplace_back("innovation_tail_held_out");
+  return m;
 }
 
 std::string joined(const std::vector<std::string>& v) {
@@ -193,23 +207,34 @@ std::string notExplainedReason(const ExtensionVerdict& v) {
   return "the extended model with it gained on no out-of-sample measure beyond its noise";
 }
 
-json verdictJson(const ExtensionVerdict& v) {
-  return {{"judged", v.judged}, {"accepted", v.accepted}, {"worse", worseMeasures(v)}, {"better", betterMeasures(v)}};
+json verdictJson(const ExtensionVerdict& v, const ModelCheckGain& g) {
+  return {{"judged", v.judged},
+          {"accepted", v.accepted},
+          {"judged_by", judgedMeasures(v, g)},
+          {"worse", worseMeasures(v)},
+          {"better", betterMeasures(v)}};
 }
 
 json gainJson(const ModelCheckGain& g) {
-  return {{"adev_log_error_base", g.adev_log_error_base},
-          {"adev_log_error_extended", g.adev_log_error_extended},
-          {"innovation_var_base", g.innovation_var_base},
-          {"innovation_var_extended", g.innovation_var_extended},
-          {"ljung_box_p_base", g.ljung_box_p_base},
-          {"ljung_box_p_extended", g.ljung_box_p_extended},
-          {"in_band_base", g.in_band_base},
-          {"in_band_extended", g.in_band_extended},
-          {"innovation_var_base_held_out", g.innovation_var_base_held_out},
-          {"innovation_var_extended_held_out", g.innovation_var_extended_held_out},
-          {"ljung_box_p_base_held_out", g.ljung_box_p_base_held_out},
-          {"ljung_box_p_extended_held_out", g.ljung_box_p_extended_held_out}};
+  json j = {{"adev_log_error_base", g.adev_log_error_base},
+            {"adev_log_error_extended", g.adev_log_error_extended},
+            {"innovation_var_base", g.innovation_var_base},
+            {"innovation_var_extended", g.innovation_var_extended},
+            {"ljung_box_p_base", g.ljung_box_p_base},
+            {"ljung_box_p_extended", g.ljung_box_p_extended},
+            {"in_band_base", g.in_band_base},
+            {"in_band_extended", g.in_band_extended},
+            {"innovation_var_base_held_out", g.innovation_var_base_held_out},
+            {"innovation_var_extended_held_out", g.innovation_var_extended_held_out},
+            {"ljung_box_p_base_held_out", g.ljung_box_p_base_held_out},
+            {"ljung_box_p_extended_held_out", g.ljung_box_p_extended_held_out}};
+  if (g.tail_judged)
+    j["innovation_tail_held_out"] = {{"count", g.tail_count_held_out},
+                                     {"expected_base", g.tail_expected_base_held_out},
+                                     {"expected_extended", g.tail_expected_extended_held_out},
+                                     {"log_likelihood_base", g.tail_log_likelihood_base_held_out},
+                                     {"log_likelihood_extended", g.tail_log_likelihood_extended_held_out}};
+  return j;
 }
 
 }  // namespace gyrod::gyroctl

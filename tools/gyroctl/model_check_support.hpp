@@ -52,7 +52,10 @@ std::vector<std::string> betterMeasures(const processing::ExtensionVerdict& v);
 std::string joined(const std::vector<std::string>& v);
 // Why the effects of an extension that was not accepted are "seen, not explained".
 std::string notExplainedReason(const processing::ExtensionVerdict& v);
-nlohmann::json verdictJson(const processing::ExtensionVerdict& v);
+// The measures an extension was judged by: without the Allan ones when outliers are the only
+// effect named (they cannot see spikes), with the held-out tail when outliers are named.
+std::vector<std::string> judgedMeasures(const processing::ExtensionVerdict& v, const processing::ModelCheckGain& g);
+nlohmann::json verdictJson(const processing::ExtensionVerdict& v, const processing::ModelCheckGain& g);
 // The gain figures, base against extended, by their JSON names.
 nlohmann::json gainJson(const processing::ModelCheckGain& g);
 
