@@ -43,9 +43,8 @@ constexpr auto kPumpPeriod = std::chrono::milliseconds(10);
 constexpr std::int64_t kMaxVirtualStepNs = 200'000'000;
 // Real time one pump may spend before returning to the loop.
 constexpr std::int64_t kMaxPumpWorkNs = 20'000'000;
-// What all clients' requests may take of one CPU (daemon/unix_socket_server.hpp): the client
-// thread runs real-time when gyrod does, and must leave the kernel's real-time throttling
-// (95 % of a CPU) far away, whatever is asked of it.
+// What all clients' requests may take of one CPU (daemon/unix_socket_server.hpp): the RATE lines
+// go on however many requests come.
 constexpr double kRequestCpuShare = 0.5;
 std::string hostName() {
   std::array<char, 256> name{};
@@ -346,8 +345,8 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
     spdlog::info("configuration: loaded from {}", config_file_);
   if (!device_.virtual_clock)
     spdlog::info(
-        "event loop scheduling: {}; the clients' loop runs beside it (one priority below when real-time), "
-        "its requests at most {:.0f} % of a CPU",
+        "event loop scheduling: {}; the clients' loop runs beside it at normal priority, its requests at "
+        "most {:.0f} % of a CPU",
         loopSchedulingNote(), kRequestCpuShare * 100.0);
   spdlog::info("rate stream: {}", pipeline_.rateModel() == RateModel::SensorModel
                                       ? "raw - the bias of the sensor model " + config_.filter.model
@@ -586,15 +585,12 @@ void Gyrod::publishQueuedLines() {
 }
 
 void Gyrod::clientThreadMain() {
-  // One real-time priority below the samples when gyrod runs real-time, so that a sample's line
-  // reaches its clients at once on a busy machine; the requests' CPU share (kRequestCpuShare)
-  // keeps a flood of them from making this a real-time task that takes a whole CPU.
-  int policy = SCHED_OTHER;
-  sched_param param{};
-  if (::pthread_getschedparam(::pthread_self(), &policy, &param) == 0 && (policy == SCHED_FIFO || policy == SCHED_RR)) {
-    param.sched_priority = std::max(::sched_get_priority_min(policy), param.sched_priority - 1);
-    ::pthread_setschedparam(::pthread_self(), policy, &param);
-  }
+  // Never real-time, whatever gyrod runs as. A flood of requests keeps this thread busy; a busy
+  // real-time thread starves the machine's other tasks, and the kernel then stops real-time work
+  // on that CPU to let them run (RT throttling; the fair server of Linux 6.12+), the sample
+  // thread's included: at 8 kHz, whose FIFO lasts 9 ms, that lost samples.
+  const sched_param normal{};
+  ::pthread_setschedparam(::pthread_self(), SCHED_OTHER, &normal);
   try {
     client_loop_.run();
   } catch (const std::exception& e) {

@@ -3,7 +3,8 @@
 // priority, and the loop runs `done` with its result (or `failed` with the exception's message)
 // when it is ready, so that the state the loop owns is only ever touched by the loop. gyrod uses
 // it for the end of the start-up still window (the motion check and the filter's identification:
-// tens of milliseconds at 8 kHz, longer than the chip's FIFO holds there). One job at a time.
+// tens of milliseconds at 8 kHz, longer than the chip's FIFO holds there) and for SIGHUP's
+// reading (daemon/reload_worker.hpp). One job at a time.
 // A job still running when the object is destroyed is abandoned: its thread finishes and drops
 // the result.
 #include <pthread.h>
@@ -38,6 +39,8 @@ class OffLoopJob {
   OffLoopJob& operator=(const OffLoopJob&) = delete;
 
   bool running() const { return current_ != nullptr; }
+  // Forgets the running job, if any: its thread finishes and its result is dropped.
+  void abandon() { forgetCurrent(); }
 
   // Throws std::logic_error while a job runs, std::system_error when no eventfd or thread can be had.
   void start(std::function<Result()> work) {

@@ -18,9 +18,8 @@
 //    and answered on later turns (EventLoop::defer).
 //  - Requests together take at most ServerOptions::request_cpu_share of a CPU over time
 //    (a token bucket of request time, at most kMaxRequestTimeBanked banked): past it, they
-//    wait for a timer while RATE and GAP lines go on. gyrod's client thread may run
-//    SCHED_FIFO for prompt delivery of the samples; a flood of requests then cannot make it
-//    a real-time task that takes a whole CPU (and the kernel's real-time throttling with it).
+//    wait for a timer while RATE and GAP lines go on, and a flood never takes the whole CPU
+//    the server's thread runs on.
 // A dropped client has received a prefix of its stream; its last line may be incomplete if
 // the kernel had taken part of it (docs/protocol.md: a line without its newline at EOF is
 // to be discarded).

@@ -13,8 +13,11 @@
 // time, so what it measures at 3.6 M samples is what does not depend on the fill: the copy
 // of a raw stream for the refit worker (the whole ring, every refit) and the per-request
 // costs; the refit's own O(fill) work runs on the worker thread.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sched.h>
+#include <sys/file.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -77,6 +80,24 @@ void requestInBatches(const std::string& socket, const std::string& request, std
   }
 }
 
+// The tests that run gyrod SCHED_FIFO take turns (ctest runs two tests at a time): each measures
+// one real-time gyrod on the machine, not two of them and their real-time watchers competing
+// for 2 CPUs. Released when the test ends (the lock goes with the descriptor).
+class RealTimeTurn {
+ public:
+  RealTimeTurn() : fd_(::open("/tmp/gyrod-tests-real-time.lock", O_CREAT | O_RDWR | O_CLOEXEC, 0666)) {
+    if (fd_ >= 0) ::flock(fd_, LOCK_EX);
+  }
+  ~RealTimeTurn() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  RealTimeTurn(const RealTimeTurn&) = delete;
+  RealTimeTurn& operator=(const RealTimeTurn&) = delete;
+
+ private:
+  int fd_;
+};
+
 double monotonicSeconds() {
   timespec ts{};
   ::clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -91,14 +112,15 @@ double percentile(std::vector<double> v, double p) {
 }
 
 void floodAndCheck(const FloodSetup& setup) {
+  const RealTimeTurn turn_of_this_test;
   ScratchDir d;
   const auto cfg = d.write("gyrod.toml", floodConfig(d.path(), setup));
   const auto log = d.path() / "log.txt";
   // gyrod runs SCHED_FIFO as its systemd unit runs it (CPUSchedulingPolicy=fifo): what is
   // measured is then the loop's own turns, not how long a loaded test machine leaves it
   // unscheduled (SCHED_OTHER at load 6: one 235 ms turn, 235 samples lost). Its client thread
-  // runs one priority below with at most half a CPU for requests, so however hard it is
-  // flooded, the real-time threads stay far from the kernel's throttling (95 % of a CPU).
+  // is never real-time and its requests take at most half a CPU, so however hard it is flooded
+  // the sample thread stays light and far from the kernel's real-time throttling.
   // Where real-time scheduling is refused (no CAP_SYS_NICE, no RLIMIT_RTPRIO) it runs as it
   // can, and the test says so.
   GyrodProcess gyrod({"--config", cfg.string()}, log, [] {
@@ -129,7 +151,7 @@ void floodAndCheck(const FloodSetup& setup) {
   // The watcher itself real-time too (after the flooders are started: they must not inherit
   // it), as a latency-sensitive client runs: its lateness is then gyrod's, not its own.
   sched_param watcher_priority{};
-  watcher_priority.sched_priority = 10;
+  watcher_priority.sched_priority = 9;  // below gyrod's sample thread: it never holds a CPU from it
   const bool watcher_real_time = ::pthread_setschedparam(::pthread_self(), SCHED_FIFO, &watcher_priority) == 0;
 
   std::uint64_t rates = 0, gaps = 0;
@@ -240,6 +262,7 @@ TEST(GyrodFlood, NoSampleLostAt8kHzWhileClientsFloodIt) { floodAndCheck({8000, 0
 // sample is lost; the mock at rest passes the still check (its DLPF-correlated noise is read at
 // the low-pass's correlation time, processing/motion/still_period_check.hpp).
 TEST(GyrodStartUp, At8kHzTheStillWindowEndsOffTheLoopAndTheMockAtRestIsStill) {
+  const RealTimeTurn turn_of_this_test;
   ScratchDir d;
   std::ostringstream c;
   c << "[device]\nbackend = \"mock\"\nrate_hz = 8000\ndlpf = 0\n"
