@@ -121,26 +121,25 @@ void MqttPublisher::publishStatus(const char* state) {
 }
 
 void MqttPublisher::publishLine(const LineForClients& line) {
-  std::array<char, protocol::kMaxRateLineBytes> buffer;
-  std::array<char, protocol::kMaxGapLineBytes> gap_buffer;
-  char* text = buffer.data();
-  std::size_t n = 0;
-  const std::string* topic = &rate_topic_;
-  if (line.kind == LineForClients::Kind::Rate) {
+  const bool rate = line.kind == LineForClients::Kind::Rate;
+  if (rate) {
     ++samples_seen_;
     if ((samples_seen_ - 1) % settings_.rate_every != 0) return;
-    n = protocol::formatRateLine(line.rate, buffer);
   } else {
     ++gaps_seen_;
     samples_lost_ += line.gap_count;
-    topic = &gap_topic_;
-    n = protocol::formatGapLine({line.gap_first_seq, line.gap_count, std::string_view(line.gap_reason.data())},
-                                gap_buffer);
-    text = gap_buffer.data();
   }
+  if (!connected_) return;  // counted, but nothing formatted or queued for a broker that is not there
+  std::array<char, protocol::kMaxRateLineBytes> buffer;
+  std::array<char, protocol::kMaxGapLineBytes> gap_buffer;
+  char* text = rate ? buffer.data() : gap_buffer.data();
+  std::size_t n = rate
+                      ? protocol::formatRateLine(line.rate, buffer)
+                      : protocol::formatGapLine(
+                            {line.gap_first_seq, line.gap_count, std::string_view(line.gap_reason.data())}, gap_buffer);
   if (n > 0 && text[n - 1] == '\n') --n;  // a message is one JSON object, without the line's newline
-  if (!connected_) return;                // nothing queued for a broker that is not there
-  if (mosquitto_publish(mosq_, nullptr, topic->c_str(), static_cast<int>(n), text, settings_.qos, false) ==
+  const std::string& topic = rate ? rate_topic_ : gap_topic_;
+  if (mosquitto_publish(mosq_, nullptr, topic.c_str(), static_cast<int>(n), text, settings_.qos, false) ==
       MOSQ_ERR_SUCCESS)
     published_.fetch_add(1, std::memory_order_relaxed);
 }

@@ -37,6 +37,13 @@ void feed(SamplePipeline& p, std::uint64_t first, std::uint64_t count, unsigned 
   }
 }
 
+void expectSameNoiseTerms(const gyrod::processing::NoiseTermFit& got, const gyrod::processing::NoiseTermFit& expected) {
+  for (const auto term : gyrod::processing::kAllNoiseTerms) {
+    EXPECT_EQ(got.value.get(term), expected.value.get(term));
+    EXPECT_EQ(got.uncertainty.get(term), expected.uncertainty.get(term));
+  }
+}
+
 }  // namespace
 
 TEST(NoiseRefitWorker, GivesExactlyTheNoiseTermsOfTheRefitOnTheLoop) {
@@ -62,10 +69,7 @@ TEST(NoiseRefitWorker, GivesExactlyTheNoiseTermsOfTheRefitOnTheLoop) {
   const auto& got = off_loop.noiseTerms()[0];
   ASSERT_TRUE(expected.has_value());
   ASSERT_TRUE(got.has_value());
-  for (const auto term : gyrod::processing::kAllNoiseTerms) {
-    EXPECT_EQ(got->value.get(term), expected->value.get(term));
-    EXPECT_EQ(got->uncertainty.get(term), expected->uncertainty.get(term));
-  }
+  expectSameNoiseTerms(*got, *expected);
   EXPECT_EQ(got->points_used, expected->points_used);
   for (std::size_t axis = 1; axis < kAxes; ++axis) EXPECT_TRUE(off_loop.noiseTerms()[axis].has_value()) << axis;
 }
@@ -170,8 +174,5 @@ TEST(NoiseRefitWorker, ACopyOverSeveralTurnsIsTheStateWhenTheCycleBegan) {
   const auto& got = off_loop.noiseTerms()[0];
   ASSERT_TRUE(expected.has_value());
   ASSERT_TRUE(got.has_value());
-  for (const auto term : gyrod::processing::kAllNoiseTerms) {
-    EXPECT_EQ(got->value.get(term), expected->value.get(term));
-    EXPECT_EQ(got->uncertainty.get(term), expected->uncertainty.get(term));
-  }
+  expectSameNoiseTerms(*got, *expected);
 }
