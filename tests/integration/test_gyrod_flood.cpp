@@ -22,6 +22,7 @@
 #include <algorithm>
 #include <atomic>
 #include <csignal>
+#include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <regex>
@@ -78,6 +79,14 @@ void requestInBatches(const std::string& socket, const std::string& request, std
       ++replies;
     }
   }
+}
+
+// The 1, 5 and 15 minute load averages (/proc/loadavg): what else the machine ran meanwhile.
+std::string loadAverage() {
+  std::ifstream in("/proc/loadavg");
+  std::string one, five, fifteen;
+  in >> one >> five >> fifteen;
+  return one + " " + five + " " + fifteen;
 }
 
 // The tests that run gyrod SCHED_FIFO take turns (ctest runs two tests at a time): each measures
@@ -159,6 +168,7 @@ void floodAndCheck(const FloodSetup& setup) {
   std::string first_problem;
   std::vector<double> latency_ms;
   latency_ms.reserve(static_cast<std::size_t>(setup.rate_hz) * 13);
+  const std::string load_before = loadAverage();
   const auto until = std::chrono::steady_clock::now() + kFloodTime;
   while (std::chrono::steady_clock::now() < until) {
     const auto line = watcher.readLine(2s);
@@ -206,7 +216,8 @@ void floodAndCheck(const FloodSetup& setup) {
             << " samples lost, longest loop turn " << turn[1] << " us; " << allan_replies << " ALLAN, "
             << status_replies << " STATUS, " << pipelined_replies << " pipelined replies; gyrod "
             << (real_time ? "SCHED_FIFO" : "not real-time (refused)") << ", watcher "
-            << (watcher_real_time ? "SCHED_FIFO" : "not real-time") << "\n";
+            << (watcher_real_time ? "SCHED_FIFO" : "not real-time") << "; load average before " << load_before
+            << ", after " << loadAverage() << "\n";
   ::testing::Test::RecordProperty("samples_published", m[1].str());
   ::testing::Test::RecordProperty("samples_lost", m[3].str());
   ::testing::Test::RecordProperty("longest_loop_turn_us", turn[1].str());
