@@ -21,6 +21,7 @@
 #include <system_error>
 
 #include "daemon/command_line.hpp"
+#include "daemon/network_sandbox.hpp"
 #include "daemon/watchdog.hpp"
 #include "driver/counter_names.hpp"
 #include "driver/fifo_frame.hpp"
@@ -283,7 +284,14 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
     recorder_ = std::make_unique<Recorder>(options);
   }
 
-  if (config_.mqtt.enabled()) mqtt_ = std::make_unique<MqttPublisher>(mqttSettings(config_, device_.description));
+  if (config_.mqtt.enabled()) {
+    mqtt_ = std::make_unique<MqttPublisher>(mqttSettings(config_, device_.description));
+    if (const std::string obstacle = networkSandboxObstacle(parseMqttUrl(config_.mqtt.url).host); !obstacle.empty())
+      spdlog::warn(
+          "MQTT: {}, so no broker but one on this board can be reached; under systemd the unit's sandbox "
+          "does this, and /usr/share/gyrod/gyrod-mqtt.conf is the drop-in that opens it (docs/fleet.md)",
+          obstacle);
+  }
 
   auto log = [](driver::LogLevel level, std::string_view message) { spdlog::log(spdlogLevel(level), "{}", message); };
   driver_ = std::make_unique<driver::Mpu6050Driver>(*device_.bus, *device_.data_ready, *device_.clock, *this,

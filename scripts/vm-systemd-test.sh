@@ -32,12 +32,12 @@ kernel_dir=$(scripts/vm-kernel-test.sh --prepare-only)
 
 # --- the root file system ---
 base=$sd/rootfs-base
-if [ ! -x "$base/lib/systemd/systemd" ]; then
+if [ ! -x "$base/lib/systemd/systemd" ] || [ ! -x "$base/usr/sbin/mosquitto" ]; then
   command -v debootstrap >/dev/null || apt-get install -y -qq --no-install-recommends debootstrap >/dev/null
-  log "debootstrap bookworm (minbase + systemd and gyrod's libraries) into $base"
+  log "debootstrap bookworm (minbase + systemd, gyrod's libraries and an MQTT broker) into $base"
   rm -rf "$base"
   debootstrap --variant=minbase \
-    --include=systemd,systemd-sysv,udev,libtomlplusplus3,libspdlog1.10,libfmt9,libi2c0,libgpiod2,libmosquitto1 \
+    --include=systemd,systemd-sysv,udev,libtomlplusplus3,libspdlog1.10,libfmt9,libi2c0,libgpiod2,libmosquitto1,mosquitto \
     bookworm "$base" http://deb.debian.org/debian >"$sd/debootstrap.log" 2>&1 ||
     { tail -n 20 "$sd/debootstrap.log" >&2; exit 1; }
 fi

@@ -155,6 +155,41 @@ case "${level#* }" in
   *) fail security "${exposure:-no exposure line} (want SAFE or OK)" ;;
 esac
 
+# MQTT from the installed unit (docs/fleet.md): its sandbox has no network, and gyrod says so;
+# with the package's drop-in (/usr/share/gyrod/gyrod-mqtt.conf) it reaches the board's broker,
+# and gyroctl fleet shows it online.
+cp /etc/gyrod/gyrod.toml /tmp/gyrod.toml.orig
+if grep -q '^\[mqtt\]$' /etc/gyrod/gyrod.toml; then
+  sed -i 's|^\[mqtt\]$|[mqtt]\nurl = "mqtt://127.0.0.1:1883"|' /etc/gyrod/gyrod.toml
+else
+  printf '[mqtt]\nurl = "mqtt://127.0.0.1:1883"\n' >>/etc/gyrod/gyrod.toml
+fi
+systemctl start mosquitto.service 2>/dev/null || mosquitto -d -p 1883
+n_before=$(journal gyrod.service | grep -c "MQTT: this gyrod may not open IP sockets")
+timeout 120 systemctl restart gyrod.service
+if wait_for 30 sh -c "[ \$(journalctl -b -o cat --no-pager -u gyrod.service | grep -c 'MQTT: this gyrod may not open IP sockets') -gt $n_before ]"; then
+  sandboxed="$(journal gyrod.service | grep 'MQTT: this gyrod' | tail -n1 | cut -c1-120)"
+  install -D -m 644 /usr/share/gyrod/gyrod-mqtt.conf /etc/systemd/system/gyrod.service.d/mqtt.conf
+  systemctl daemon-reload
+  timeout 120 systemctl restart gyrod.service
+  fleet=""
+  wait_for 30 sh -c 'gyroctl fleet --broker mqtt://127.0.0.1 --once --json --wait 2 >/tmp/fleet.json 2>&1 && grep -q "\"state\":\"online\"" /tmp/fleet.json && grep -q "\"rate_messages\":[1-9]" /tmp/fleet.json' &&
+    fleet=$(cut -c1-200 /tmp/fleet.json)
+  if [ -n "$fleet" ]; then
+    pass mqtt-drop-in "in the sandbox: $sandboxed; with the drop-in: $fleet"
+  else
+    fail mqtt-drop-in "with the drop-in: $(cut -c1-300 /tmp/fleet.json)"
+    show
+  fi
+  rm -f /etc/systemd/system/gyrod.service.d/mqtt.conf
+else
+  fail mqtt-drop-in "no 'MQTT: this gyrod may not open IP sockets' line in the sandbox"
+  show
+fi
+cp /tmp/gyrod.toml.orig /etc/gyrod/gyrod.toml
+systemctl daemon-reload
+timeout 120 systemctl restart gyrod.service
+
 echo "VMTEST checks took $(since "$t0") s"
 echo "VMTEST summary: $passed passed, $failed failed; guest uptime $(uptime_s) s"
 sync

@@ -24,5 +24,7 @@ void addSimulateCommand(CLI::App& app, CommandRunner& run);
 // watch, allan, status: talk to a running gyrod over its socket.
 void addClientCommands(CLI::App& app, CommandRunner& run);
 void addModelCheckCommand(CLI::App& app, CommandRunner& run);
+// fleet: every gyrod on an MQTT broker.
+void addFleetCommand(CLI::App& app, CommandRunner& run);
 
 }  // namespace gyrod::gyroctl
