@@ -75,6 +75,7 @@ MqttPublisher::MqttPublisher(MqttSettings settings)
       rate_topic_(settings_.prefix + "/" + std::string(protocol::kMqttRateTopic)),
       gap_topic_(settings_.prefix + "/" + std::string(protocol::kMqttGapTopic)),
       ring_(settings_.queue_lines),
+      buffer_(settings_.qos == 1 ? settings_.buffer_messages : 0),
       jitter_(std::random_device{}()) {
   initialiseLibraryOnce();
   // qos 1: a persistent session, so that the broker keeps what it has not acknowledged or
@@ -249,11 +250,7 @@ void MqttPublisher::takeLine(const LineForClients& line) {
     samples_lost_ += line.gap_count;
   }
   if (settings_.qos == 1 && settings_.buffer_messages > 0) {
-    if (buffer_.size() >= settings_.buffer_messages) {  // full: the oldest goes
-      buffer_.pop_front();
-      dropped_.fetch_add(1, std::memory_order_relaxed);
-    }
-    buffer_.push_back(line);
+    if (!buffer_.pushBack(line)) dropped_.fetch_add(1, std::memory_order_relaxed);  // the oldest went
     if (!connected_) ++outage_buffered_;
     buffered_.store(buffer_.size(), std::memory_order_relaxed);
     return;
@@ -287,7 +284,7 @@ bool MqttPublisher::publishLine(const LineForClients& line) {
 void MqttPublisher::sendBuffered() {
   while (connected_ && !buffer_.empty() && unacknowledged_ < kMaxUnacknowledged) {
     if (!publishLine(buffer_.front())) break;  // kept: the connection is being lost
-    buffer_.pop_front();
+    buffer_.popFront();
   }
   buffered_.store(buffer_.size(), std::memory_order_relaxed);
 }

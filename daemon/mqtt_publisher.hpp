@@ -15,7 +15,6 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
-#include <deque>
 #include <memory>
 #include <mutex>
 #include <random>
@@ -23,6 +22,7 @@
 #include <thread>
 
 #include "daemon/client_handover.hpp"
+#include "daemon/kept_lines.hpp"
 #include "daemon/spsc_ring.hpp"
 
 struct mosquitto;
@@ -107,7 +107,7 @@ class MqttPublisher {
   std::uint64_t samples_seen_ = 0, gaps_seen_ = 0, samples_lost_ = 0;  // publisher thread
   // Publisher thread: qos 1 messages not yet handed to libmosquitto, oldest first, and the
   // qos 1 messages handed to it and not yet acknowledged (PUBACK).
-  std::deque<LineForClients> buffer_;
+  KeptLines<LineForClients> buffer_;
   std::size_t unacknowledged_ = 0;
   // Publisher thread: the retries' schedule, and the current outage (since the connection was
   // lost or the first attempt failed) for the line that says what it cost.
