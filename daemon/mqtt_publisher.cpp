@@ -36,7 +36,9 @@ constexpr double kRetryJitter = 0.2;
 constexpr std::size_t kMaxUnacknowledged = 1000;
 // Where OpenSSL finds the system's CA certificates on Debian (ca-certificates).
 constexpr const char* kSystemCaPath = "/etc/ssl/certs";
-constexpr int kSslVerifyPeer = 1;  // OpenSSL's SSL_VERIFY_PEER, which mosquitto_tls_opts_set takes
+constexpr int kSslVerifyPeer = 1;
+// Different causes of failure logged in one outage, at most (the last error is in STATUS).
+constexpr std::size_t kMaxLoggedCauses = 8;  // OpenSSL's SSL_VERIFY_PEER, which mosquitto_tls_opts_set takes
 
 // libmosquitto's global state, set up once per process.
 void initialiseLibraryOnce() {
@@ -150,7 +152,7 @@ void MqttPublisher::onConnect(mosquitto* /*mosq*/, void* self, int rc) {
   p->connecting_ = false;
   p->connected_ = true;
   p->failures_ = 0;
-  p->logged_error_.clear();
+  p->logged_causes_.clear();
   // Nothing is published from here: libmosquitto resends what it holds in flight after this
   // callback, and the buffer must go after those (sendBuffered, once mosquitto_loop returns).
   p->reportOutageOver();
@@ -209,15 +211,18 @@ void MqttPublisher::connectionFailed(const std::string& why) {
   }
   const std::string keeping = settings_.qos == 1 && settings_.buffer_messages > 0
                                   ? "keeping up to " + std::to_string(settings_.buffer_messages) + " messages"
-                                  : "messages meanwhile are dropped (qos 0)";
+                                  : "dropping the messages meanwhile";
+  // Each cause once per outage: the retries go on for as long as the broker is away, and a
+  // cause that comes and goes (a handshake that times out now and then) is not news either.
+  const bool new_cause = std::find(logged_causes_.begin(), logged_causes_.end(), cause) == logged_causes_.end();
   if (was_connected && !stop_) {
     spdlog::warn("MQTT: lost the broker at {}:{} ({}); reconnecting, {}", settings_.host, settings_.port, cause,
                  keeping);
-  } else if (cause != logged_error_ && !stop_) {
+  } else if (new_cause && logged_causes_.size() < kMaxLoggedCauses && !stop_) {
     spdlog::warn("MQTT: cannot connect to the broker at {}:{}: {}; streaming on the socket and retrying, {}",
                  settings_.host, settings_.port, cause, keeping);
   }
-  logged_error_ = cause;
+  if (new_cause && logged_causes_.size() < kMaxLoggedCauses) logged_causes_.push_back(cause);
   ++failures_;
   const double base = std::min(kMaxRetrySeconds, kFirstRetrySeconds * std::pow(2.0, std::min(failures_ - 1, 16)));
   const double factor = std::uniform_real_distribution<double>(1.0 - kRetryJitter, 1.0 + kRetryJitter)(jitter_);

@@ -20,6 +20,7 @@
 #include <random>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "daemon/client_handover.hpp"
 #include "daemon/kept_lines.hpp"
@@ -115,7 +116,7 @@ class MqttPublisher {
   bool attempted_ = false, in_outage_ = false;
   std::chrono::steady_clock::time_point next_attempt_{}, outage_start_{};
   std::uint64_t outage_dropped_start_ = 0, outage_buffered_ = 0;
-  std::string logged_error_;  // the last failure logged, so that each cause is logged once
+  std::vector<std::string> logged_causes_;  // the causes of failure logged in this outage
   // Why the attempt under way failed, as libmosquitto tells it before its calls return an
   // error code: the broker's refusal (CONNACK) or OpenSSL's reason (its log).
   std::string pending_cause_;

@@ -386,6 +386,8 @@ std::string tlsConfig(const ScratchDir& d, int port, const std::string& ca, cons
 
 // gyrod publishing to port with ca and password cannot: one log line says why (`cause`),
 // however often it retries, STATUS mqtt_last_error says the same, and the socket streams on.
+// (libmosquitto 2.0 now and then leaves a TLS handshake waiting until its keep-alive ends it:
+// that cause is logged once too, so the log is read for `cause` alone.)
 void expectFailureReported(int port, const std::string& ca, const std::string& password, const std::string& cause) {
   SCOPED_TRACE(cause);
   ScratchDir d;
@@ -395,20 +397,20 @@ void expectFailureReported(int port, const std::string& ca, const std::string& p
   ASSERT_TRUE(watcher.readLine());  // VERSION
   ASSERT_TRUE(watcher.send("{\"cmd\":\"watch\",\"enable\":true}\n"));
   json status;
+  std::vector<std::uint64_t> seqs;
   const auto until = std::chrono::steady_clock::now() + 30s;
   while (std::chrono::steady_clock::now() < until) {
     status = statusOf(d.path() / "gyrod.sock");
-    if (status.contains("mqtt_last_error")) break;
-    std::this_thread::sleep_for(200ms);
+    if (status.value("mqtt_last_error", "").find(cause) != std::string::npos) break;
+    watchFor(watcher, 200ms, seqs);
   }
   EXPECT_NE(status.value("mqtt_last_error", "").find(cause), std::string::npos) << status.dump();
   EXPECT_EQ(status.value("mqtt_connected", true), false) << status.dump();
-  std::vector<std::uint64_t> seqs;
+  seqs.clear();
   watchFor(watcher, 4s, seqs);  // retries after 0.5, 1, 2 s meanwhile (±20 %)
   EXPECT_GE(seqs.size(), 100u) << "the socket must stream on";
   const std::string log = readWholeFile(d.path() / "log.txt");
-  EXPECT_EQ(occurrences(log, "MQTT: cannot connect to the broker"), 1u) << log;
-  EXPECT_NE(log.find(cause), std::string::npos) << log;
+  EXPECT_EQ(occurrences(log, cause), 1u) << log;
   gyrod.signal(SIGTERM);
   EXPECT_EQ(gyrod.waitExit(10s), std::optional<int>(0));
 }
