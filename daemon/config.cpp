@@ -252,6 +252,23 @@ bool validTopicPrefix(std::string_view p) {
   return true;
 }
 
+void readMqttTls(const Section& s, MqttConfig& m) {
+  for (const auto& [key, member] :
+       {std::pair{"ca_file", &MqttConfig::ca_file}, std::pair{"cert_file", &MqttConfig::cert_file},
+        std::pair{"key_file", &MqttConfig::key_file}}) {
+    if (auto v = s.string(key)) {
+      if (v->empty() || hasControlCharacter(*v)) s.failValue(key, "must be a path without control characters");
+      m.*member = *v;
+    }
+  }
+  const bool tls = !m.url.empty() && parseMqttUrl(m.url).tls;
+  for (const char* key : {"ca_file", "cert_file", "key_file"})
+    if (s.has(key) && !tls) s.failValue(key, "needs an mqtts:// url (TLS)");
+  if (!m.cert_file.empty() && m.key_file.empty())
+    s.failValue("cert_file", "needs mqtt.key_file (the client certificate's private key)");
+  if (!m.key_file.empty() && m.cert_file.empty()) s.failValue("key_file", "needs mqtt.cert_file (its certificate)");
+}
+
 void readMqtt(const Section& s, MqttConfig& m) {
   if (auto v = s.string("url")) {
     try {
@@ -292,6 +309,12 @@ void readMqtt(const Section& s, MqttConfig& m) {
   }
   if (!m.password_file.empty() && m.username.empty())
     s.failValue("password_file", "needs mqtt.username (the broker checks the pair)");
+  if (auto v = s.integer("buffer_messages")) {
+    if (*v < 0 || *v > 100'000'000)
+      s.failValue("buffer_messages", "must be 0..100000000 messages (0: none kept while the broker is away)");
+    m.buffer_messages = static_cast<std::size_t>(*v);
+  }
+  readMqttTls(s, m);
 }
 
 void readRecord(const Section& s, RecordConfig& r) {
@@ -508,6 +531,20 @@ bool groupExists(const std::string& name) {
 // The files and names the configuration refers to, read as start-up will use them, so that
 // a bad one stops gyrod with exit 78 and the file:line of its key, and a SIGHUP that names
 // one keeps the running settings (both go through loadConfigFile).
+// A TLS file is read by OpenSSL inside libmosquitto; it is checked here as every file gyrod
+// reads is (formats/input_file.hpp), so that a directory or a FIFO is refused at its line.
+void checkMqttFiles(const Section& mqtt, const MqttConfig& m) {
+  for (const auto& [key, path] :
+       {std::pair{"ca_file", &m.ca_file}, std::pair{"cert_file", &m.cert_file}, std::pair{"key_file", &m.key_file}}) {
+    if (path->empty()) continue;
+    try {
+      (void)formats::readInputFile(*path, formats::kTlsFileInput);
+    } catch (const std::exception& e) {
+      mqtt.failValue(key, e.what());
+    }
+  }
+}
+
 void checkReferences(const Section& filter, const Section& socket, const Section& mock, const GyrodConfig& config) {
   if (!config.filter.model.empty()) {
     try {
@@ -588,9 +625,13 @@ GyrodConfig readConfig(const formats::TomlDocument& doc, ReferenceChecks checks)
                                      "temperature_coefficient_dps_per_c", "faults"});
   readMock(mock, config.mock);
   readLimits(section("limits", {"memory_mb"}), config.limits);
-  readMqtt(section("mqtt", {"url", "prefix", "qos", "client_id", "rate_every", "username", "password_file"}),
-           config.mqtt);
-  if (checks == ReferenceChecks::On) checkReferences(filter, socket, mock, config);
+  const auto mqtt = section("mqtt", {"url", "prefix", "qos", "client_id", "rate_every", "username", "password_file",
+                                     "buffer_messages", "ca_file", "cert_file", "key_file"});
+  readMqtt(mqtt, config.mqtt);
+  if (checks == ReferenceChecks::On) {
+    checkReferences(filter, socket, mock, config);
+    checkMqttFiles(mqtt, config.mqtt);
+  }
   checkMemory(doc, config, checks);
   return config;
 }
@@ -598,13 +639,19 @@ GyrodConfig readConfig(const formats::TomlDocument& doc, ReferenceChecks checks)
 }  // namespace
 
 MqttEndpoint parseMqttUrl(std::string_view url) {
-  constexpr std::string_view scheme = "mqtt://";
-  if (url.rfind("mqtts://", 0) == 0)
-    throw std::invalid_argument("mqtts:// (TLS) is not supported by this gyrod; use mqtt:// on a trusted network");
-  if (url.rfind(scheme, 0) != 0) throw std::invalid_argument("must be mqtt://HOST or mqtt://HOST:PORT");
-  std::string_view rest = url.substr(scheme.size());
-  if (!rest.empty() && rest.back() == '/') rest.remove_suffix(1);
+  constexpr std::string_view plain = "mqtt://", tls = "mqtts://";
   MqttEndpoint e;
+  std::string_view rest;
+  if (url.rfind(plain, 0) == 0) {
+    rest = url.substr(plain.size());
+  } else if (url.rfind(tls, 0) == 0) {
+    rest = url.substr(tls.size());
+    e.tls = true;
+    e.port = 8883;
+  } else {
+    throw std::invalid_argument("must be mqtt://HOST[:PORT] or mqtts://HOST[:PORT] (TLS)");
+  }
+  if (!rest.empty() && rest.back() == '/') rest.remove_suffix(1);
   const auto colon = rest.rfind(':');
   const bool bracketed = !rest.empty() && rest.front() == '[';  // [IPv6]:port
   if (colon != std::string_view::npos && (!bracketed || rest.find(']') < colon)) {
@@ -618,7 +665,7 @@ MqttEndpoint parseMqttUrl(std::string_view url) {
   }
   if (bracketed && rest.size() >= 2 && rest.back() == ']') rest = rest.substr(1, rest.size() - 2);
   if (rest.empty() || hasControlCharacter(rest) || rest.find_first_of("/@ ") != std::string_view::npos)
-    throw std::invalid_argument("must name a host: mqtt://HOST or mqtt://HOST:PORT");
+    throw std::invalid_argument("must name a host: mqtt://HOST[:PORT] or mqtts://HOST[:PORT]");
   e.host = std::string(rest);
   return e;
 }

@@ -91,21 +91,29 @@ struct SocketConfig {
 
 // [mqtt]: publishing to a broker (docs/protocol.md "MQTT"); off unless url is set.
 struct MqttConfig {
-  std::string url;             // mqtt://host[:port] (port 1883 by default)
+  std::string url;             // mqtt://host[:port] (port 1883) or mqtts://host[:port] (TLS, port 8883)
   std::string prefix;          // topics' prefix; empty: gyrod/<hostname>
   int qos = 0;                 // 0 or 1, for rate and gap (status is always QoS 1, retained)
   std::string client_id;       // empty: gyrod-<hostname>
   std::size_t rate_every = 1;  // publish every N-th RATE line
   std::string username;        // empty: no credentials
   std::string password_file;   // the password, read at start (systemd: LoadCredential=)
+  // qos 1: messages kept on the publisher's thread while the broker is away, oldest dropped
+  // past this (60 s at 1 kHz); 0: none kept.
+  std::size_t buffer_messages = 60000;
+  std::string ca_file;    // mqtts: the CA certificates the broker's is checked against; empty: /etc/ssl/certs
+  std::string cert_file;  // mqtts: a client certificate (PEM), with key_file
+  std::string key_file;   // mqtts: its private key (PEM, not encrypted)
   bool enabled() const { return !url.empty(); }
   bool operator==(const MqttConfig&) const = default;
 };
 
-// The host and port of an mqtt:// URL. Throws std::invalid_argument saying what is wrong.
+// The host and port of an mqtt:// or mqtts:// URL. Throws std::invalid_argument saying what
+// is wrong.
 struct MqttEndpoint {
   std::string host;
-  int port = 1883;
+  int port = 1883;  // 8883 for mqtts://
+  bool tls = false;
 };
 MqttEndpoint parseMqttUrl(std::string_view url);
 

@@ -61,6 +61,11 @@ MqttSettings mqttSettings(const GyrodConfig& c, const std::string& device) {
   MqttSettings s;
   s.host = endpoint.host;
   s.port = endpoint.port;
+  s.tls = endpoint.tls;
+  s.ca_file = c.mqtt.ca_file;
+  s.cert_file = c.mqtt.cert_file;
+  s.key_file = c.mqtt.key_file;
+  s.buffer_messages = c.mqtt.buffer_messages;
   s.prefix = c.mqtt.prefix.empty() ? "gyrod/" + hostName() : c.mqtt.prefix;
   s.client_id = c.mqtt.client_id.empty() ? "gyrod-" + hostName() : c.mqtt.client_id;
   s.qos = c.mqtt.qos;
@@ -390,9 +395,10 @@ int Gyrod::run() {
   }
   std::string mqtt;
   if (mqtt_) {
-    const std::uint64_t dropped = mqtt_->stats().dropped;
-    mqtt_.reset();  // publishes "offline" (retained) and disconnects
-    mqtt = fmt::format("; MQTT: {} lines dropped (the publisher fell behind)", dropped);
+    mqtt_->stop();  // publishes "offline" (retained) and disconnects
+    const MqttStats s = mqtt_->stats();
+    mqtt = fmt::format("; MQTT: {} messages published, {} dropped, {} still kept for the broker at the stop",
+                       s.published, s.dropped, s.buffered);
   }
   const std::string behind = behind_total_ == 0
                                  ? std::string()
@@ -753,6 +759,10 @@ AllanReport Gyrod::allanReport() {
 }
 
 StatusReport Gyrod::statusReport() {
+  // Before the state lock: the publisher's error string has a lock of its own, and the sample
+  // loop waits for the state lock.
+  std::optional<MqttStats> mqtt;
+  if (mqtt_) mqtt = mqtt_->stats();
   const std::lock_guard state(state_mutex_);
   StatusReport r;
   r.uptime_s = static_cast<double>(monotonicNowNs() - start_real_ns_) * 1e-9;
@@ -793,6 +803,7 @@ StatusReport Gyrod::statusReport() {
     r.recorder = protocol::RecorderStatus{stats.written, stats.dropped, stats.lost_to_errors, stats.write_errors,
                                           recorder_->lastError()};
   }
+  if (mqtt) r.mqtt = protocol::MqttStatus{mqtt->connected, mqtt->buffered, mqtt->dropped, std::move(mqtt->last_error)};
   return r;
 }
 

@@ -142,6 +142,14 @@ MemoryNeed memoryNeeded(const GyrodConfig& c) {
                             std::to_string(sizeof(LineForClients)) + " B",
                         "device.rate_hz", formats::shortest(c.device.rate_hz),
                         handover * static_cast<double>(sizeof(LineForClients))});
+  if (c.mqtt.enabled() && c.mqtt.qos == 1 && c.mqtt.buffer_messages > 0) {
+    const auto kept = static_cast<double>(c.mqtt.buffer_messages);
+    // 1.5 times: the array it grew from is still there while its lines are copied.
+    need.items.push_back({"MQTT messages kept while the broker is away: " + count(kept) + " x " +
+                              std::to_string(sizeof(LineForClients)) + " B x 1.5 (while it grows)",
+                          "mqtt.buffer_messages", std::to_string(c.mqtt.buffer_messages),
+                          1.5 * kept * static_cast<double>(sizeof(LineForClients))});
+  }
   if (c.record.enabled()) {
     const auto ring = static_cast<double>(recorderOptions(c.record, recordedSamplesPerSecond(c)).ring_capacity);
     need.items.push_back(

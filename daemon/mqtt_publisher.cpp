@@ -1,12 +1,16 @@
 #include "daemon/mqtt_publisher.hpp"
 
 #include <mosquitto.h>
+#include <poll.h>
 #include <pthread.h>
 #include <sched.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <array>
+#include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <mutex>
 #include <stdexcept>
@@ -21,12 +25,33 @@ constexpr int kKeepAliveSeconds = 10;
 constexpr auto kIdleWait = std::chrono::milliseconds(10);
 constexpr auto kStatusEvery = std::chrono::seconds(5);
 constexpr auto kOfflineWait = std::chrono::seconds(2);
-constexpr int kMaxRetrySeconds = 10;
+// Retries after 0.5 s, doubling to 30 s, each ±20 % so that a fleet of boards that lost the
+// same broker does not come back to it in step.
+constexpr double kFirstRetrySeconds = 0.5;
+constexpr double kMaxRetrySeconds = 30.0;
+constexpr double kRetryJitter = 0.2;
+// qos 1 messages handed to libmosquitto and not yet acknowledged, at most: beyond it they wait
+// in the publisher's buffer, which is bounded, instead of libmosquitto's queue, which is not.
+// Also libmosquitto's in-flight window, so that it never queues behind it either.
+constexpr std::size_t kMaxUnacknowledged = 1000;
+// Where OpenSSL finds the system's CA certificates on Debian (ca-certificates).
+constexpr const char* kSystemCaPath = "/etc/ssl/certs";
+constexpr int kSslVerifyPeer = 1;
+// Different causes of failure logged in one outage, at most (the last error is in STATUS).
+constexpr std::size_t kMaxLoggedCauses = 8;  // OpenSSL's SSL_VERIFY_PEER, which mosquitto_tls_opts_set takes
 
 // libmosquitto's global state, set up once per process.
 void initialiseLibraryOnce() {
   static std::once_flag once;
   std::call_once(once, [] { mosquitto_lib_init(); });
+}
+
+// A libmosquitto error code for a person.
+std::string describe(int rc) {
+  if (rc == MOSQ_ERR_ERRNO) return std::strerror(errno);
+  if (rc == MOSQ_ERR_KEEPALIVE)
+    return "no answer from the broker within " + std::to_string(kKeepAliveSeconds) + " s (the keep-alive)";
+  return mosquitto_strerror(rc);
 }
 
 std::string jsonString(std::string_view text) {
@@ -51,25 +76,53 @@ MqttPublisher::MqttPublisher(MqttSettings settings)
       status_topic_(settings_.prefix + "/" + std::string(protocol::kMqttStatusTopic)),
       rate_topic_(settings_.prefix + "/" + std::string(protocol::kMqttRateTopic)),
       gap_topic_(settings_.prefix + "/" + std::string(protocol::kMqttGapTopic)),
-      ring_(settings_.queue_lines) {
+      ring_(settings_.queue_lines),
+      buffer_(settings_.qos == 1 ? settings_.buffer_messages : 0),
+      jitter_(std::random_device{}()) {
   initialiseLibraryOnce();
-  mosq_ = mosquitto_new(settings_.client_id.c_str(), true, this);
+  // qos 1: a persistent session, so that the broker keeps what it has not acknowledged or
+  // delivered across a lost connection; qos 0 promises nothing of the kind.
+  const bool clean_session = settings_.qos != 1;
+  mosq_ = mosquitto_new(settings_.client_id.c_str(), clean_session, this);
   if (mosq_ == nullptr) throw std::runtime_error("MQTT: libmosquitto cannot create a client");
   const std::string offline = R"({"state":"offline"})";
   mosquitto_will_set(mosq_, status_topic_.c_str(), static_cast<int>(offline.size()), offline.data(), 1, true);
   if (!settings_.username.empty())
     mosquitto_username_pw_set(mosq_, settings_.username.c_str(),
                               settings_.password.empty() ? nullptr : settings_.password.c_str());
+  mosquitto_max_inflight_messages_set(mosq_, static_cast<unsigned>(kMaxUnacknowledged));
+  setUpTls();
   mosquitto_connect_callback_set(mosq_, &MqttPublisher::onConnect);
   mosquitto_disconnect_callback_set(mosq_, &MqttPublisher::onDisconnect);
   mosquitto_publish_callback_set(mosq_, &MqttPublisher::onPublish);
+  mosquitto_log_callback_set(mosq_, &MqttPublisher::onLog);
   thread_ = std::thread([this] { threadMain(); });
 }
 
 MqttPublisher::~MqttPublisher() {
+  stop();
+  mosquitto_destroy(mosq_);
+}
+
+void MqttPublisher::stop() {
   stop_ = true;
   if (thread_.joinable()) thread_.join();
-  mosquitto_destroy(mosq_);
+}
+
+void MqttPublisher::setUpTls() {
+  if (!settings_.tls) return;
+  const auto orNull = [](const std::string& s) { return s.empty() ? nullptr : s.c_str(); };
+  const char* ca_path = settings_.ca_file.empty() ? kSystemCaPath : nullptr;
+  int rc = mosquitto_tls_set(mosq_, orNull(settings_.ca_file), ca_path, orNull(settings_.cert_file),
+                             orNull(settings_.key_file), nullptr);
+  if (rc == MOSQ_ERR_SUCCESS) rc = mosquitto_tls_opts_set(mosq_, kSslVerifyPeer, nullptr, nullptr);
+  if (rc == MOSQ_ERR_SUCCESS) rc = mosquitto_tls_insecure_set(mosq_, false);  // the host name is checked too
+  if (rc != MOSQ_ERR_SUCCESS) {
+    mosquitto_destroy(mosq_);
+    throw std::runtime_error(std::string("MQTT: libmosquitto refuses the TLS settings (mqtt.ca_file, cert_file, "
+                                         "key_file): ") +
+                             mosquitto_strerror(rc));
+  }
 }
 
 void MqttPublisher::push(const LineForClients& line) noexcept {
@@ -77,59 +130,144 @@ void MqttPublisher::push(const LineForClients& line) noexcept {
 }
 
 MqttStats MqttPublisher::stats() const {
-  return {connected_.load(), published_.load(), dropped_.load(), connects_.load()};
+  MqttStats s{connected_.load(), published_.load(), buffered_.load(), dropped_.load(), connects_.load(), {}};
+  const std::lock_guard lock(error_mutex_);
+  s.last_error = last_error_;
+  return s;
 }
 
+void MqttPublisher::setLastError(const std::string& why) {
+  const std::lock_guard lock(error_mutex_);
+  last_error_ = why;
+}
+
+// The callbacks run on the publisher's thread, inside mosquitto_loop and the connect calls.
 void MqttPublisher::onConnect(mosquitto* /*mosq*/, void* self, int rc) {
   auto* p = static_cast<MqttPublisher*>(self);
-  if (rc != 0) {
-    spdlog::warn("MQTT: the broker at {}:{} refused the connection: {}", p->settings_.host, p->settings_.port,
-                 mosquitto_connack_string(rc));
+  if (rc != 0) {  // libmosquitto closes the connection next; connectionFailed says why
+    p->pending_cause_ = std::string("the broker refused the connection: ") + mosquitto_connack_string(rc);
     return;
   }
   p->connects_.fetch_add(1);
   p->connecting_ = false;
   p->connected_ = true;
-  spdlog::info("MQTT: connected to {}:{} as {}; publishing under {}/", p->settings_.host, p->settings_.port,
-               p->settings_.client_id, p->settings_.prefix);
+  p->failures_ = 0;
+  p->logged_causes_.clear();
+  // Nothing is published from here: libmosquitto resends what it holds in flight after this
+  // callback, and the buffer must go after those (sendBuffered, once mosquitto_loop returns).
+  p->reportOutageOver();
 }
 
 void MqttPublisher::onDisconnect(mosquitto* /*mosq*/, void* self, int rc) {
   auto* p = static_cast<MqttPublisher*>(self);
-  p->connecting_ = false;
-  if (p->connected_.exchange(false) && rc != 0 && !p->stop_)
-    spdlog::warn("MQTT: lost the broker at {}:{} ({}); reconnecting", p->settings_.host, p->settings_.port,
-                 mosquitto_strerror(rc));
+  if (rc != 0 && p->pending_cause_.empty()) p->pending_cause_ = describe(rc);
+  if (rc != 0) p->disconnected_ = true;
 }
 
 void MqttPublisher::onPublish(mosquitto* /*mosq*/, void* self, int mid) {
   auto* p = static_cast<MqttPublisher*>(self);
   if (mid == p->last_status_mid_.load()) p->last_status_sent_ = true;
+  if (p->unacknowledged_ > 0) --p->unacknowledged_;  // qos 1: the broker's PUBACK
+}
+
+void MqttPublisher::onLog(mosquitto* /*mosq*/, void* self, int level, const char* text) {
+  // libmosquitto reports why a TLS handshake failed only here ("OpenSSL Error[0]: ...").
+  auto* p = static_cast<MqttPublisher*>(self);
+  constexpr std::string_view openssl = "OpenSSL Error";
+  const std::string_view t(text);
+  if (level != MOSQ_LOG_ERR || t.rfind(openssl, 0) != 0 || !p->pending_cause_.empty()) return;
+  const auto colon = t.find(": ");
+  p->pending_cause_ = "TLS handshake failed: " + std::string(colon == std::string_view::npos ? t : t.substr(colon + 2));
+}
+
+void MqttPublisher::reportOutageOver() {
+  if (!in_outage_) {
+    spdlog::info("MQTT: connected to {}:{} as {}; publishing under {}/", settings_.host, settings_.port,
+                 settings_.client_id, settings_.prefix);
+    return;
+  }
+  in_outage_ = false;
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - outage_start_).count();
+  spdlog::info(
+      "MQTT: connected to {}:{} as {} after {:.1f} s without the broker; {} messages kept meanwhile are sent now, {} "
+      "dropped",
+      settings_.host, settings_.port, settings_.client_id, seconds, outage_buffered_,
+      dropped_.load() - outage_dropped_start_);
+}
+
+void MqttPublisher::connectionFailed(const std::string& why) {
+  const auto now = std::chrono::steady_clock::now();
+  const std::string cause = pending_cause_.empty() ? why : pending_cause_;
+  pending_cause_.clear();
+  disconnected_ = false;
+  connecting_ = false;
+  const bool was_connected = connected_.exchange(false);
+  setLastError(cause);
+  if (!in_outage_) {
+    in_outage_ = true;
+    outage_start_ = now;
+    outage_dropped_start_ = dropped_.load();
+    outage_buffered_ = 0;
+  }
+  const std::string keeping = settings_.qos == 1 && settings_.buffer_messages > 0
+                                  ? "keeping up to " + std::to_string(settings_.buffer_messages) + " messages"
+                                  : "dropping the messages meanwhile";
+  // Each cause once per outage: the retries go on for as long as the broker is away, and a
+  // cause that comes and goes (a handshake that times out now and then) is not news either.
+  const bool new_cause = std::find(logged_causes_.begin(), logged_causes_.end(), cause) == logged_causes_.end();
+  if (was_connected && !stop_) {
+    spdlog::warn("MQTT: lost the broker at {}:{} ({}); reconnecting, {}", settings_.host, settings_.port, cause,
+                 keeping);
+  } else if (new_cause && logged_causes_.size() < kMaxLoggedCauses && !stop_) {
+    spdlog::warn("MQTT: cannot connect to the broker at {}:{}: {}; streaming on the socket and retrying, {}",
+                 settings_.host, settings_.port, cause, keeping);
+  }
+  if (new_cause && logged_causes_.size() < kMaxLoggedCauses) logged_causes_.push_back(cause);
+  ++failures_;
+  const double base = std::min(kMaxRetrySeconds, kFirstRetrySeconds * std::pow(2.0, std::min(failures_ - 1, 16)));
+  const double factor = std::uniform_real_distribution<double>(1.0 - kRetryJitter, 1.0 + kRetryJitter)(jitter_);
+  next_attempt_ = now + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(base * factor));
 }
 
 void MqttPublisher::publishStatus(const char* state) {
   std::string s = std::string(R"({"state":")") + state + R"(","device":)" + jsonString(settings_.device) +
                   R"(,"rate_hz":)" + formats::shortest(settings_.rate_hz) + R"(,"samples":)" +
                   std::to_string(samples_seen_) + R"(,"gaps":)" + std::to_string(gaps_seen_) + R"(,"samples_lost":)" +
-                  std::to_string(samples_lost_) + R"(,"mqtt_dropped":)" + std::to_string(dropped_.load()) + "}";
+                  std::to_string(samples_lost_) + R"(,"mqtt_buffered":)" + std::to_string(buffer_.size()) +
+                  R"(,"mqtt_dropped":)" + std::to_string(dropped_.load()) + "}";
   int mid = 0;
   if (mosquitto_publish(mosq_, &mid, status_topic_.c_str(), static_cast<int>(s.size()), s.data(), 1, true) ==
       MOSQ_ERR_SUCCESS) {
     last_status_mid_ = mid;
     published_.fetch_add(1, std::memory_order_relaxed);
+    if (settings_.qos == 1) ++unacknowledged_;
   }
 }
 
-void MqttPublisher::publishLine(const LineForClients& line) {
-  const bool rate = line.kind == LineForClients::Kind::Rate;
-  if (rate) {
+// A line from the ring: counted, then sent, kept for the broker (qos 1) or dropped.
+void MqttPublisher::takeLine(const LineForClients& line) {
+  if (line.kind == LineForClients::Kind::Rate) {
     ++samples_seen_;
     if ((samples_seen_ - 1) % settings_.rate_every != 0) return;
   } else {
     ++gaps_seen_;
     samples_lost_ += line.gap_count;
   }
-  if (!connected_) return;  // counted, but nothing formatted or queued for a broker that is not there
+  if (settings_.qos == 1 && settings_.buffer_messages > 0) {
+    if (!buffer_.pushBack(line)) dropped_.fetch_add(1, std::memory_order_relaxed);  // the oldest went
+    if (!connected_) ++outage_buffered_;
+    buffered_.store(buffer_.size(), std::memory_order_relaxed);
+    return;
+  }
+  // Nothing formatted or queued for a broker that is not there, or (qos 1 without a buffer)
+  // past what libmosquitto may hold unacknowledged.
+  const bool room = settings_.qos == 0 || unacknowledged_ < kMaxUnacknowledged;
+  if (!connected_ || !room || !publishLine(line)) dropped_.fetch_add(1, std::memory_order_relaxed);
+}
+
+bool MqttPublisher::publishLine(const LineForClients& line) {
+  const bool rate = line.kind == LineForClients::Kind::Rate;
   std::array<char, protocol::kMaxRateLineBytes> buffer;
   std::array<char, protocol::kMaxGapLineBytes> gap_buffer;
   char* text = rate ? buffer.data() : gap_buffer.data();
@@ -139,73 +277,102 @@ void MqttPublisher::publishLine(const LineForClients& line) {
                             {line.gap_first_seq, line.gap_count, std::string_view(line.gap_reason.data())}, gap_buffer);
   if (n > 0 && text[n - 1] == '\n') --n;  // a message is one JSON object, without the line's newline
   const std::string& topic = rate ? rate_topic_ : gap_topic_;
-  if (mosquitto_publish(mosq_, nullptr, topic.c_str(), static_cast<int>(n), text, settings_.qos, false) ==
+  if (mosquitto_publish(mosq_, nullptr, topic.c_str(), static_cast<int>(n), text, settings_.qos, false) !=
       MOSQ_ERR_SUCCESS)
-    published_.fetch_add(1, std::memory_order_relaxed);
+    return false;
+  published_.fetch_add(1, std::memory_order_relaxed);
+  if (settings_.qos == 1) ++unacknowledged_;
+  return true;
+}
+
+// The buffer, oldest first, as far as the broker keeps up with its acknowledgements.
+void MqttPublisher::sendBuffered() {
+  while (connected_ && !buffer_.empty() && unacknowledged_ < kMaxUnacknowledged) {
+    if (!publishLine(buffer_.front())) break;  // kept: the connection is being lost
+    buffer_.popFront();
+  }
+  buffered_.store(buffer_.size(), std::memory_order_relaxed);
+}
+
+void MqttPublisher::attemptConnection(std::chrono::steady_clock::time_point now) {
+  if (connected_ || connecting_ || now < next_attempt_) return;
+  pending_cause_.clear();
+  errno = 0;
+  const int rc = attempted_ ? mosquitto_reconnect_async(mosq_)
+                            : mosquitto_connect_async(mosq_, settings_.host.c_str(), settings_.port, kKeepAliveSeconds);
+  connect_errno_ = errno;
+  attempted_ = true;
+  if (rc == MOSQ_ERR_SUCCESS) {
+    connecting_ = true;
+  } else {
+    connectionFailed(describe(rc));
+  }
+}
+
+// A connection being made: libmosquitto 2.0 does not notice a TCP connection that failed
+// under TLS (its handshake swallows the error and it waits for the keep-alive to end), so a
+// socket that hung up before the broker answered is a failure here. Its cause is what errno
+// said right after the connect call, when that is a connection error. False when it failed.
+bool MqttPublisher::checkConnecting() {
+  const int sock = mosquitto_socket(mosq_);
+  if (sock < 0) return true;
+  pollfd p{sock, POLLOUT, 0};
+  if (::poll(&p, 1, 0) != 1 || (p.revents & (POLLHUP | POLLERR)) == 0) return true;
+  const int e = connect_errno_;
+  const bool known = e == ECONNREFUSED || e == ECONNRESET || e == ETIMEDOUT || e == EHOSTUNREACH || e == ENETUNREACH;
+  connectionFailed(known ? std::strerror(e) : "the connection was closed before the broker answered");
+  return false;
+}
+
+void MqttPublisher::runLoop() {
+  if (connecting_ && !connected_ && !checkConnecting()) return;
+  const int rc = mosquitto_loop(mosq_, static_cast<int>(kIdleWait.count()), 1);
+  if (rc != MOSQ_ERR_SUCCESS) {  // refused, lost or never made: try again later
+    connectionFailed(describe(rc));
+  } else if (disconnected_) {
+    connectionFailed("the connection was closed");
+  }
 }
 
 void MqttPublisher::threadMain() {
   // Never in competition with the sample loop, which may run SCHED_FIFO.
   const sched_param normal{};
   ::pthread_setschedparam(::pthread_self(), SCHED_OTHER, &normal);
-  // The client is driven from here (mosquitto_loop): DNS, connect and every send happen on this
-  // thread, and a connection that fails or is lost is tried again after 1, 2, ... 10 s.
-  bool attempted = false, warned = false, was_connected = false;
-  int failures = 0;
-  auto now = std::chrono::steady_clock::now();
-  auto next_attempt = now, next_status = now;
+  // The client is driven from here (mosquitto_loop): DNS, TLS, connect and every send happen
+  // on this thread, and libmosquitto's callbacks run on it.
+  bool was_connected = false;
+  auto next_status = std::chrono::steady_clock::now();
   LineForClients line;
   while (!stop_) {
-    now = std::chrono::steady_clock::now();
-    if (!connected_ && !connecting_ && now >= next_attempt) {
-      const int rc = attempted
-                         ? mosquitto_reconnect_async(mosq_)
-                         : mosquitto_connect_async(mosq_, settings_.host.c_str(), settings_.port, kKeepAliveSeconds);
-      attempted = true;
-      if (rc == MOSQ_ERR_SUCCESS) {
-        connecting_ = true;
-      } else {
-        if (!warned)
-          spdlog::warn("MQTT: cannot reach the broker at {}:{} ({}); streaming on the socket and retrying",
-                       settings_.host, settings_.port,
-                       rc == MOSQ_ERR_ERRNO ? std::strerror(errno) : mosquitto_strerror(rc));
-        warned = true;
-        failures = std::min(failures + 1, kMaxRetrySeconds);
-        next_attempt = now + std::chrono::seconds(failures);
-      }
-    }
+    const auto now = std::chrono::steady_clock::now();
+    attemptConnection(now);
     const bool connected = connected_.load();
     if (connected && (!was_connected || now >= next_status)) {
       publishStatus("online");
       next_status = now + kStatusEvery;
-      warned = false;
-      failures = 0;
     }
     was_connected = connected;
-    while (ring_.tryPop(line)) publishLine(line);
+    while (ring_.tryPop(line)) takeLine(line);
+    sendBuffered();
     if (connected_ || connecting_) {
-      const int rc = mosquitto_loop(mosq_, static_cast<int>(kIdleWait.count()), 1);
-      if (rc != MOSQ_ERR_SUCCESS) {  // refused, lost or never made: try again later
-        connecting_ = false;
-        if (connected_.exchange(false) && !stop_)
-          spdlog::warn("MQTT: lost the broker at {}:{} ({}); reconnecting", settings_.host, settings_.port,
-                       mosquitto_strerror(rc));
-        failures = std::min(failures + 1, kMaxRetrySeconds);
-        next_attempt = std::chrono::steady_clock::now() + std::chrono::seconds(failures);
-      }
+      runLoop();
     } else {
       std::this_thread::sleep_for(kIdleWait);
     }
   }
-  if (connected_) {  // a clean stop: say so, and give it a moment to leave
-    last_status_sent_ = false;
-    publishStatus("offline");
-    const auto until = std::chrono::steady_clock::now() + kOfflineWait;
-    while (!last_status_sent_ && connected_ && std::chrono::steady_clock::now() < until)
-      if (mosquitto_loop(mosq_, static_cast<int>(kIdleWait.count()), 1) != MOSQ_ERR_SUCCESS) break;
-    mosquitto_disconnect(mosq_);
-    mosquitto_loop(mosq_, static_cast<int>(kIdleWait.count()), 1);  // the DISCONNECT out
-  }
+  stopCleanly();
+}
+
+void MqttPublisher::stopCleanly() {
+  if (!connected_) return;
+  // A clean stop: say so, and give it a moment to leave.
+  last_status_sent_ = false;
+  publishStatus("offline");
+  const auto until = std::chrono::steady_clock::now() + kOfflineWait;
+  while (!last_status_sent_ && connected_ && std::chrono::steady_clock::now() < until)
+    if (mosquitto_loop(mosq_, static_cast<int>(kIdleWait.count()), 1) != MOSQ_ERR_SUCCESS) break;
+  mosquitto_disconnect(mosq_);
+  mosquitto_loop(mosq_, static_cast<int>(kIdleWait.count()), 1);  // the DISCONNECT out
 }
 
 }  // namespace gyrod::daemon

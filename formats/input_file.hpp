@@ -41,6 +41,9 @@ inline constexpr InputKind kReplayInput{"replay file", 256 * kMiB};
 inline constexpr InputKind kRecordingInput{"recording", 256 * kGiB};
 // A password (gyrod's mqtt.password_file; systemd's LoadCredential=): one line.
 inline constexpr InputKind kCredentialInput{"credential file", 64 * 1024};
+// A TLS certificate or private key in PEM (gyrod's mqtt.ca_file, cert_file, key_file): a CA
+// bundle such as Debian's ca-certificates.crt is about 200 KiB.
+inline constexpr InputKind kTlsFileInput{"TLS file", 4 * kMiB};
 // A foreign recording `gyroctl import` converts (read whole into memory).
 inline constexpr InputKind kImportInput{"recording to import", 4 * kGiB};
 

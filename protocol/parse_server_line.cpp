@@ -200,7 +200,11 @@ constexpr std::string_view kStatusFields[] = {"class",
                                               "client_list",
                                               "recorder",
                                               "still_check",
-                                              "still_check_detail"};
+                                              "still_check_detail",
+                                              "mqtt_connected",
+                                              "mqtt_buffered",
+                                              "mqtt_dropped",
+                                              "mqtt_last_error"};
 
 StatusReply statusOf(const json& j) {
   constexpr std::string_view cls = "STATUS";
@@ -231,6 +235,13 @@ StatusReply statusOf(const json& j) {
     rs.lost = count(*recorder, cls, "lost");
     rs.errors = count(*recorder, cls, "errors");
     rs.last_error = optionalText(*recorder, cls, "last_error").value_or("");
+  }
+  if (const auto connected = optionalFlag(j, cls, "mqtt_connected")) {
+    MqttStatus& m = d.mqtt.emplace();
+    m.connected = *connected;
+    m.buffered = count(j, cls, "mqtt_buffered");
+    m.dropped = count(j, cls, "mqtt_dropped");
+    m.last_error = optionalText(j, cls, "mqtt_last_error").value_or("");
   }
   if (const json* counters = field(j, cls, "counters", &json::is_object, "an object")) {
     for (auto it = counters->begin(); it != counters->end(); ++it) {

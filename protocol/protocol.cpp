@@ -284,6 +284,12 @@ std::string statusLine(const StatusReport& d, const ServerStatus& s) {
     if (!d.recorder->last_error.empty()) recorder["last_error"] = d.recorder->last_error;
     j["recorder"] = std::move(recorder);
   }
+  if (d.mqtt) {
+    j["mqtt_connected"] = d.mqtt->connected;
+    j["mqtt_buffered"] = d.mqtt->buffered;
+    j["mqtt_dropped"] = d.mqtt->dropped;
+    if (!d.mqtt->last_error.empty()) j["mqtt_last_error"] = d.mqtt->last_error;
+  }
   if (!d.device_counters.empty()) {
     json counters = json::object();
     for (const NamedCount& c : d.device_counters) counters[c.name] = c.value;

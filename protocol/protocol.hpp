@@ -23,7 +23,7 @@
 namespace gyrod::protocol {
 
 inline constexpr int kProtocolMajor = 1;  // incompatible changes
-inline constexpr int kProtocolMinor = 4;  // compatible additions (new classes, new fields)
+inline constexpr int kProtocolMinor = 5;  // compatible additions (new classes, new fields)
 
 // A client line longer than this (not counting the '\n' and an optional '\r') is refused
 // with an ERROR and the client is disconnected.
@@ -153,6 +153,15 @@ struct RecorderStatus {
   bool operator==(const RecorderStatus&) const = default;
 };
 
+// The MQTT publisher's state (STATUS mqtt_*, when [mqtt] url is set).
+struct MqttStatus {
+  bool connected = false;      // to the broker, now
+  std::uint64_t buffered = 0;  // messages kept for the broker now (qos 1)
+  std::uint64_t dropped = 0;   // messages the broker will never get from this gyrod
+  std::string last_error;      // why the last connection or attempt failed; empty (omitted) when none
+  bool operator==(const MqttStatus&) const = default;
+};
+
 // The verdict on the start-up still period (STATUS "still_check", docs/protocol.md).
 enum class StillCheck {
   Pending,        // the still period is being collected
@@ -183,6 +192,7 @@ struct StatusReport {
   std::optional<std::string> rate_model;          // what the rate stream subtracts: "model FILE" or "bias"
   std::optional<std::string> recording;           // file being recorded to
   std::optional<RecorderStatus> recorder;         // the recorder's counts, while recording
+  std::optional<MqttStatus> mqtt;                 // the MQTT publisher, when configured
 };
 
 // What the server knows about its clients; added to every STATUS line.

@@ -5,7 +5,7 @@ set -euo pipefail
 packages=(
   g++ cmake make ninja-build pkg-config
   libeigen3-dev libboost-math-dev nlohmann-json3-dev libcli11-dev libtomlplusplus-dev
-  libspdlog-dev libi2c-dev libgpiod-dev libsystemd-dev libmosquitto-dev mosquitto
+  libspdlog-dev libi2c-dev libgpiod-dev libsystemd-dev libmosquitto-dev mosquitto openssl
   libgtest-dev libbenchmark-dev zlib1g-dev
   gnuplot-nox systemd python3
   python3-numpy python3-pandas

@@ -234,7 +234,7 @@ TEST_F(GyroctlTest, StatusHumanAndJson) {
 
   const CommandResult h = run({"status", "--socket", socketPath()});
   ASSERT_EQ(h.exit_status, 0) << h.err;
-  EXPECT_NE(h.out.find(std::string("gyrod ") + GYROD_RELEASE + " (protocol 1.4)"), std::string::npos) << h.out;
+  EXPECT_NE(h.out.find(std::string("gyrod ") + GYROD_RELEASE + " (protocol 1.5)"), std::string::npos) << h.out;
   EXPECT_NE(h.out.find("device_state:    streaming\n"), std::string::npos) << h.out;
   EXPECT_NE(h.out.find("device:          /dev/i2c-1@0x68\n"), std::string::npos) << h.out;
   EXPECT_NE(h.out.find("samples:         1234\n"), std::string::npos) << h.out;
@@ -247,6 +247,7 @@ TEST_F(GyroctlTest, StatusShowsTheDeviceReasonAndEveryDriverCounter) {
   content_.status.device_reason = "WHO_AM_I reads 0x00: no MPU6050 at 0x68";
   content_.status.device_retrying = false;
   content_.status.device_counters = {{"transfers_failed", 12}, {"recoveries", 3}, {"data_ready_missed", 7}};
+  content_.status.mqtt = protocol::MqttStatus{false, 250, 0, "Connection refused"};
   startServer();
   const CommandResult h = run({"status", "--socket", socketPath()});
   ASSERT_EQ(h.exit_status, 0) << h.err;
@@ -258,6 +259,10 @@ TEST_F(GyroctlTest, StatusShowsTheDeviceReasonAndEveryDriverCounter) {
                        "  data_ready_missed:     7\n"),
             std::string::npos)
       << h.out;
+  EXPECT_NE(h.out.find("mqtt:            not connected, 250 kept for the broker, 0 dropped; last error: Connection "
+                       "refused\n"),
+            std::string::npos)
+      << h.out;
 
   const CommandResult j = run({"status", "--socket", socketPath(), "--json"});
   ASSERT_EQ(j.exit_status, 0) << j.err;
@@ -265,6 +270,7 @@ TEST_F(GyroctlTest, StatusShowsTheDeviceReasonAndEveryDriverCounter) {
   EXPECT_EQ(s["device_reason"], content_.status.device_reason);
   EXPECT_EQ(s["device_retrying"], false);
   EXPECT_EQ(s["counters"], json::parse(R"({"transfers_failed":12,"recoveries":3,"data_ready_missed":7})"));
+  EXPECT_EQ(s["mqtt_buffered"], 250);
 }
 
 namespace {

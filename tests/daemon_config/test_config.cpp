@@ -609,10 +609,9 @@ TEST(ConfigMqtt, ValuesAreReadAndBadOnesNameFileLineAndKey) {
   EXPECT_FALSE(parseConfig("[log]\nlevel = \"info\"\n", "x.toml").mqtt.enabled());
 
   const auto error = [](const std::string& line) { return errorOf("[mqtt]\n" + line + "\n"); };
-  EXPECT_NE(error("url = \"mqtts://b:8883\"").find("x.toml:2: key 'mqtt.url'"), std::string::npos)
-      << error("url = \"mqtts://b:8883\"");
-  EXPECT_NE(error("url = \"mqtts://b:8883\"").find("TLS"), std::string::npos);
-  EXPECT_NE(error("url = \"http://b\"").find("mqtt://HOST"), std::string::npos);
+  EXPECT_NE(error("url = \"mqtts:/b:8883\"").find("x.toml:2: key 'mqtt.url'"), std::string::npos)
+      << error("url = \"mqtts:/b:8883\"");
+  EXPECT_NE(error("url = \"http://b\"").find("mqtts://HOST[:PORT] (TLS)"), std::string::npos);
   EXPECT_NE(error("url = \"mqtt://b:0\"").find("port must be 1..65535"), std::string::npos);
   EXPECT_NE(error("url = \"mqtt://\"").find("must name a host"), std::string::npos);
   EXPECT_NE(error("qos = 2").find("x.toml:2: key 'mqtt.qos'"), std::string::npos);
@@ -621,4 +620,57 @@ TEST(ConfigMqtt, ValuesAreReadAndBadOnesNameFileLineAndKey) {
   EXPECT_NE(error("rate_every = 0").find("key 'mqtt.rate_every'"), std::string::npos);
   EXPECT_NE(error("password_file = \"/p\"").find("needs mqtt.username"), std::string::npos);
   EXPECT_NE(error("colour = 1").find("unknown key"), std::string::npos);
+}
+
+TEST(ConfigMqtt, BufferAndTlsKeysAreReadAndBadOnesNameFileLineAndKey) {
+  EXPECT_EQ(parseConfig("[mqtt]\nurl = \"mqtt://b\"\n", "x.toml").mqtt.buffer_messages, 60000u);
+  const GyrodConfig c = parseConfig(
+      "[mqtt]\nurl = \"mqtts://broker.lan\"\nqos = 1\nbuffer_messages = 500\nca_file = \"/etc/gyrod/ca.pem\"\n"
+      "cert_file = \"/etc/gyrod/board.pem\"\nkey_file = \"/etc/gyrod/board.key\"\n",
+      "x.toml");
+  EXPECT_EQ(c.mqtt.buffer_messages, 500u);
+  EXPECT_EQ(c.mqtt.ca_file, "/etc/gyrod/ca.pem");
+  EXPECT_EQ(c.mqtt.cert_file, "/etc/gyrod/board.pem");
+  EXPECT_EQ(c.mqtt.key_file, "/etc/gyrod/board.key");
+  const MqttEndpoint tls = parseMqttUrl(c.mqtt.url);
+  EXPECT_TRUE(tls.tls);
+  EXPECT_EQ(tls.port, 8883);
+  EXPECT_EQ(parseMqttUrl("mqtts://b:9999").port, 9999);
+  EXPECT_FALSE(parseMqttUrl("mqtt://b").tls);
+
+  const auto error = [](const std::string& lines) { return errorOf("[mqtt]\nurl = \"mqtts://b\"\n" + lines + "\n"); };
+  EXPECT_EQ(error("buffer_messages = -1"),
+            "x.toml:3: key 'mqtt.buffer_messages': must be 0..100000000 messages (0: none kept while the broker is "
+            "away) (got -1)");
+  EXPECT_NE(error("buffer_messages = \"many\"").find("x.toml:3: key 'mqtt.buffer_messages'"), std::string::npos);
+  EXPECT_NE(error("ca_file = \"\"").find("x.toml:3: key 'mqtt.ca_file': must be a path"), std::string::npos);
+  EXPECT_NE(error("cert_file = \"/c.pem\"").find("x.toml:3: key 'mqtt.cert_file': needs mqtt.key_file"),
+            std::string::npos);
+  EXPECT_NE(error("key_file = \"/k.pem\"").find("x.toml:3: key 'mqtt.key_file': needs mqtt.cert_file"),
+            std::string::npos);
+  const std::string plain = errorOf("[mqtt]\nurl = \"mqtt://b\"\nca_file = \"/ca.pem\"\n");
+  EXPECT_NE(plain.find("x.toml:3: key 'mqtt.ca_file': needs an mqtts:// url (TLS)"), std::string::npos) << plain;
+}
+
+// The TLS files are read as every file gyrod reads: a regular file, within a size limit.
+TEST(ConfigMqtt, TlsFilesMustBeRegularFilesWhenLoadingAFile) {
+  TempDir d;
+  const auto ca = d.write("ca.pem", "-----BEGIN CERTIFICATE-----\n");
+  const auto good = d.write("good.toml", "[mqtt]\nurl = \"mqtts://b\"\nca_file = \"" + ca + "\"\n");
+  EXPECT_EQ(loadConfigFile(good).mqtt.ca_file, ca);
+  const auto cases = {std::pair{"ca_file", d.path("")}, std::pair{"cert_file", d.path("missing.pem")},
+                      std::pair{"key_file", std::string("/dev/zero")}};
+  for (const auto& [key, path] : cases) {
+    const std::string other = std::string(key) == "ca_file"     ? ""
+                              : std::string(key) == "cert_file" ? "key_file = \"" + ca + "\"\n"
+                                                                : "cert_file = \"" + ca + "\"\n";
+    const auto f = d.write("tls.toml", "[mqtt]\nurl = \"mqtts://b\"\n" + other + key + " = \"" + path + "\"\n");
+    try {
+      loadConfigFile(f);
+      ADD_FAILURE() << key << " = " << path << ": no error";
+    } catch (const ConfigError& e) {
+      const std::string line = other.empty() ? ":3: " : ":4: ";
+      EXPECT_EQ(std::string(e.what()).rfind(f + line + "key 'mqtt." + key + "': " + path, 0), 0u) << e.what();
+    }
+  }
 }

@@ -156,6 +156,7 @@ TEST(ParseServerLine, StatusRoundTripsEveryField) {
   d.temp_c = 31.25;
   d.bias_source = "config [0, 0, 0] deg/s";
   d.recording = "/var/lib/gyrod/gyro.csv";
+  d.mqtt = MqttStatus{true, 12, 3, "TLS handshake failed: certificate verify failed"};
   ServerStatus s;
   s.clients = 2;
   s.clients_total = 5;
@@ -172,6 +173,7 @@ TEST(ParseServerLine, StatusRoundTripsEveryField) {
   EXPECT_EQ(back.daemon.device_reason, d.device_reason);
   EXPECT_EQ(back.daemon.device_retrying, d.device_retrying);
   EXPECT_EQ(back.daemon.rate_hz, d.rate_hz);
+  EXPECT_EQ(back.daemon.mqtt, d.mqtt);
   EXPECT_EQ(back.server.client_list.size(), 2u);
   EXPECT_EQ(back.server.client_list[0].pid, 4242);
   EXPECT_FALSE(back.server.client_list[1].pid.has_value());

@@ -99,6 +99,7 @@ nlohmann::json fullStatus() {
   d.rate_model = "bias";
   d.recording = "file.csv";
   d.recorder = protocol::RecorderStatus{1, 2, 3, 4, "write to file.csv: No space left on device"};
+  d.mqtt = protocol::MqttStatus{false, 5, 6, "Connection refused"};
   protocol::ServerStatus s;
   s.client_list.push_back({1, 2, 3, true, 1, 1, 1, 1, true});
   return nlohmann::json::parse(protocol::statusLine(d, s));

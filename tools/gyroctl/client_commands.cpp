@@ -431,6 +431,10 @@ void printStatus(const protocol::StatusReply& status) {
     printField("recorder", count(r->written) + " written, " + count(r->dropped) + " dropped (ring full), " +
                                count(r->lost) + " lost to write errors (" + count(r->errors) + " failed calls)" +
                                (r->last_error.empty() ? "" : "; last: " + r->last_error));
+  if (const auto& m = d.mqtt)
+    printField("mqtt", std::string(m->connected ? "connected" : "not connected") + ", " + count(m->buffered) +
+                           " kept for the broker, " + count(m->dropped) + " dropped" +
+                           (m->last_error.empty() ? "" : "; last error: " + m->last_error));
   printField("clients", count(s.clients));
   printField("clients_total", count(s.clients_total));
   printField("clients_dropped", count(s.clients_dropped));
