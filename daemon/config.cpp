@@ -315,6 +315,14 @@ void readMqtt(const Section& s, MqttConfig& m) {
     m.buffer_messages = static_cast<std::size_t>(*v);
   }
   readMqttTls(s, m);
+  if (auto v = s.boolean("home_assistant")) m.home_assistant = *v;
+  if (auto v = s.string("home_assistant_prefix")) {
+    if (!validTopicPrefix(*v))
+      s.failValue("home_assistant_prefix",
+                  "must be topic levels like \"homeassistant\": no '+', '#', control characters, empty levels or "
+                  "leading/trailing '/'");
+    m.home_assistant_prefix = *v;
+  }
 }
 
 void readRecord(const Section& s, RecordConfig& r) {
@@ -625,8 +633,9 @@ GyrodConfig readConfig(const formats::TomlDocument& doc, ReferenceChecks checks)
                                      "temperature_coefficient_dps_per_c", "faults"});
   readMock(mock, config.mock);
   readLimits(section("limits", {"memory_mb"}), config.limits);
-  const auto mqtt = section("mqtt", {"url", "prefix", "qos", "client_id", "rate_every", "username", "password_file",
-                                     "buffer_messages", "ca_file", "cert_file", "key_file"});
+  const auto mqtt = section(
+      "mqtt", {"url", "prefix", "qos", "client_id", "rate_every", "username", "password_file", "buffer_messages",
+               "ca_file", "cert_file", "key_file", "home_assistant", "home_assistant_prefix"});
   readMqtt(mqtt, config.mqtt);
   if (checks == ReferenceChecks::On) {
     checkReferences(filter, socket, mock, config);
@@ -637,38 +646,6 @@ GyrodConfig readConfig(const formats::TomlDocument& doc, ReferenceChecks checks)
 }
 
 }  // namespace
-
-MqttEndpoint parseMqttUrl(std::string_view url) {
-  constexpr std::string_view plain = "mqtt://", tls = "mqtts://";
-  MqttEndpoint e;
-  std::string_view rest;
-  if (url.rfind(plain, 0) == 0) {
-    rest = url.substr(plain.size());
-  } else if (url.rfind(tls, 0) == 0) {
-    rest = url.substr(tls.size());
-    e.tls = true;
-    e.port = 8883;
-  } else {
-    throw std::invalid_argument("must be mqtt://HOST[:PORT] or mqtts://HOST[:PORT] (TLS)");
-  }
-  if (!rest.empty() && rest.back() == '/') rest.remove_suffix(1);
-  const auto colon = rest.rfind(':');
-  const bool bracketed = !rest.empty() && rest.front() == '[';  // [IPv6]:port
-  if (colon != std::string_view::npos && (!bracketed || rest.find(']') < colon)) {
-    const std::string_view port = rest.substr(colon + 1);
-    int value = 0;
-    const auto [end, ec] = std::from_chars(port.data(), port.data() + port.size(), value);
-    if (port.empty() || ec != std::errc() || end != port.data() + port.size() || value < 1 || value > 65535)
-      throw std::invalid_argument("the port must be 1..65535");
-    e.port = value;
-    rest = rest.substr(0, colon);
-  }
-  if (bracketed && rest.size() >= 2 && rest.back() == ']') rest = rest.substr(1, rest.size() - 2);
-  if (rest.empty() || hasControlCharacter(rest) || rest.find_first_of("/@ ") != std::string_view::npos)
-    throw std::invalid_argument("must name a host: mqtt://HOST[:PORT] or mqtts://HOST[:PORT]");
-  e.host = std::string(rest);
-  return e;
-}
 
 bool hasControlCharacter(std::string_view text) {
   return std::any_of(text.begin(), text.end(), [](char c) {

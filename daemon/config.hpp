@@ -15,6 +15,7 @@
 #include <string_view>
 #include <vector>
 
+#include "protocol/mqtt_url.hpp"
 #include "protocol/socket_path.hpp"
 
 namespace gyrod::daemon {
@@ -101,21 +102,19 @@ struct MqttConfig {
   // qos 1: messages kept on the publisher's thread while the broker is away, oldest dropped
   // past this (60 s at 1 kHz); 0: none kept.
   std::size_t buffer_messages = 60000;
-  std::string ca_file;    // mqtts: the CA certificates the broker's is checked against; empty: /etc/ssl/certs
-  std::string cert_file;  // mqtts: a client certificate (PEM), with key_file
-  std::string key_file;   // mqtts: its private key (PEM, not encrypted)
+  std::string ca_file;          // mqtts: the CA certificates the broker's is checked against; empty: /etc/ssl/certs
+  std::string cert_file;        // mqtts: a client certificate (PEM), with key_file
+  std::string key_file;         // mqtts: its private key (PEM, not encrypted)
+  bool home_assistant = false;  // Home Assistant's MQTT discovery configs, retained
+  std::string home_assistant_prefix = "homeassistant";
   bool enabled() const { return !url.empty(); }
   bool operator==(const MqttConfig&) const = default;
 };
 
-// The host and port of an mqtt:// or mqtts:// URL. Throws std::invalid_argument saying what
-// is wrong.
-struct MqttEndpoint {
-  std::string host;
-  int port = 1883;  // 8883 for mqtts://
-  bool tls = false;
-};
-MqttEndpoint parseMqttUrl(std::string_view url);
+// The host, port and TLS of an mqtt:// or mqtts:// URL (protocol/mqtt_url.hpp, which gyroctl
+// fleet reads its --broker with). Throws std::invalid_argument saying what is wrong.
+using MqttEndpoint = protocol::MqttBrokerAddress;
+using protocol::parseMqttUrl;
 
 struct RecordConfig {
   std::string path;               // base file name, e.g. /var/lib/gyrod/gyro.csv; empty = off

@@ -17,6 +17,7 @@
 #include <cstring>
 #include <limits>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <system_error>
 
@@ -82,6 +83,8 @@ MqttSettings mqttSettings(const GyrodConfig& c, const std::string& device) {
   s.device = device;
   s.rate_hz = c.device.rate_hz;
   s.queue_lines = clientQueueLines(recordedSamplesPerSecond(c));
+  s.home_assistant = c.mqtt.home_assistant;
+  s.home_assistant_prefix = c.mqtt.home_assistant_prefix;
   return s;
 }
 
@@ -290,7 +293,7 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
   }
 
   if (config_.mqtt.enabled()) {
-    mqtt_ = std::make_unique<MqttPublisher>(mqttSettings(config_, device_.description));
+    mqtt_ = std::make_unique<MqttPublisher>(mqttSettings(config_, device_.description), mqttDerivedSources());
     if (const std::string obstacle = networkSandboxObstacle(parseMqttUrl(config_.mqtt.url).host); !obstacle.empty())
       spdlog::warn(
           "MQTT: {}, so no broker but one on this board can be reached; under systemd the unit's sandbox "
@@ -375,6 +378,7 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
 Gyrod::~Gyrod() { stopClientThread(); }
 
 int Gyrod::run() {
+  running_.store(true, std::memory_order_release);
   client_thread_ = std::thread([this] { clientThreadMain(); });
   loop_.run();
   stopClientThread();
@@ -674,6 +678,19 @@ void Gyrod::applyReload(ReloadedFilter&& reloaded) {
   }
 }
 
+// Under the state mutex.
+std::string Gyrod::biasDescription() const {
+  std::ostringstream bias;
+  bias << toString(pipeline_.biasOrigin());
+  if (pipeline_.phase() != PipelinePhase::Running) {
+    bias << " (estimating)";
+  } else {
+    bias.precision(6);
+    bias << " [" << pipeline_.bias()[0] << ", " << pipeline_.bias()[1] << ", " << pipeline_.bias()[2] << "] deg/s";
+  }
+  return bias.str();
+}
+
 std::string Gyrod::rateModelDescription() const {
   if (pipeline_.rateModel() == RateModel::SensorModel) return "model " + config_.filter.model;
   return "bias";
@@ -733,6 +750,30 @@ std::string Gyrod::allanReplyLine() {
   return allan_reply_.line();
 }
 
+// On the MQTT publisher's thread: each reads the state under the state mutex, as a client's
+// request does.
+// On the MQTT publisher's thread, which starts while gyrod is still being built: each source
+// answers nothing until run() has begun, then reads the state under the state mutex, as a
+// client's request does.
+MqttDerivedSources Gyrod::mqttDerivedSources() {
+  MqttDerivedSources sources;
+  sources.refit_cycles = [this] { return refit_cycles_.load(std::memory_order_acquire); };
+  sources.allan_json = [this] {
+    if (!running_.load(std::memory_order_acquire)) return std::string();
+    std::string line = protocol::allanLine(allanReport());
+    if (!line.empty() && line.back() == '\n') line.pop_back();
+    return line;
+  };
+  sources.model_json = [this] {
+    if (!running_.load(std::memory_order_acquire)) return std::string();
+    const std::lock_guard state(state_mutex_);
+    return nlohmann::json{
+        {"rate_model", rateModelDescription()}, {"bias", biasDescription()}, {"filter_model", config_.filter.model}}
+        .dump();
+  };
+  return sources;
+}
+
 AllanReport Gyrod::allanReport() {
   std::unique_lock state(state_mutex_);
   AllanWindowDeviations d = pipeline_.allanWindowDeviations();
@@ -782,15 +823,7 @@ StatusReport Gyrod::statusReport() {
   r.nominal_rate_hz = config_.device.rate_hz;
   if (samples_published_ > 0) r.rate_hz = driver_->estimatedSampleRateHz();
   r.temp_c = last_temp_c_;
-  std::ostringstream bias;
-  bias << toString(pipeline_.biasOrigin());
-  if (pipeline_.phase() != PipelinePhase::Running) {
-    bias << " (estimating)";
-  } else {
-    bias.precision(6);
-    bias << " [" << pipeline_.bias()[0] << ", " << pipeline_.bias()[1] << ", " << pipeline_.bias()[2] << "] deg/s";
-  }
-  r.bias_source = bias.str();
+  r.bias_source = biasDescription();
   const StillPeriodReport& still = pipeline_.stillPeriod();
   if (still.state != StillPeriodState::None) {
     r.still_check = std::string(stillCheckToken(still.state));

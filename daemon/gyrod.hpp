@@ -101,6 +101,8 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   void wakeClientThread();
   void publishQueuedLines();
   void clientThreadMain();
+  MqttDerivedSources mqttDerivedSources();
+  std::string biasDescription() const;
   void stopClientThread();
 
   GyrodConfig config_;
@@ -135,6 +137,7 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   std::uint64_t behind_first_seq_ = 0;  // sample thread: lines the ring could not take,
   std::uint64_t behind_count_ = 0;      //   sent as one GAP delivery_behind when it can
   std::uint64_t behind_total_ = 0;
+  std::atomic<bool> running_{false};                      // run() has begun: every member is built
   std::atomic<std::uint64_t> refit_cycles_{0};            // completed by the sample thread
   std::uint64_t allan_cycle_served_ = ~std::uint64_t{0};  // client thread: the cached line's cycle
   std::thread client_thread_;

@@ -71,14 +71,17 @@ std::string jsonString(std::string_view text) {
 
 }  // namespace
 
-MqttPublisher::MqttPublisher(MqttSettings settings)
+MqttPublisher::MqttPublisher(MqttSettings settings, MqttDerivedSources sources)
     : settings_(std::move(settings)),
       status_topic_(settings_.prefix + "/" + std::string(protocol::kMqttStatusTopic)),
       rate_topic_(settings_.prefix + "/" + std::string(protocol::kMqttRateTopic)),
       gap_topic_(settings_.prefix + "/" + std::string(protocol::kMqttGapTopic)),
       ring_(settings_.queue_lines),
       buffer_(settings_.qos == 1 ? settings_.buffer_messages : 0),
-      jitter_(std::random_device{}()) {
+      jitter_(std::random_device{}()),
+      derived_({settings_.prefix, settings_.client_id, settings_.device, settings_.home_assistant,
+                settings_.home_assistant_prefix},
+               std::move(sources)) {
   initialiseLibraryOnce();
   // qos 1: a persistent session, so that the broker keeps what it has not acknowledged or
   // delivered across a lost connection; qos 0 promises nothing of the kind.
@@ -248,6 +251,7 @@ void MqttPublisher::publishStatus(const char* state) {
 // A line from the ring: counted, then sent, kept for the broker (qos 1) or dropped.
 void MqttPublisher::takeLine(const LineForClients& line) {
   if (line.kind == LineForClients::Kind::Rate) {
+    derived_.take(line.rate);
     ++samples_seen_;
     if ((samples_seen_ - 1) % settings_.rate_every != 0) return;
   } else {
@@ -334,6 +338,14 @@ void MqttPublisher::runLoop() {
   }
 }
 
+void MqttPublisher::publishDerived(bool just_connected) {
+  const double now = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  for (const MqttMessage& m : derived_.due(now, just_connected))
+    if (mosquitto_publish(mosq_, nullptr, m.topic.c_str(), static_cast<int>(m.payload.size()), m.payload.data(), m.qos,
+                          m.retain) == MOSQ_ERR_SUCCESS)
+      published_.fetch_add(1, std::memory_order_relaxed);
+}
+
 void MqttPublisher::threadMain() {
   // Never in competition with the sample loop, which may run SCHED_FIFO.
   const sched_param normal{};
@@ -351,9 +363,10 @@ void MqttPublisher::threadMain() {
       publishStatus("online");
       next_status = now + kStatusEvery;
     }
-    was_connected = connected;
     while (ring_.tryPop(line)) takeLine(line);
     sendBuffered();
+    if (connected) publishDerived(!was_connected);
+    was_connected = connected;
     if (connected_ || connecting_) {
       runLoop();
     } else {

@@ -24,6 +24,7 @@
 
 #include "daemon/client_handover.hpp"
 #include "daemon/kept_lines.hpp"
+#include "daemon/mqtt_derived_topics.hpp"
 #include "daemon/spsc_ring.hpp"
 
 struct mosquitto;
@@ -47,6 +48,8 @@ struct MqttSettings {
   double rate_hz = 0.0;
   std::size_t queue_lines = 4096;   // the ring between the sample thread and the publisher
   std::size_t buffer_messages = 0;  // qos 1: kept while the broker is away (0: none)
+  bool home_assistant = false;      // Home Assistant's discovery configs (daemon/mqtt_derived_topics.hpp)
+  std::string home_assistant_prefix = "homeassistant";
 };
 
 struct MqttStats {
@@ -62,7 +65,9 @@ class MqttPublisher {
  public:
   // Starts the publisher's thread, which connects in the background. Throws std::runtime_error
   // when libmosquitto cannot make a client.
-  explicit MqttPublisher(MqttSettings settings);
+  // `sources` feed the summary, allan and model topics (daemon/mqtt_derived_topics.hpp); they are
+  // called on the publisher's thread.
+  explicit MqttPublisher(MqttSettings settings, MqttDerivedSources sources = {});
   // stop().
   ~MqttPublisher();
   // Publishes "offline" (retained), waits up to 2 s for it to leave, disconnects, and ends the
@@ -91,6 +96,7 @@ class MqttPublisher {
   void connectionFailed(const std::string& why);
   void setLastError(const std::string& why);
   void reportOutageOver();
+  void publishDerived(bool just_connected);
   static void onConnect(mosquitto* mosq, void* self, int rc);
   static void onDisconnect(mosquitto* mosq, void* self, int rc);
   static void onPublish(mosquitto* mosq, void* self, int mid);
@@ -123,6 +129,7 @@ class MqttPublisher {
   bool disconnected_ = false;  // onDisconnect saw the connection end
   int connect_errno_ = 0;      // errno right after the last connect call
   std::minstd_rand jitter_;
+  MqttDerivedTopics derived_;       // publisher thread
   mutable std::mutex error_mutex_;  // last_error_: publisher thread writes, STATUS reads
   std::string last_error_;
   mosquitto* mosq_ = nullptr;

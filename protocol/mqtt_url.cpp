@@ -26,7 +26,7 @@ MqttBrokerAddress parseMqttUrl(std::string_view url) {
     a.tls = true;
     a.port = kMqttTlsPort;
   } else {
-    throw std::invalid_argument("must be mqtt://HOST[:PORT] or mqtts://HOST[:PORT]");
+    throw std::invalid_argument("must be mqtt://HOST[:PORT] or mqtts://HOST[:PORT] (TLS)");
   }
   if (!rest.empty() && rest.back() == '/') rest.remove_suffix(1);
   const auto colon = rest.rfind(':');
@@ -41,8 +41,8 @@ MqttBrokerAddress parseMqttUrl(std::string_view url) {
     rest = rest.substr(0, colon);
   }
   if (bracketed && rest.size() >= 2 && rest.back() == ']') rest = rest.substr(1, rest.size() - 2);
-  if (rest.empty() || hasControlCharacter(rest) || rest.find_first_of("/@ []") != std::string_view::npos)
-    throw std::invalid_argument("must name a host: mqtt://HOST or mqtt://HOST:PORT");
+  if (rest.empty() || hasControlCharacter(rest) || rest.find_first_of("/@ ") != std::string_view::npos)
+    throw std::invalid_argument("must name a host: mqtt://HOST[:PORT] or mqtts://HOST[:PORT]");
   a.host = std::string(rest);
   return a;
 }

@@ -70,6 +70,9 @@ inline constexpr std::string_view kDeliveryBehindGapReason = "delivery_behind";
 inline constexpr std::string_view kMqttStatusTopic = "status";
 inline constexpr std::string_view kMqttRateTopic = "rate";
 inline constexpr std::string_view kMqttGapTopic = "gap";
+inline constexpr std::string_view kMqttSummaryTopic = "summary";  // 1 Hz: mean rate, temperature, still
+inline constexpr std::string_view kMqttAllanTopic = "allan";      // retained: the ALLAN reply
+inline constexpr std::string_view kMqttModelTopic = "model";      // retained: the calibration in use
 
 // Longest possible RATE line: 23 doubles of ≤ 24 characters in shortest round-trip form
 // (552), "time" (≤ 24: fixed with 6 decimals below 1e15, else shortest), a 20-digit seq,

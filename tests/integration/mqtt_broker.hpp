@@ -9,6 +9,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <thread>
 
@@ -37,31 +38,43 @@ inline bool acceptsConnections(int port) {
   return up;
 }
 
-// The broker without a configuration file: the loopback only, anonymous clients. Ready when it
-// accepts a connection (up to 5 s); stopped with SIGTERM.
-class LoopbackBroker {
+// Debian's broker, on the loopback only: its default without a configuration file, or the
+// configuration file given (whose listeners must include port). Its log is not the test's
+// output. Ready when it accepts a connection (generous: a loaded machine, a broker reading its
+// persistence file); stop() and start() restart it on the same port.
+class Broker {
  public:
-  explicit LoopbackBroker(int port) {
+  explicit Broker(int port, std::filesystem::path config = {}) : port_(port), config_(std::move(config)) { start(); }
+  ~Broker() { stop(); }
+  Broker(const Broker&) = delete;
+  Broker& operator=(const Broker&) = delete;
+  void start() {
     pid_ = ::fork();
     if (pid_ == 0) {
-      const int quiet = ::open("/dev/null", O_WRONLY);  // its connection log is not the test's output
+      const int quiet = ::open("/dev/null", O_WRONLY);  // its connection log, its warnings as root
       ::dup2(quiet, 1);
       ::dup2(quiet, 2);
-      const std::string p = std::to_string(port);
-      ::execl("/usr/sbin/mosquitto", "mosquitto", "-p", p.c_str(), static_cast<char*>(nullptr));
+      const std::string p = std::to_string(port_);
+      if (config_.empty())
+        ::execl("/usr/sbin/mosquitto", "mosquitto", "-p", p.c_str(), static_cast<char*>(nullptr));
+      else
+        ::execl("/usr/sbin/mosquitto", "mosquitto", "-c", config_.c_str(), static_cast<char*>(nullptr));
       ::_exit(127);
     }
-    for (int i = 0; i < 100 && !acceptsConnections(port); ++i)
+    for (int i = 0; i < 400 && !acceptsConnections(port_); ++i)
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
-  ~LoopbackBroker() {
+  // SIGTERM: mosquitto saves its persistence file and exits.
+  void stop() {
+    if (pid_ <= 0) return;
     ::kill(pid_, SIGTERM);
     ::waitpid(pid_, nullptr, 0);
+    pid_ = -1;
   }
-  LoopbackBroker(const LoopbackBroker&) = delete;
-  LoopbackBroker& operator=(const LoopbackBroker&) = delete;
 
  private:
+  int port_;
+  std::filesystem::path config_;
   pid_t pid_ = -1;
 };
 

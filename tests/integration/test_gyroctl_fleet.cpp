@@ -61,13 +61,14 @@ bool streaming(const json& boards, const std::string& name) {
 
 TEST(GyroctlFleet, ShowsEveryBoardOnTheBrokerAndTheOneThatDied) {
   const int port = freeLoopbackPort();
-  LoopbackBroker broker(port);
+  Broker broker(port);
   ScratchDir d;
   GyrodProcess one({"--config", d.write("one.toml", boardConfig(d, port, "board-1")).string()}, d.path() / "1.log");
   GyrodProcess two({"--config", d.write("two.toml", boardConfig(d, port, "board-2")).string()}, d.path() / "2.log");
   json boards = fleetUntil(d, port, [](const json& b) { return streaming(b, "board-1") && streaming(b, "board-2"); });
-  ASSERT_TRUE(streaming(boards, "board-1") && streaming(boards, "board-2")) << boards.dump() << "\n"
-                                                                            << readWholeFile(d.path() / "1.log");
+  ASSERT_TRUE(streaming(boards, "board-1") && streaming(boards, "board-2"))
+      << boards.dump() << "\n"
+      << readWholeFile(d.path() / "1.log") << readWholeFile(d.path() / "2.log");
   for (const char* name : {"board-1", "board-2"}) {
     const json& b = *board(boards, name);
     EXPECT_EQ(b["rate_hz"], 50.0);
@@ -107,6 +108,6 @@ TEST(GyroctlFleet, AnUnreachableBrokerOrABadUrlIsOneLineAndASysexitsStatus) {
             "gyroctl: fleet: cannot read the broker at 127.0.0.1:" + std::to_string(port) + ": Connection refused\n");
   r = runGyroctl("fleet --broker http://example.org --once", d.path());
   EXPECT_EQ(r.exit_status, 64) << r.err;
-  EXPECT_EQ(r.err, "gyroctl: --broker 'http://example.org': must be mqtt://HOST[:PORT] or mqtts://HOST[:PORT]\n");
+  EXPECT_EQ(r.err, "gyroctl: --broker 'http://example.org': must be mqtt://HOST[:PORT] or mqtts://HOST[:PORT] (TLS)\n");
   EXPECT_TRUE(r.out.empty());
 }

@@ -25,6 +25,7 @@
 #include <fcntl.h>
 
 #include "gyrod_process.hpp"
+#include "mqtt_broker.hpp"
 #include "tools/run_command.hpp"
 
 using namespace gyrod::test;
@@ -32,66 +33,6 @@ using namespace std::chrono_literals;
 using nlohmann::json;
 
 namespace {
-
-int freeTcpPort() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
-  socklen_t n = sizeof a;
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &n);
-  ::close(fd);
-  return ntohs(a.sin_port);
-}
-
-bool acceptsConnections(int port) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  a.sin_port = htons(static_cast<std::uint16_t>(port));
-  const bool up = ::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
-  ::close(fd);
-  return up;
-}
-
-// Debian's broker, on the loopback only: its default without a configuration file, or the
-// configuration file given (whose listeners must include port).
-class Broker {
- public:
-  explicit Broker(int port, std::filesystem::path config = {}) : port_(port), config_(std::move(config)) { start(); }
-  ~Broker() { stop(); }
-  void start() {
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      const std::string p = std::to_string(port_);
-      if (config_.empty()) {
-        ::execl("/usr/sbin/mosquitto", "mosquitto", "-p", p.c_str(), static_cast<char*>(nullptr));
-      } else {
-        const int null = ::open("/dev/null", O_WRONLY);
-        ::dup2(null, 2);  // its warnings about running as root
-        ::execl("/usr/sbin/mosquitto", "mosquitto", "-c", config_.c_str(), static_cast<char*>(nullptr));
-      }
-      ::_exit(127);
-    }
-    // Ready when it accepts a connection (generous: a loaded machine, a broker reading its
-    // persistence file).
-    for (int i = 0; i < 400 && !acceptsConnections(port_); ++i) std::this_thread::sleep_for(50ms);
-  }
-  // SIGTERM: mosquitto saves its persistence file and exits.
-  void stop() {
-    if (pid_ <= 0) return;
-    ::kill(pid_, SIGTERM);
-    ::waitpid(pid_, nullptr, 0);
-    pid_ = -1;
-  }
-
- private:
-  int port_;
-  std::filesystem::path config_;
-  pid_t pid_ = -1;
-};
 
 // The lines of a mosquitto configuration that keep it on the loopback as the user running the
 // test (as root, mosquitto would otherwise become the user mosquitto and could not write into
@@ -231,7 +172,7 @@ std::size_t occurrences(const std::string& text, const std::string& what) {
 }  // namespace
 
 TEST(GyrodMqtt, PublishesTheStatusAndEveryRateLineInOrderAndGoesOfflineAtAStop) {
-  const int port = freeTcpPort();
+  const int port = freeLoopbackPort();
   Broker broker(port);
   ScratchDir d;
   const auto cfg = d.write("gyrod.toml", mqttConfig(d, port));
@@ -272,7 +213,7 @@ TEST(GyrodMqtt, PublishesTheStatusAndEveryRateLineInOrderAndGoesOfflineAtAStop) 
 }
 
 TEST(GyrodMqtt, StreamsWithoutABrokerConnectsWhenOneComesAndItsLastWillIsOffline) {
-  const int port = freeTcpPort();
+  const int port = freeLoopbackPort();
   ScratchDir d;
   const auto cfg = d.write("gyrod.toml", mqttConfig(d, port));
   GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt");
@@ -299,7 +240,7 @@ TEST(GyrodMqtt, StreamsWithoutABrokerConnectsWhenOneComesAndItsLastWillIsOffline
 // qos 1 across a broker restart: the messages made while it is away are kept and delivered in
 // order when it is back, to a subscriber with a persistent session; the socket streams on.
 TEST(GyrodMqtt, KeepsEveryRateMessageInOrderAcrossABrokerRestart) {
-  const int port = freeTcpPort();
+  const int port = freeLoopbackPort();
   ScratchDir d;
   std::filesystem::create_directories(d.path() / "broker");
   const auto broker_config =
@@ -430,7 +371,7 @@ void expectFailureReported(int port, const std::string& ca, const std::string& p
 TEST(GyrodMqtt, PublishesOverTlsWithAPasswordAndReportsWhatKeepsItFromConnecting) {
   ScratchDir certs;
   ASSERT_TRUE(makeTlsFiles(certs.path())) << "openssl and mosquitto_passwd make the test's CA and password file";
-  const int tls_port = freeTcpPort(), plain_port = freeTcpPort();
+  const int tls_port = freeLoopbackPort(), plain_port = freeLoopbackPort();
   const auto dir = certs.path().string();
   const auto broker_config =
       certs.write("mosquitto.conf", "per_listener_settings false\nallow_anonymous false\npassword_file " + dir +
@@ -454,14 +395,14 @@ TEST(GyrodMqtt, PublishesOverTlsWithAPasswordAndReportsWhatKeepsItFromConnecting
   }
   expectFailureReported(tls_port, dir + "/other-ca.crt", "s3cret", "certificate verify failed");
   expectFailureReported(tls_port, dir + "/ca.crt", "wrong", "not authorised");
-  expectFailureReported(freeTcpPort(), dir + "/ca.crt", "s3cret", "Connection refused");
+  expectFailureReported(freeLoopbackPort(), dir + "/ca.crt", "s3cret", "Connection refused");
 }
 
 // A broker that asks for a client certificate: gyrod presents mqtt.cert_file and key_file.
 TEST(GyrodMqtt, PresentsItsClientCertificateWhenTheBrokerAsksForOne) {
   ScratchDir certs;
   ASSERT_TRUE(makeTlsFiles(certs.path())) << "openssl and mosquitto_passwd make the test's CA and password file";
-  const int tls_port = freeTcpPort(), plain_port = freeTcpPort();
+  const int tls_port = freeLoopbackPort(), plain_port = freeLoopbackPort();
   const auto dir = certs.path().string();
   const auto broker_config = certs.write(
       "mosquitto.conf", "per_listener_settings false\nallow_anonymous true\nlistener " + std::to_string(tls_port) +
@@ -479,4 +420,52 @@ TEST(GyrodMqtt, PresentsItsClientCertificateWhenTheBrokerAsksForOne) {
       << readWholeFile(d.path() / "log.txt");
   gyrod.signal(SIGTERM);
   EXPECT_EQ(gyrod.waitExit(10s), std::optional<int>(0));
+}
+
+// What gyrod derives for dashboards: a summary each second, the retained allan and model
+// topics, and with home_assistant the discovery configs, retained, pointing at them.
+TEST(GyrodMqtt, PublishesTheSummaryTheRetainedAllanAndModelAndHomeAssistantDiscovery) {
+  const int port = freeLoopbackPort();
+  Broker broker(port);
+  ScratchDir d;
+  const auto cfg = d.write("gyrod.toml", mqttConfig(d, port) + "client_id = \"board.1\"\nhome_assistant = true\n");
+  Subscriber sub(port, "#");
+  ASSERT_TRUE(sub.connected());
+  GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt");
+  ASSERT_TRUE(sub.waitFor([](const auto& m) { return count(m, "test/board-1/summary") >= 3; }, 30s))
+      << readWholeFile(d.path() / "log.txt");
+  const auto messages = sub.messages();
+  int summaries = 0;
+  for (const auto& m : messages) {
+    if (m.topic != "test/board-1/summary") continue;
+    const json j = json::parse(m.payload);
+    const json& mean = j.contains("rate") ? j["rate"] : j["raw"];
+    ASSERT_EQ(mean.size(), 3u) << m.payload;
+    if (++summaries > 1) {                                  // the first second may be cut by the connection
+      EXPECT_GE(j["samples"].get<int>(), 40) << m.payload;  // 50 Hz
+      EXPECT_LE(j["samples"].get<int>(), 60) << m.payload;
+    }
+    // The mock's bias is -3.34 deg/s on x: in raw, and taken out of the rate stream.
+    EXPECT_NEAR(mean[0].get<double>(), j.contains("rate") ? 0.0 : -3.34, 1.0) << m.payload;
+  }
+  Subscriber late(port, "test/board-1/+");  // the retained topics reach a subscriber that comes later
+  ASSERT_TRUE(late.waitFor(
+      [](const auto& m) { return count(m, "test/board-1/allan") == 1 && count(m, "test/board-1/model") == 1; }, 10s));
+  for (const auto& m : late.messages()) {
+    if (m.topic == "test/board-1/allan") {
+      EXPECT_TRUE(m.retained);
+      EXPECT_EQ(json::parse(m.payload)["class"], "ALLAN");
+    }
+    if (m.topic == "test/board-1/model") {
+      EXPECT_TRUE(m.retained);
+      EXPECT_EQ(json::parse(m.payload)["rate_model"], "bias") << m.payload;
+    }
+  }
+  Subscriber home(port, "homeassistant/#");
+  ASSERT_TRUE(home.waitFor([](const auto& m) { return m.size() >= 5; }, 10s));
+  for (const auto& m : home.messages()) {
+    EXPECT_TRUE(m.retained) << m.topic;
+    EXPECT_EQ(m.topic.rfind("homeassistant/sensor/board_1/", 0), 0u) << m.topic;
+  }
+  EXPECT_EQ(json::parse(home.messages().front().payload)["device"]["identifiers"], json::array({"board_1"}));
 }

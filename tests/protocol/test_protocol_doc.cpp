@@ -228,7 +228,9 @@ TEST(ProtocolDoc, AllanFieldsAreTheOnesSent) {
 
 TEST(ProtocolDoc, MqttTopicsAreTheOnesPublished) {
   const auto documented = firstColumnNames(section(readDoc(), "#### MQTT topics"));
-  const std::set<std::string> published = {std::string(protocol::kMqttStatusTopic),
-                                           std::string(protocol::kMqttRateTopic), std::string(protocol::kMqttGapTopic)};
+  const std::set<std::string> published = {
+      std::string(protocol::kMqttStatusTopic), std::string(protocol::kMqttRateTopic),
+      std::string(protocol::kMqttGapTopic),    std::string(protocol::kMqttSummaryTopic),
+      std::string(protocol::kMqttAllanTopic),  std::string(protocol::kMqttModelTopic)};
   EXPECT_EQ(documented, published);
 }
