@@ -588,6 +588,7 @@ void Gyrod::wakeClientThread() {
   clients_to_wake_ = false;
   const std::uint64_t one = 1;
   [[maybe_unused]] const ssize_t n = ::write(to_clients_fd_.get(), &one, sizeof one);
+  if (mqtt_) mqtt_->wake();  // the same lines are in its ring
 }
 
 void Gyrod::publishQueuedLines() {

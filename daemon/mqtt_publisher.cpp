@@ -5,6 +5,8 @@
 #include <pthread.h>
 #include <sched.h>
 #include <spdlog/spdlog.h>
+#include <sys/eventfd.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -81,7 +83,9 @@ MqttPublisher::MqttPublisher(MqttSettings settings, MqttDerivedSources sources)
       jitter_(std::random_device{}()),
       derived_({settings_.prefix, settings_.client_id, settings_.device, settings_.home_assistant,
                 settings_.home_assistant_prefix},
-               std::move(sources)) {
+               std::move(sources)),
+      wake_fd_(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)) {
+  if (!wake_fd_) throw std::runtime_error("MQTT: no eventfd for the publisher's thread");
   initialiseLibraryOnce();
   // qos 1: a persistent session, so that the broker keeps what it has not acknowledged or
   // delivered across a lost connection; qos 0 promises nothing of the kind.
@@ -130,6 +134,11 @@ void MqttPublisher::setUpTls() {
 
 void MqttPublisher::push(const LineForClients& line) noexcept {
   if (!ring_.tryPush(line)) dropped_.fetch_add(1, std::memory_order_relaxed);
+}
+
+void MqttPublisher::wake() noexcept {
+  const std::uint64_t one = 1;
+  [[maybe_unused]] const ssize_t n = ::write(wake_fd_.get(), &one, sizeof one);
 }
 
 MqttStats MqttPublisher::stats() const {
@@ -328,10 +337,26 @@ bool MqttPublisher::checkConnecting() {
   return false;
 }
 
+// Until the broker's socket has something to read (or room for what libmosquitto wants to
+// write), the sample thread hands over lines, or kIdleWait passes: lines leave as soon as they
+// come, and an idle gyrod wakes a few times a second for the keep-alive.
+void MqttPublisher::waitForNetworkOrLines() {
+  std::array<pollfd, 2> fds{};
+  fds[0] = {wake_fd_.get(), POLLIN, 0};
+  nfds_t n = 1;
+  if (const int sock = mosquitto_socket(mosq_); sock >= 0)
+    fds[n++] = {sock, static_cast<short>(POLLIN | (mosquitto_want_write(mosq_) ? POLLOUT : 0)), 0};
+  if (::poll(fds.data(), n, static_cast<int>(kIdleWait.count())) > 0 && (fds[0].revents & POLLIN) != 0) {
+    std::uint64_t count = 0;
+    [[maybe_unused]] const ssize_t r = ::read(wake_fd_.get(), &count, sizeof count);
+  }
+}
+
 void MqttPublisher::runLoop() {
   if (connecting_ && !connected_ && !checkConnecting()) return;
-  const int rc = mosquitto_loop(mosq_, static_cast<int>(kIdleWait.count()), 1);
-  if (rc != MOSQ_ERR_SUCCESS) {  // refused, lost or never made: try again later
+  waitForNetworkOrLines();
+  const int rc = mosquitto_loop(mosq_, 0, 1);  // what the wait found: read, write, keep-alive
+  if (rc != MOSQ_ERR_SUCCESS) {                // refused, lost or never made: try again later
     connectionFailed(describe(rc));
   } else if (disconnected_) {
     connectionFailed("the connection was closed");

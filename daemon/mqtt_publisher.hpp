@@ -1,7 +1,8 @@
 #pragma once
 // gyrod's samples and status on an MQTT broker (libmosquitto), for a fleet of boards read from
 // one place (docs/protocol.md "MQTT"). The sample thread only pushes into a lock-free ring
-// (push: no lock, no allocation, no system call); a thread of the publisher's own, at normal
+// (push: no lock, no allocation, no system call) and, once per loop turn, wakes the publisher
+// (wake: one eventfd write); a thread of the publisher's own, at normal
 // priority, takes from it, formats the messages and drives libmosquitto (mosquitto_loop): DNS,
 // TLS, connect, reconnect after 0.5, 1, 2, ... 30 s (±20 %), send. A broker that is down or
 // unreachable is not an error: gyrod streams on its socket and the publisher keeps retrying.
@@ -11,7 +12,8 @@
 // the broker keeps its side of them. With qos 0 nothing waits for a broker that is not there.
 // Whatever is dropped (the ring full, the buffer full, qos 0 while disconnected) is counted.
 // Topics under the prefix: status (retained; "online" when connected, "offline" as the last
-// will and at a clean stop), rate (every rate_every-th RATE line), gap (every GAP line).
+// will and at a clean stop), rate (every rate_every-th RATE line), gap (every GAP line), and
+// those of daemon/mqtt_derived_topics.hpp (summary, allan, model, Home Assistant discovery).
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -26,6 +28,7 @@
 #include "daemon/kept_lines.hpp"
 #include "daemon/mqtt_derived_topics.hpp"
 #include "daemon/spsc_ring.hpp"
+#include "protocol/fd.hpp"
 
 struct mosquitto;
 
@@ -78,6 +81,9 @@ class MqttPublisher {
 
   // Sample thread only: never waits.
   void push(const LineForClients& line) noexcept;
+  // Sample thread, once per loop turn that pushed lines (one write to an eventfd): the
+  // publisher takes them at once rather than at its next keep-alive wake-up.
+  void wake() noexcept;
 
   MqttStats stats() const;
   const std::string& statusTopic() const { return status_topic_; }
@@ -97,6 +103,7 @@ class MqttPublisher {
   void setLastError(const std::string& why);
   void reportOutageOver();
   void publishDerived(bool just_connected);
+  void waitForNetworkOrLines();
   static void onConnect(mosquitto* mosq, void* self, int rc);
   static void onDisconnect(mosquitto* mosq, void* self, int rc);
   static void onPublish(mosquitto* mosq, void* self, int mid);
@@ -130,6 +137,7 @@ class MqttPublisher {
   int connect_errno_ = 0;      // errno right after the last connect call
   std::minstd_rand jitter_;
   MqttDerivedTopics derived_;       // publisher thread
+  protocol::Fd wake_fd_;            // eventfd: the sample thread's wake() to the publisher's poll
   mutable std::mutex error_mutex_;  // last_error_: publisher thread writes, STATUS reads
   std::string last_error_;
   mosquitto* mosq_ = nullptr;
