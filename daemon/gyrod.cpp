@@ -292,14 +292,7 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
     recorder_ = std::make_unique<Recorder>(options);
   }
 
-  if (config_.mqtt.enabled()) {
-    mqtt_ = std::make_unique<MqttPublisher>(mqttSettings(config_, device_.description), mqttDerivedSources());
-    if (const std::string obstacle = networkSandboxObstacle(parseMqttUrl(config_.mqtt.url).host); !obstacle.empty())
-      spdlog::warn(
-          "MQTT: {}, so no broker but one on this board can be reached; under systemd the unit's sandbox "
-          "does this, and /usr/share/gyrod/gyrod-mqtt.conf is the drop-in that opens it (docs/fleet.md)",
-          obstacle);
-  }
+  if (config_.mqtt.enabled()) startMqtt();
 
   auto log = [](driver::LogLevel level, std::string_view message) { spdlog::log(spdlogLevel(level), "{}", message); };
   driver_ = std::make_unique<driver::Mpu6050Driver>(*device_.bus, *device_.data_ready, *device_.clock, *this,
@@ -753,6 +746,15 @@ std::string Gyrod::allanReplyLine() {
 
 // On the MQTT publisher's thread: each reads the state under the state mutex, as a client's
 // request does.
+void Gyrod::startMqtt() {
+  mqtt_ = std::make_unique<MqttPublisher>(mqttSettings(config_, device_.description), mqttDerivedSources());
+  if (const std::string obstacle = networkSandboxObstacle(parseMqttUrl(config_.mqtt.url).host); !obstacle.empty())
+    spdlog::warn(
+        "MQTT: {}, so no broker but one on this board can be reached; under systemd the unit's sandbox "
+        "does this, and /usr/share/gyrod/gyrod-mqtt.conf is the drop-in that opens it (docs/fleet.md)",
+        obstacle);
+}
+
 // On the MQTT publisher's thread, which starts while gyrod is still being built: each source
 // answers nothing until run() has begun, then reads the state under the state mutex, as a
 // client's request does.

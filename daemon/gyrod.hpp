@@ -101,6 +101,7 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   void wakeClientThread();
   void publishQueuedLines();
   void clientThreadMain();
+  void startMqtt();
   MqttDerivedSources mqttDerivedSources();
   std::string biasDescription() const;
   void stopClientThread();
