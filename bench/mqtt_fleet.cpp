@@ -30,8 +30,6 @@
 #include <thread>
 #include <vector>
 
-#include "tests/integration/mqtt_broker.hpp"
-
 namespace {
 
 namespace fs = std::filesystem;
@@ -48,6 +46,19 @@ double monotonicSeconds() {
   timespec ts{};
   ::clock_gettime(CLOCK_MONOTONIC, &ts);
   return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+}
+
+// A loopback port nobody holds now (the kernel's choice for port 0), for the broker.
+int freeLoopbackPort() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t n = sizeof a;
+  const bool ok = ::bind(fd, reinterpret_cast<sockaddr*>(&a), n) == 0 &&
+                  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &n) == 0;
+  ::close(fd);
+  return ok ? ntohs(a.sin_port) : 1883;
 }
 
 pid_t spawn(const std::vector<std::string>& argv, const fs::path& log) {
@@ -217,7 +228,7 @@ int main(int argc, char** argv) {
 
   const double cpu_without = runBoards(o, dir, 0, nullptr, settle_s);
 
-  const int port = gyrod::test::freeLoopbackPort();  // the tests' helper: a port nobody holds
+  const int port = freeLoopbackPort();
   const pid_t broker = spawn({"/usr/sbin/mosquitto", "-p", std::to_string(port)}, dir / "mosquitto.log");
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   RateSubscriber sub(port, o.qos);
