@@ -89,9 +89,11 @@ std::string loadAverage() {
   return one + " " + five + " " + fifteen;
 }
 
-// The tests that run gyrod SCHED_FIFO take turns (ctest runs two tests at a time): each measures
-// one real-time gyrod on the machine, not two of them and their real-time watchers competing
-// for 2 CPUs. Released when the test ends (the lock goes with the descriptor).
+// The tests that run gyrod SCHED_FIFO take turns: ctest runs them alone (RUN_SERIAL,
+// tests/CMakeLists.txt), and this lock keeps two of them apart when they are run otherwise
+// (two test binaries, gtest filters by hand): each measures one real-time gyrod on the machine,
+// not two of them and their real-time watchers competing for 2 CPUs. Released when the test
+// ends (the lock goes with the descriptor).
 class RealTimeTurn {
  public:
   RealTimeTurn() : fd_(::open("/tmp/gyrod-tests-real-time.lock", O_CREAT | O_RDWR | O_CLOEXEC, 0666)) {
