@@ -86,6 +86,40 @@ LineScan scanForLines(const std::vector<double>& power, const std::vector<double
   return best;
 }
 
+std::vector<LineScanSegment> lineScanHalves(std::size_t n, double rate) {
+  std::vector<LineScanSegment> halves;
+  const std::size_t length = n / 2;
+  const std::size_t nfft = fftLength(length);
+  const double df = rate / static_cast<double>(nfft);
+  // The whole record's limits (series.cpp: 10 cycles, bin 64, 98 % of Nyquist) on the half's bins.
+  const std::size_t k_lo = std::max<std::size_t>(
+      64, static_cast<std::size_t>(std::ceil(10.0 * static_cast<double>(nfft) / static_cast<double>(length))));
+  const std::size_t k_hi = nfft / 2 - std::max<std::size_t>(2, nfft / 100);
+  if (k_hi <= k_lo) return halves;
+  const std::vector<std::size_t> scales = lineScanScales(k_hi - k_lo, df);
+  if (scales.empty()) return halves;
+  for (std::size_t h = 0; h < 2; ++h)
+    halves.push_back({h * length, length, k_lo, k_hi, scales, lineBackgroundBlock(df)});
+  return halves;
+}
+
+HalfLineScan scanHalvesForLines(std::span<const double> x, const Context& c) {
+  HalfLineScan best;
+  for (std::size_t h = 0; h < c.line_halves.size(); ++h) {
+    const LineScanSegment& seg = c.line_halves[h];
+    const Periodogram p = hannPeriodogram(x.subspan(seg.offset, seg.length));
+    const LineScan scan =
+        scanForLines(p.power, blockMedianBackground(p.power, seg.background_block), seg.k_lo, seg.k_hi, seg.scales);
+    if (scan.statistic <= best.statistic) continue;
+    const double df = c.rate / static_cast<double>(p.nfft);
+    best.statistic = scan.statistic;
+    best.centre_hz = static_cast<double>(scan.centre_bin) * df;
+    best.width_hz = static_cast<double>(scan.width_bins) * df;
+    best.half = h;
+  }
+  return best;
+}
+
 namespace {
 
 // The periodogram near a line, grouped into at most kMaxGroups bands of equal width for the

@@ -42,18 +42,29 @@ struct ChainModel {
 
 // ---- what every replica (and the measured series) is measured by ----------------------
 
+// The narrowband scan's grid over one half of the record: a line whose power changes over
+// the record (it comes and goes with the board's surroundings) stands out in the half that
+// holds it and is diluted over the whole.
+struct LineScanSegment {
+  std::size_t offset = 0, length = 0;  // samples of the record
+  std::size_t k_lo = 0, k_hi = 0;      // bins of the segment's own periodogram
+  std::vector<std::size_t> scales;
+  std::size_t background_block = 0;
+};
+
 struct Context {
   std::size_t n = 0;
   double rate = 0.0, tau0 = 0.0;
   std::vector<std::size_t> ms;
   std::vector<double> taus, edf;
-  std::vector<double> t_grid;             // Gauss–Markov correlation times tried
-  std::size_t block = 1, blocks = 0;      // block length [samples], number of blocks
-  std::vector<double> temp_blocks;        // detrended block means of temperature (empty: none)
-  std::vector<std::size_t> scales;        // Haar scales [blocks]
-  std::size_t k_lo = 0, k_hi = 0;         // periodogram bins searched for a sinusoid or a line
-  std::vector<std::size_t> line_scales;   // widths [bins] of the narrowband scan (narrowband.cpp)
-  std::size_t line_background_block = 0;  // bins per median of its background
+  std::vector<double> t_grid;                // Gauss–Markov correlation times tried
+  std::size_t block = 1, blocks = 0;         // block length [samples], number of blocks
+  std::vector<double> temp_blocks;           // detrended block means of temperature (empty: none)
+  std::vector<std::size_t> scales;           // Haar scales [blocks]
+  std::size_t k_lo = 0, k_hi = 0;            // periodogram bins searched for a sinusoid or a line
+  std::vector<std::size_t> line_scales;      // widths [bins] of the narrowband scan (narrowband.cpp)
+  std::size_t line_background_block = 0;     // bins per median of its background
+  std::vector<LineScanSegment> line_halves;  // the same scan on each half (empty: too short)
   std::vector<double> psd_edges;
   ChainModel chain;
 };
@@ -207,6 +218,17 @@ struct LineScan {
 };
 LineScan scanForLines(const std::vector<double>& power, const std::vector<double>& background, std::size_t k_lo,
                       std::size_t k_hi, const std::vector<std::size_t>& scales);
+// The scan of each half of x (c.line_halves): the best band of either, in Hz; statistic 0
+// when the halves are too short to scan. Its statistic is on the whole record's scale
+// (−ln of a tail probability), and the detector reads the larger of the two.
+struct HalfLineScan {
+  double statistic = 0.0;
+  double centre_hz = 0.0, width_hz = 0.0;
+  std::size_t half = 0;  // which of c.line_halves
+};
+HalfLineScan scanHalvesForLines(std::span<const double> x, const Context& c);
+// The grids of c.line_halves for a record of n samples at `rate`.
+std::vector<LineScanSegment> lineScanHalves(std::size_t n, double rate);
 // The resonance (narrowband_line.hpp) plus a log-linear background, fitted by the Whittle
 // likelihood to the one-sided PSD near `centre_bin`.
 struct NarrowbandFit {

@@ -54,6 +54,7 @@ Context makeContext(const AxisModelCheckInput& in, std::span<const double> xd, s
   const double df = in.rate_hz / static_cast<double>(nfft);
   c.line_scales = lineScanScales(c.k_hi > c.k_lo ? c.k_hi - c.k_lo : 0, df);
   c.line_background_block = lineBackgroundBlock(df);
+  c.line_halves = lineScanHalves(c.n, in.rate_hz);
   const double f_lo = 2.0 / duration, f_hi = 0.5 * in.rate_hz;
   for (std::size_t j = 0; j <= kPsdBands; ++j)
     c.psd_edges.push_back(f_lo * std::pow(f_hi / f_lo, static_cast<double>(j) / static_cast<double>(kPsdBands)));
@@ -103,9 +104,10 @@ SeriesStats measureSeries(std::span<const double> xd, const Context& c, unsigned
       const SpectralPeak peak = largestSpectralPeak(p.power, spectralBackground(p.power), c.k_lo, c.k_hi);
       s.spectral_log_ratio = std::log(peak.ratio);
       s.spectral_bin = peak.bin;
-      s.line_scan =
+      s.line_scan = std::max(
           scanForLines(p.power, blockMedianBackground(p.power, c.line_background_block), c.k_lo, c.k_hi, c.line_scales)
-              .statistic;
+              .statistic,
+          scanHalvesForLines(xd, c).statistic);
     }
     if (mask & kStatPsd) s.psd = bandAveragedPsd(p, c.rate, c.psd_edges, &s.psd_max);
   }

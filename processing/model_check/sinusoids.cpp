@@ -57,23 +57,39 @@ bool checkSinusoids(std::vector<double>& xc, const Context& c, const NullSummary
     const SpectralPeak peak = largestSpectralPeak(p.power, spectralBackground(p.power), c.k_lo, c.k_hi);
     const double stat = std::log(peak.ratio);
     const std::vector<double> wide_bg = blockMedianBackground(p.power, c.line_background_block);
-    const LineScan scan = scanForLines(p.power, wide_bg, c.k_lo, c.k_hi, c.line_scales);
+    LineScan scan = scanForLines(p.power, wide_bg, c.k_lo, c.k_hi, c.line_scales);
+    const double df = rate / static_cast<double>(p.nfft);
+    const HalfLineScan half = scanHalvesForLines(xc, c);
+    const bool half_wins = half.statistic > scan.statistic;
+    if (half_wins) scan.statistic = half.statistic;
     if (s == 0) {
       out.statistics.push_back(makeStatistic("spectral_peak_log_ratio", stat, null));
       out.statistics.push_back(makeStatistic("narrowband_scan", scan.statistic, scan_null));
     }
     const bool peak_fires = null.fires(stat), scan_fires = !c.line_scales.empty() && scan_null.fires(scan.statistic);
     if (!peak_fires && !scan_fires) break;
-    const double df = rate / static_cast<double>(p.nfft);
     // The line's shape decides its kind: fitted as a resonance where it fired, resolved wider
     // than a bin it is a narrowband line.
     {
-      const std::size_t centre = peak_fires ? peak.bin : scan.centre_bin;
-      const std::size_t width = peak_fires ? 4 : scan.width_bins;
-      const std::vector<double> psd = onesidedPsd(p, rate);
-      std::vector<double> bg_psd = wide_bg;
-      for (double& v : bg_psd) v *= 2.0 / (rate * p.window_power);
-      const NarrowbandFit fit = fitNarrowbandLine(psd, bg_psd, df, rate, centre, width, c.k_lo, c.k_hi);
+      NarrowbandFit fit;
+      if (!peak_fires && half_wins) {
+        // Fitted on the half that holds it: diluted over the whole record, a line whose power
+        // changes is a bump the fit would merge with its neighbours.
+        const LineScanSegment& seg = c.line_halves[half.half];
+        const Periodogram ph = hannPeriodogram(std::span<const double>(xc).subspan(seg.offset, seg.length));
+        const double dfh = rate / static_cast<double>(ph.nfft);
+        std::vector<double> bg_h = blockMedianBackground(ph.power, seg.background_block);
+        for (double& v : bg_h) v *= 2.0 / (rate * ph.window_power);
+        fit = fitNarrowbandLine(onesidedPsd(ph, rate), bg_h, dfh, rate,
+                                static_cast<std::size_t>(std::lround(half.centre_hz / dfh)),
+                                static_cast<std::size_t>(std::lround(half.width_hz / dfh)), seg.k_lo, seg.k_hi);
+      } else {
+        const std::size_t centre = peak_fires ? peak.bin : scan.centre_bin;
+        const std::size_t width = peak_fires ? 4 : scan.width_bins;
+        std::vector<double> bg_psd = wide_bg;
+        for (double& v : bg_psd) v *= 2.0 / (rate * p.window_power);
+        fit = fitNarrowbandLine(onesidedPsd(p, rate), bg_psd, df, rate, centre, width, c.k_lo, c.k_hi);
+      }
       // Broader than any line: no catalogue entry (the Allan band names it unexplained).
       if (fit.fitted && fit.broadband) break;
       if (fit.fitted && fit.resolved) {
