@@ -18,7 +18,8 @@ records=(mpu6050-arduino-100hz/imu_static_test.csv mpu6050-arduino-100hz/example
          mpu6050-sensor-fusion-set1/unmoved-z-pointing-left.csv
          mpu6050-sensor-fusion-set2/unmoved-with-x-pointing-forward.csv
          mpu6050-sensor-fusion-set2/unmoved-with-z-pointing-front-and-x-up.csv
-         mpu6050-sensor-fusion-set2/unmoved-with-z-pointing-front-and-y-down.csv)
+         mpu6050-sensor-fusion-set2/unmoved-with-z-pointing-front-and-y-down.csv
+         mpu6050-sensor-fusion-set2/unmoved-with-x-pointing-forward-10min.csv.gz)
 for r in "${records[@]}"; do
   src=tests/data/$r
   name=$(echo "$r" | tr '/' '_')
@@ -26,6 +27,9 @@ for r in "${records[@]}"; do
   if [[ $r == mpu6050-arduino-100hz/* ]]; then  # raw counts with a 5-line header: gyroctl import reads them
     in=$scratch/$name
     "$gyroctl" import "$src" -o "$in" >/dev/null 2>&1
+  elif [[ $r == *.gz ]]; then  # the long record ships compressed
+    in=$scratch/${name%.gz}
+    gzip -dc "$src" >"$in"
   fi
   "$gyroctl" model-check "$in" --json >"$scratch/$name.json" 2>/dev/null
 done
@@ -49,7 +53,7 @@ for r in records:
         entry["axes"][axis] = {"effects": effects, "ljung_box_p_held_out": p, "in_band": band, "fits": fit,
                                "passes": ok}
         verdict = ("holds" if not effects else "fits") if fit else "does not fit"
-        print(f"| `{r.split('/')[1]}` | {axis} | {', '.join(effects) or '—'} | {verdict} | {p:.2g} | "
+        print(f"| `{r.split('/')[1].removesuffix('.gz')}` | {axis} | {', '.join(effects) or '—'} | {verdict} | {p:.2g} | "
               f"{band:.0%} ({m['band_p']:.2g}) | "
               f"{g['innovation_var_base_held_out']:.4g} → {g['innovation_var_extended_held_out']:.4g} | "
               f"{'yes' if ok else 'no'} |")
