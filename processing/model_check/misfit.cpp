@@ -96,9 +96,17 @@ LjungBox blockLjungBox(std::span<const double> e, std::size_t lags, std::size_t 
   if (!(c0 > 0.0)) return lb;
   const double bb = static_cast<double>(block), nn = static_cast<double>(y.size());
   for (std::size_t k = 1; k <= lags; ++k) {
-    double ck = 0.0;
-    for (std::size_t b = 0; b < blocks; ++b)
-      for (std::size_t i = b * block + k; i < (b + 1) * block; ++i) ck += y[i] * y[i - k];
+    // Four partial sums: the compiler may not reorder one floating-point sum, and these lags
+    // over every replica's held-out half were ~3 % of a check.
+    double part[4] = {0.0, 0.0, 0.0, 0.0};
+    for (std::size_t b = 0; b < blocks; ++b) {
+      std::size_t i = b * block + k;
+      const std::size_t end = (b + 1) * block;
+      for (; i + 4 <= end; i += 4)
+        for (std::size_t u = 0; u < 4; ++u) part[u] += y[i + u] * y[i + u - k];
+      for (; i < end; ++i) part[0] += y[i] * y[i - k];
+    }
+    const double ck = (part[0] + part[1]) + (part[2] + part[3]);
     // Removing each block's mean makes white noise's lag-k products −σ²/B on average:
     // E ρ̂_k = −(B − k)/(B(B − 1)), taken off.
     const double kk = static_cast<double>(k);

@@ -106,22 +106,35 @@ Periodogram hannPeriodogram(std::span<const double> x) {
   const std::size_t n = x.size();
   if (n < 4) throw std::invalid_argument("the periodogram needs at least 4 samples, got " + std::to_string(n));
   const std::size_t nfft = fftLength(n);
-  // The window of the last length this thread used (every replica of a round has the
-  // record's length; its cosines were ~4 % of a check).
-  thread_local std::vector<double> window;
-  thread_local double window_power = 0.0;
-  if (window.size() != n) {
-    window.resize(n);
-    window_power = 0.0;
+  // The windows of the last lengths this thread used (every replica of a round has the
+  // record's length, and the narrowband scan also takes its halves; the cosines were ~4 % of a
+  // check when made per call).
+  struct HannWindow {
+    std::vector<double> w;
+    double power = 0.0;
+  };
+  thread_local std::array<HannWindow, 3> windows;
+  thread_local std::size_t next_slot = 0;
+  auto cached = std::find_if(windows.begin(), windows.end(), [n](const HannWindow& h) { return h.w.size() == n; });
+  if (cached == windows.end()) {
+    cached = windows.begin() + static_cast<std::ptrdiff_t>(next_slot);
+    next_slot = (next_slot + 1) % windows.size();
+    cached->w.resize(n);
+    cached->power = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
-      window[i] = 0.5 - 0.5 * std::cos(2.0 * std::numbers::pi * static_cast<double>(i) / static_cast<double>(n - 1));
-      window_power += window[i] * window[i];
+      cached->w[i] = 0.5 - 0.5 * std::cos(2.0 * std::numbers::pi * static_cast<double>(i) / static_cast<double>(n - 1));
+      cached->power += cached->w[i] * cached->w[i];
     }
   }
-  std::vector<double> in(nfft, 0.0);
+  const std::vector<double>& window = cached->w;
+  const double window_power = cached->power;
+  // The FFT's buffers too: a fresh pair per call cost its page faults and zero fill (~3 % of a
+  // check, whose base round takes three periodograms per replica).
+  thread_local std::vector<double> in;
+  thread_local std::vector<std::complex<double>> out;
+  in.assign(nfft, 0.0);
   for (std::size_t i = 0; i < n; ++i) in[i] = window[i] * x[i];
   const double wp = window_power;
-  std::vector<std::complex<double>> out;
   // One per thread: its plan (the twiddles, ~3 % of a check when made per call) is cached
   // inside it, and that cache is not safe to share between threads.
   thread_local Eigen::FFT<double> fft;
@@ -158,6 +171,11 @@ std::vector<double> blockMedianLevels(const std::vector<double>& power,
   for (std::size_t b = 0; b < levels.size(); ++b) log_levels[b] = std::log(levels[b]);
   std::vector<double> bg(n, levels.front());
   std::size_t j = 0;
+  // Between two centres the level is exp(a + b·i): one exp where a segment begins, then a
+  // product per bin (an exp per bin was several per cent of a check; the product's rounding
+  // over a block of at most a few thousand bins stays below 1e-12 of the level).
+  std::size_t segment = std::numeric_limits<std::size_t>::max();
+  double level = 0.0, step = 1.0;
   for (std::size_t i = 1; i < n; ++i) {
     const double f = static_cast<double>(i);
     while (j + 1 < centres.size() && centres[j + 1] < f) ++j;
@@ -166,8 +184,15 @@ std::vector<double> blockMedianLevels(const std::vector<double>& power,
     } else if (j + 1 >= centres.size()) {
       bg[i] = levels.back();
     } else {
-      const double u = (f - centres[j]) / (centres[j + 1] - centres[j]);
-      bg[i] = std::exp((1.0 - u) * log_levels[j] + u * log_levels[j + 1]);
+      const double slope = (log_levels[j + 1] - log_levels[j]) / (centres[j + 1] - centres[j]);
+      if (segment != j) {
+        segment = j;
+        level = std::exp(log_levels[j] + slope * (f - centres[j]));
+        step = std::exp(slope);
+      } else {
+        level *= step;
+      }
+      bg[i] = level;
     }
   }
   return bg;
