@@ -647,13 +647,6 @@ GyrodConfig readConfig(const formats::TomlDocument& doc, ReferenceChecks checks)
 
 }  // namespace
 
-bool hasControlCharacter(std::string_view text) {
-  return std::any_of(text.begin(), text.end(), [](char c) {
-    const auto byte = static_cast<unsigned char>(c);
-    return byte < 0x20 || byte == 0x7f;
-  });
-}
-
 GyrodConfig parseConfig(std::string_view toml_text, const std::string& source_name, ReferenceChecks checks) {
   try {
     return readConfig(formats::TomlDocument(toml_text, source_name, formats::SyntaxErrorColumn::Shown), checks);

@@ -15,6 +15,7 @@
 #include <string_view>
 #include <vector>
 
+#include "protocol/control_characters.hpp"
 #include "protocol/mqtt_url.hpp"
 #include "protocol/socket_path.hpp"
 
@@ -168,9 +169,8 @@ struct MockFaults {
   bool operator==(const MockFaults&) const = default;
 };
 
-// A control character (C0 or DEL) in `text`: a path holding one (an escape sequence) would act on
-// the terminal of whoever reads gyrod's log, which names the recording's file.
-bool hasControlCharacter(std::string_view text);
+// Paths, names and URLs with a control character are refused (protocol/control_characters.hpp).
+using protocol::hasControlCharacter;
 
 // mock.speed's range. Below the minimum the mock's virtual clock hardly moves: at 0.01 its
 // start-up (a few hundred ms of the chip's time) already takes most of a minute.

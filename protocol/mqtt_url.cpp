@@ -4,17 +4,9 @@
 #include <charconv>
 #include <stdexcept>
 
+#include "protocol/control_characters.hpp"
+
 namespace gyrod::protocol {
-namespace {
-
-bool hasControlCharacter(std::string_view text) {
-  return std::any_of(text.begin(), text.end(), [](char c) {
-    const auto byte = static_cast<unsigned char>(c);
-    return byte < 0x20 || byte == 0x7f;
-  });
-}
-
-}  // namespace
 
 MqttBrokerAddress parseMqttUrl(std::string_view url) {
   MqttBrokerAddress a;
