@@ -238,8 +238,7 @@ void EffectIntervals::measureLines(std::size_t index, std::span<const double> x)
   const Context& c = context_;
   const Periodogram p = hannPeriodogram(x);
   const double df = c.rate / static_cast<double>(p.nfft);
-  std::vector<double> bg = blockMedianBackground(p.power, c.line_background_block);
-  for (double& v : bg) v *= 2.0 / (c.rate * p.window_power);
+  const std::vector<double> bg = onesidedPsd(p, blockMedianBackground(p.power, c.line_background_block), c.rate);
   const std::vector<double> psd = onesidedPsd(p, c.rate);
   std::vector<double>& est = line_estimates_[index];
   for (const NarrowbandLine& l : removal_.lines) {

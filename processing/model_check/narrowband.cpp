@@ -89,12 +89,8 @@ LineScan scanForLines(const std::vector<double>& power, const std::vector<double
 std::vector<LineScanSegment> lineScanHalves(std::size_t n, double rate) {
   std::vector<LineScanSegment> halves;
   const std::size_t length = n / 2;
-  const std::size_t nfft = fftLength(length);
+  const auto [nfft, k_lo, k_hi] = searchedBins(length);  // the whole record's limits, on the half's bins
   const double df = rate / static_cast<double>(nfft);
-  // The whole record's limits (series.cpp: 10 cycles, bin 64, 98 % of Nyquist) on the half's bins.
-  const std::size_t k_lo = std::max<std::size_t>(
-      64, static_cast<std::size_t>(std::ceil(10.0 * static_cast<double>(nfft) / static_cast<double>(length))));
-  const std::size_t k_hi = nfft / 2 - std::max<std::size_t>(2, nfft / 100);
   if (k_hi <= k_lo) return halves;
   const std::vector<std::size_t> scales = lineScanScales(k_hi - k_lo, df);
   if (scales.empty()) return halves;
@@ -306,12 +302,13 @@ NarrowbandFit fitNarrowbandLine(const std::vector<double>& psd, const std::vecto
   return out;
 }
 
-std::vector<double> onesidedPsd(const Periodogram& p, double rate) {
-  std::vector<double> psd(p.power.size());
+std::vector<double> onesidedPsd(const Periodogram& p, std::vector<double> level, double rate) {
   const double scale = 2.0 / (rate * p.window_power);
-  for (std::size_t k = 0; k < psd.size(); ++k) psd[k] = scale * p.power[k];
-  return psd;
+  for (double& v : level) v *= scale;
+  return level;
 }
+
+std::vector<double> onesidedPsd(const Periodogram& p, double rate) { return onesidedPsd(p, p.power, rate); }
 
 void shrinkNarrowbandLine(std::vector<double>& x, const NarrowbandLine& line, double background_psd, double rate) {
   const NarrowbandLineRecursion r = narrowbandLineRecursion(line, rate);

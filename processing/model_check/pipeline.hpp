@@ -89,6 +89,12 @@ void quantiseLikeTheChip(std::vector<double>& x, const ChainModel& chain, std::u
 
 // The Allan grid, Gauss–Markov grid, blocks, Haar scales, sinusoid bins and PSD bands of the
 // detrended series xd; `curve` gets its Allan deviation table.
+// The periodogram bins searched for a sinusoid or a line in a series of n samples.
+struct SearchedBins {
+  std::size_t nfft = 0, k_lo = 0, k_hi = 0;
+};
+SearchedBins searchedBins(std::size_t n);
+
 Context makeContext(const AxisModelCheckInput& in, std::span<const double> xd, std::vector<AllanPoint>& curve);
 
 enum StatMask : unsigned {
@@ -247,6 +253,8 @@ NarrowbandFit fitNarrowbandLine(const std::vector<double>& psd, const std::vecto
                                 std::size_t k_hi, LineFitEffort effort = LineFitEffort::Search);
 // One-sided PSD [(°/s)²/Hz] of a Hann periodogram.
 std::vector<double> onesidedPsd(const Periodogram& p, double rate);
+// Any level on the periodogram's scale (its background) on the PSD's.
+std::vector<double> onesidedPsd(const Periodogram& p, std::vector<double> level, double rate);
 // x with the line's power taken out: its spectrum times √(b/(b + S_line)), b the background.
 void shrinkNarrowbandLine(std::vector<double>& x, const NarrowbandLine& line, double background_psd, double rate);
 

@@ -16,6 +16,19 @@ constexpr std::size_t kPsdBands = 48;
 
 }  // namespace
 
+SearchedBins searchedBins(std::size_t n) {
+  SearchedBins b;
+  b.nfft = fftLength(n);
+  // At least 10 cycles in the series, and clear of the lowest bins where the background
+  // (random walk, flicker) changes too fast for a local median.
+  b.k_lo = std::max<std::size_t>(
+      64, static_cast<std::size_t>(std::ceil(10.0 * static_cast<double>(b.nfft) / static_cast<double>(n))));
+  // Up to 98 % of Nyquist: a line at the very top of the band cannot be told from aliasing,
+  // and there the background has bins on one side only.
+  b.k_hi = b.nfft / 2 - std::max<std::size_t>(2, b.nfft / 100);
+  return b;
+}
+
 Context makeContext(const AxisModelCheckInput& in, std::span<const double> xd, std::vector<AllanPoint>& curve) {
   Context c;
   c.n = xd.size();
@@ -43,15 +56,10 @@ Context makeContext(const AxisModelCheckInput& in, std::span<const double> xd, s
   // Haar scales of the step scan (steps.cpp): 2, 4, … blocks, up to 1/16 of the record.
   for (std::size_t w = 2; 16 * w <= c.blocks; w *= 2) c.scales.push_back(w);
 
-  const std::size_t nfft = fftLength(c.n);
-  // At least 10 cycles in the record, and clear of the lowest bins where the background
-  // (random walk, flicker) changes too fast for a local median.
-  c.k_lo = std::max<std::size_t>(
-      64, static_cast<std::size_t>(std::ceil(10.0 * static_cast<double>(nfft) / static_cast<double>(c.n))));
-  // Up to 98 % of Nyquist: a line at the very top of the band cannot be told from aliasing,
-  // and there the background has bins on one side only.
-  c.k_hi = nfft / 2 - std::max<std::size_t>(2, nfft / 100);
-  const double df = in.rate_hz / static_cast<double>(nfft);
+  const SearchedBins bins = searchedBins(c.n);
+  c.k_lo = bins.k_lo;
+  c.k_hi = bins.k_hi;
+  const double df = in.rate_hz / static_cast<double>(bins.nfft);
   c.line_scales = lineScanScales(c.k_hi > c.k_lo ? c.k_hi - c.k_lo : 0, df);
   c.line_background_block = lineBackgroundBlock(df);
   c.line_halves = lineScanHalves(c.n, in.rate_hz);

@@ -78,17 +78,15 @@ bool checkSinusoids(std::vector<double>& xc, const Context& c, const NullSummary
         const LineScanSegment& seg = c.line_halves[half.half];
         const Periodogram ph = hannPeriodogram(std::span<const double>(xc).subspan(seg.offset, seg.length));
         const double dfh = rate / static_cast<double>(ph.nfft);
-        std::vector<double> bg_h = blockMedianBackground(ph.power, seg.background_block);
-        for (double& v : bg_h) v *= 2.0 / (rate * ph.window_power);
-        fit = fitNarrowbandLine(onesidedPsd(ph, rate), bg_h, dfh, rate,
+        fit = fitNarrowbandLine(onesidedPsd(ph, rate),
+                                onesidedPsd(ph, blockMedianBackground(ph.power, seg.background_block), rate), dfh, rate,
                                 static_cast<std::size_t>(std::lround(half.centre_hz / dfh)),
                                 static_cast<std::size_t>(std::lround(half.width_hz / dfh)), seg.k_lo, seg.k_hi);
       } else {
         const std::size_t centre = peak_fires ? peak.bin : scan.centre_bin;
         const std::size_t width = peak_fires ? 4 : scan.width_bins;
-        std::vector<double> bg_psd = wide_bg;
-        for (double& v : bg_psd) v *= 2.0 / (rate * p.window_power);
-        fit = fitNarrowbandLine(onesidedPsd(p, rate), bg_psd, df, rate, centre, width, c.k_lo, c.k_hi);
+        fit = fitNarrowbandLine(onesidedPsd(p, rate), onesidedPsd(p, wide_bg, rate), df, rate, centre, width, c.k_lo,
+                                c.k_hi);
       }
       // Broader than any line: no catalogue entry (the Allan band names it unexplained).
       if (fit.fitted && fit.broadband) break;
