@@ -28,6 +28,11 @@ constexpr double kResolvedBins = 4.0;
 // Wider than this it is broadband colour, not a line: the widest lines seen on real MPU6050
 // records (a mount's resonance near 11.6 Hz) are 1.7 Hz wide.
 constexpr double kWidestLineHz = 2.0;
+// Nor is a peak wider than this share of its centre frequency (a resonance of quality factor
+// below 2, hardly a peak at all): at low frequency such a bump is the slow noise's colour
+// (flicker, random walk) that a block median follows poorly. The real lines are narrower than
+// a sixth of their centre (the mount resonance: 1.8 Hz at 11.9 Hz).
+constexpr double kWidestLineShareOfCentre = 0.5;
 
 // −ln Q(a, x), Q the regularised upper incomplete gamma function, without underflow.
 double minusLogGammaQ(double a, double x) {
@@ -298,7 +303,7 @@ NarrowbandFit fitNarrowbandLine(const std::vector<double>& psd, const std::vecto
   const double u = std::log(out.centre_hz / w.centre_guess);
   out.background_psd = w.background_level * std::exp(p[3] + u * (p[4] + u * p[5]));
   out.resolved = out.width_hz > kResolvedBins * df;
-  out.broadband = out.width_hz > kWidestLineHz;
+  out.broadband = out.width_hz > kWidestLineHz || out.width_hz > kWidestLineShareOfCentre * out.centre_hz;
   return out;
 }
 

@@ -240,7 +240,7 @@ std::vector<LineScanSegment> lineScanHalves(std::size_t n, double rate);
 struct NarrowbandFit {
   bool fitted = false;
   bool resolved = false;   // wider than a fixed sinusoid's peak: a narrowband line
-  bool broadband = false;  // wider than any line (2 Hz): colour the catalogue does not name
+  bool broadband = false;  // wider than any line (2 Hz, or half its centre): colour the catalogue does not name
   double centre_hz = 0.0, width_hz = 0.0, rms_dps = 0.0;
   double background_psd = 0.0;  // the fitted background at the centre
 };

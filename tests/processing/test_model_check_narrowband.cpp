@@ -169,3 +169,36 @@ TEST(ModelCheckNarrowband, ALineThatMovesBetweenTheHalvesIsNamedInEach) {
                                 << narrowbandDescribe(r);
   }
 }
+
+// A line at the top of the band, as the one near 48.8 Hz on the 99.4 Hz records of
+// tests/data/mpu6050-sensor-fusion-set2 (98.2 % of Nyquist): hidden at 97.5–99 % of Nyquist on
+// a clean generator record, 0.3 Hz wide, it is named as narrowband with its centre within 1 %
+// and its width within a factor 1.5.
+TEST(ModelCheckNarrowband, ALineNearNyquistIsNamed) {
+  for (std::uint64_t seed : {41u, 42u, 43u}) {
+    HiddenEffectGenerator gen(seed);
+    GeneratedRecording g = gen.generate(kNarrowbandDuration, kNarrowbandRate, {});
+    const double white_sd = g.terms[0].get(NoiseTerm::AngleRandomWalk) / 60.0 * std::sqrt(g.rate_hz);
+    const NarrowbandLine line{gen.uniform(0.975, 0.99) * g.rate_hz / 2.0, 0.3, 0.4 * white_sd};
+    const NarrowbandLineRecursion rec = narrowbandLineRecursion(line, g.rate_hz);
+    NormalGenerator drive(seed ^ 0x9E3779B97F4A7C15ULL);
+    std::vector<double>& x = g.axes[0];
+    double y1 = 0.0, y2 = 0.0;
+    for (std::size_t i = 0; i < x.size() + 2000; ++i) {
+      const double y = rec.a1 * y1 + rec.a2 * y2 + std::sqrt(rec.drive_var) * drive.next();
+      y2 = y1;
+      y1 = y;
+      if (i >= 2000) x[i - 2000] += y;  // past the resonance's start from rest
+    }
+    const AxisModelCheck r = checkAxisModel({x, g.rate_hz, g.temp, g.t, {}}, narrowbandOptions(seed));
+    std::size_t named = 0;
+    for (const DetectedEffect& e : r.effects) {
+      if (e.effect != ModelEffect::NarrowbandLine) continue;
+      ++named;
+      EXPECT_NEAR(e.centre_hz, line.centre_hz, 0.01 * line.centre_hz) << "seed " << seed;
+      EXPECT_GT(e.width_hz, line.width_hz / 1.5) << "seed " << seed << "\n" << narrowbandDescribe(r);
+      EXPECT_LT(e.width_hz, line.width_hz * 1.5) << "seed " << seed << "\n" << narrowbandDescribe(r);
+    }
+    EXPECT_EQ(named, 1u) << "seed " << seed << ": hidden at " << line.centre_hz << " Hz\n" << narrowbandDescribe(r);
+  }
+}
