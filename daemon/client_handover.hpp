@@ -1,5 +1,5 @@
 #pragma once
-// What the sample thread hands the client thread (daemon/gyrod.hpp): one RATE or GAP line's
+// What the sample thread hands the delivery thread (daemon/gyrod.hpp): one RATE or GAP line's
 // content per slot of a lock-free ring (daemon/spsc_ring.hpp), sized here so that the memory
 // budget (daemon/memory_budget.cpp) counts exactly what gyrod allocates.
 #include <algorithm>
@@ -21,7 +21,7 @@ struct LineForClients {
   std::array<char, protocol::kMaxGapReasonBytes + 1> gap_reason{};  // NUL-terminated token
 };
 
-// The ring holds this much of the stream, in real time, for the moments the client thread is
+// The ring holds this much of the stream, in real time, for the moments the delivery thread is
 // not scheduled, within these bounds (at 8 kHz: 16384 lines).
 inline constexpr double kClientQueueSeconds = 2.0;
 inline constexpr std::size_t kMinClientQueueLines = 4096;

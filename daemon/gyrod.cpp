@@ -1,5 +1,6 @@
 #include "daemon/gyrod.hpp"
 
+#include <poll.h>
 #include <pthread.h>
 #include <sched.h>
 #include <spdlog/spdlog.h>
@@ -249,8 +250,10 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
           }),
       to_clients_(clientQueueLines(recordedSamplesPerSecond(config))),
       to_clients_fd_(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)),
+      stop_delivery_fd_(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)),
       stop_clients_fd_(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)) {
-  if (!to_clients_fd_ || !stop_clients_fd_) throw errnoError("eventfd for the client thread");
+  if (!to_clients_fd_ || !stop_delivery_fd_ || !stop_clients_fd_)
+    throw errnoError("eventfd for the delivery and client threads");
   loop_.guardTurnsWith(&state_mutex_);
   held_.reserve(static_cast<std::size_t>(std::ceil(0.5 * config.device.rate_hz)) + 16);  // as the pipeline's
   if (!rate_model_.warning.empty()) spdlog::warn("{}", rate_model_.warning);
@@ -266,10 +269,9 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
   server_options.client_buffer_bytes = config_.socket.client_buffer_kib * 1024;
   server_options.max_clients = kMaxSocketClients;  // as the memory budget counts them
   server_options.request_cpu_share = kRequestCpuShare;
+  server_options.publish_off_loop = true;  // the delivery thread publishes
   server_ =
       std::make_unique<UnixSocketServer>(client_loop_, openListeningSocket(socket_options), *this, server_options);
-  client_loop_.addFd(to_clients_fd_.get(), EPOLLIN, [this](std::uint32_t) { publishQueuedLines(); });
-  server_->runBetweenClients([this] { publishQueuedLines(); });
   client_loop_.addFd(stop_clients_fd_.get(), EPOLLIN, [this](std::uint32_t) { client_loop_.stop(); });
 
   if (config_.record.enabled()) {
@@ -313,13 +315,13 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
   if (device_.virtual_clock) {
     loop_.addPeriodicTimer(kPumpPeriod, [this](std::uint64_t) {
       pumpVirtualClock();
-      wakeClientThread();
+      wakeDeliveryThread();
     });
   } else {
     loop_.addFd(driver_->pollFd(), EPOLLIN, [this](std::uint32_t) {
       driver_->onDataReady();
       rearmDriverTimer();
-      wakeClientThread();
+      wakeDeliveryThread();
     });
     driver_timer_ = Fd(::timerfd_create(CLOCK_MONOTONIC, TFD_NONBLOCK | TFD_CLOEXEC));
     if (!driver_timer_) throw std::system_error(errno, std::generic_category(), "timerfd_create");
@@ -328,7 +330,7 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
       [[maybe_unused]] const ssize_t n = ::read(driver_timer_.get(), &expirations, sizeof expirations);
       driver_->onTimer(monotonicNowNs());
       rearmDriverTimer();
-      wakeClientThread();
+      wakeDeliveryThread();
     });
   }
 
@@ -354,7 +356,7 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
     spdlog::info("configuration: loaded from {}", config_file_);
   if (!device_.virtual_clock)
     spdlog::info(
-        "event loop scheduling: {}; the clients' loop runs beside it at normal priority, its requests at "
+        "event loop scheduling: {}; the clients' requests are served beside it at normal priority, at "
         "most {:.0f} % of a CPU",
         loopSchedulingNote(), kRequestCpuShare * 100.0);
   spdlog::info("rate stream: {}", pipeline_.rateModel() == RateModel::SensorModel
@@ -368,12 +370,21 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
   if (!device_.virtual_clock) rearmDriverTimer();
 }
 
-Gyrod::~Gyrod() { stopClientThread(); }
+Gyrod::~Gyrod() {
+  stopDeliveryThread();  // first: it publishes through the client thread's server
+  stopClientThread();
+}
 
 int Gyrod::run() {
   running_.store(true, std::memory_order_release);
   client_thread_ = std::thread([this] { clientThreadMain(); });
+  int sample_policy = SCHED_OTHER;
+  sched_param sample_param{};
+  ::pthread_getschedparam(::pthread_self(), &sample_policy, &sample_param);
+  delivery_thread_ = std::thread(
+      [this, sample_policy, priority = sample_param.sched_priority] { deliveryThreadMain(sample_policy, priority); });
   loop_.run();
+  stopDeliveryThread();
   stopClientThread();
   ::sd_notify(0, "STOPPING=1");
   std::string recording;
@@ -437,7 +448,7 @@ void Gyrod::pumpVirtualClock() {
   while (budget > 0) {
     if (monotonicNowNs() - now > kMaxPumpWorkNs) break;  // the rest of this slice is dropped
     // Sensor time can wait for the clients, a real chip's FIFO cannot: the mock runs no further
-    // ahead of the client thread than half of the hand-over holds.
+    // ahead of the delivery thread than half of the hand-over holds.
     if (to_clients_.sizeSeenByProducer() > to_clients_.capacity() / 2) break;
     const std::int64_t step = std::min(budget, max_virtual_step_ns_);
     device_.virtual_clock->advanceNs(step);
@@ -572,11 +583,11 @@ void Gyrod::queueForClients(const LineForClients& line) {
   behind_first_seq_ = rate ? line.rate.seq : line.gap_first_seq;
   behind_count_ = rate ? 1 : line.gap_count;
   if (rate) ++behind_total_;
-  spdlog::warn("the client thread is {} lines behind the samples: the next lines are sent as a GAP delivery_behind",
+  spdlog::warn("the delivery thread is {} lines behind the samples: the next lines are sent as a GAP delivery_behind",
                to_clients_.capacity());
 }
 
-void Gyrod::wakeClientThread() {
+void Gyrod::wakeDeliveryThread() {
   if (!clients_to_wake_) return;
   clients_to_wake_ = false;
   const std::uint64_t one = 1;
@@ -594,6 +605,53 @@ void Gyrod::publishQueuedLines() {
     else
       server_->publishGap({line.gap_first_seq, line.gap_count, std::string_view(line.gap_reason.data())});
   }
+}
+
+void Gyrod::deliveryThreadMain(int sample_policy, int sample_priority) {
+  // Real-time one step below a real-time sample thread: a line waits neither for the machine's
+  // other tasks nor for the flooded client thread, and never outranks the samples. The thread
+  // only copies lines and sends them (a few microseconds per watcher), so it stays far from the
+  // kernel's real-time limit, which a thread serving requests reaches.
+  std::string note;
+  if ((sample_policy == SCHED_FIFO || sample_policy == SCHED_RR) && sample_priority > 1) {
+    sched_param fifo{};
+    fifo.sched_priority = sample_priority - 1;
+    if (const int rc = ::pthread_setschedparam(::pthread_self(), SCHED_FIFO, &fifo); rc == 0)
+      note = fmt::format("SCHED_FIFO priority {}, one below the sample thread", fifo.sched_priority);
+    else
+      note = fmt::format("SCHED_OTHER (SCHED_FIFO priority {} refused: {})", fifo.sched_priority, std::strerror(rc));
+  } else {
+    note = "SCHED_OTHER, as the sample thread is not real-time above priority 1";
+  }
+  if (!note.starts_with("SCHED_FIFO")) {
+    const sched_param normal{};
+    ::pthread_setschedparam(::pthread_self(), SCHED_OTHER, &normal);
+  }
+  spdlog::info("delivery thread scheduling: {}", note);
+  std::array<pollfd, 2> fds{};
+  fds[0] = {to_clients_fd_.get(), POLLIN, 0};
+  fds[1] = {stop_delivery_fd_.get(), POLLIN, 0};
+  try {
+    while (true) {
+      if (::poll(fds.data(), fds.size(), -1) < 0) {
+        if (errno == EINTR) continue;
+        throw errnoError("poll on the delivery thread");
+      }
+      if (fds[1].revents != 0) return;
+      publishQueuedLines();
+    }
+  } catch (const std::exception& e) {
+    // As on the client thread: a fault of the daemon. Stop it rather than stream to nobody.
+    spdlog::critical("the delivery thread failed: {}; stopping", e.what());
+    ::kill(::getpid(), SIGTERM);
+  }
+}
+
+void Gyrod::stopDeliveryThread() {
+  if (!delivery_thread_.joinable()) return;
+  const std::uint64_t one = 1;
+  [[maybe_unused]] const ssize_t n = ::write(stop_delivery_fd_.get(), &one, sizeof one);
+  delivery_thread_.join();
 }
 
 void Gyrod::clientThreadMain() {

@@ -3,14 +3,20 @@
 // one way:
 //   FIFO bytes → samples (driver/) → filters and statistics (daemon/sample_pipeline) →
 //   RATE/GAP lines (daemon/unix_socket_server) and the recording (daemon/recorder).
-// Two threads, each with its own epoll loop (daemon/event_loop.hpp):
-//  - the sample thread (the process's main thread, SCHED_FIFO under the systemd unit): the
-//    device, the pipeline, the refit and reload results, signals and the watchdog. It hands
-//    each sample to the client thread through a lock-free ring and never touches a client;
-//  - the client thread (SCHED_OTHER): the socket, every client's requests and buffers, the
-//    RATE lines' formatting. However many clients flood it, it only ever competes with the
-//    sample thread for the state mutex, which it holds for the copy of one STATUS or ALLAN
-//    report (priority inheritance: daemon/priority_inheritance_mutex.hpp).
+// Three threads:
+//  - the sample thread (the process's main thread, SCHED_FIFO under the systemd unit), with
+//    its epoll loop (daemon/event_loop.hpp): the device, the pipeline, the refit and reload
+//    results, signals and the watchdog. It hands each sample to the delivery thread through a
+//    lock-free ring and never touches a client;
+//  - the delivery thread (SCHED_FIFO one step below a real-time sample thread): takes the
+//    lines from the ring, formats them and moves them into the watching clients' buffers and
+//    sockets (UnixSocketServer::publishRate, publishGap), and nothing else;
+//  - the client thread (SCHED_OTHER), with its own epoll loop: the socket, every client's
+//    requests and replies, what the delivery thread leaves it (EPOLLOUT, dropping clients).
+//    However many clients flood it, it only ever competes with the sample thread for the
+//    state mutex, which it holds for the copy of one STATUS or ALLAN report, and with the
+//    delivery thread for a client's buffer, held for the copy of one line (priority
+//    inheritance: daemon/priority_inheritance_mutex.hpp).
 // Nothing on the per-sample path allocates or blocks: the recorder is a lock-free ring
 // drained by its own thread, so is the hand-over to the clients, and every client has a
 // bounded buffer.
@@ -96,14 +102,17 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   // The start-up still window, evaluated off the loop (SamplePipeline::takeStillWindow).
   void startStillWindowIfWaiting();
   void finishStillWindow(StillWindowOutcome&& outcome);
-  // The hand-over to the client thread (sample thread: queue and wake; client thread: take).
+  // The hand-over to the delivery thread (sample thread: queue and wake; delivery thread: take).
   void queueForClients(const LineForClients& line);
-  void wakeClientThread();
+  void wakeDeliveryThread();
   void publishQueuedLines();
+  // The sample thread's policy and priority, as run() found them.
+  void deliveryThreadMain(int sample_policy, int sample_priority);
   void clientThreadMain();
   void startMqtt();
   MqttDerivedSources mqttDerivedSources();
   std::string biasDescription() const;
+  void stopDeliveryThread();
   void stopClientThread();
 
   GyrodConfig config_;
@@ -133,6 +142,7 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   Fd driver_timer_;  // absolute CLOCK_MONOTONIC deadline of the driver (real-time clocks)
   SpscRing<LineForClients> to_clients_;
   Fd to_clients_fd_;                    // eventfd: lines wait in to_clients_
+  Fd stop_delivery_fd_;                 // eventfd: the delivery thread stops
   Fd stop_clients_fd_;                  // eventfd: the client thread's loop stops
   bool clients_to_wake_ = false;        // sample thread: lines queued since the last wake-up
   std::uint64_t behind_first_seq_ = 0;  // sample thread: lines the ring could not take,
@@ -141,6 +151,7 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   std::atomic<bool> running_{false};                      // run() has begun: every member is built
   std::atomic<std::uint64_t> refit_cycles_{0};            // completed by the sample thread
   std::uint64_t allan_cycle_served_ = ~std::uint64_t{0};  // client thread: the cached line's cycle
+  std::thread delivery_thread_;
   std::thread client_thread_;
 
   std::int64_t start_real_ns_ = 0;

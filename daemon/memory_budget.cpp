@@ -138,7 +138,7 @@ MemoryNeed memoryNeeded(const GyrodConfig& c) {
        "socket.client_buffer_kib", std::to_string(c.socket.client_buffer_kib),
        static_cast<double>(kMaxSocketClients) * static_cast<double>(c.socket.client_buffer_kib) * 1024.0});
   const auto handover = static_cast<double>(clientQueueLines(recordedSamplesPerSecond(c)));
-  need.items.push_back({"hand-over to the client thread: " + count(handover) + " lines x " +
+  need.items.push_back({"hand-over to the delivery thread: " + count(handover) + " lines x " +
                             std::to_string(sizeof(LineForClients)) + " B",
                         "device.rate_hz", formats::shortest(c.device.rate_hz),
                         handover * static_cast<double>(sizeof(LineForClients))});

@@ -5,8 +5,10 @@
 // through this mutex, held by the client thread only for the few microseconds it takes to copy
 // a report. Without inheritance a SCHED_OTHER holder preempted on a busy CPU would keep the
 // sample thread waiting for a whole scheduler slice or more (the classic priority inversion);
-// with it, the sample thread waits at most for the holder's critical section. Satisfies
-// Lockable (std::lock_guard, std::unique_lock).
+// with it, the sample thread waits at most for the holder's critical section. The socket
+// server guards each client's buffer with one too, shared by the real-time delivery thread
+// and the client thread (daemon/unix_socket_server.hpp). Satisfies Lockable
+// (std::lock_guard, std::unique_lock).
 #include <pthread.h>
 
 #include <system_error>

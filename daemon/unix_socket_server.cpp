@@ -4,6 +4,7 @@
 
 #include <fcntl.h>
 #include <grp.h>
+#include <sys/eventfd.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/uio.h>
@@ -17,6 +18,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <mutex>
 #include <stdexcept>
 
 namespace gyrod::daemon {
@@ -31,31 +33,73 @@ constexpr std::size_t kMinClientBufferBytes = 4096;
 // Room for the longest accepted line plus "\r\n".
 constexpr std::size_t kInputBufferBytes = kMaxRequestLineBytes + 2;
 
+std::int64_t steadyNowNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+enum class SendResult { Drained, Blocked, Failed };
+
 }  // namespace
 
 // ---- clients -------------------------------------------------------------------------------
 
+// Owned by the loop's thread, except what `mutex` guards (shared with the publishing thread)
+// and the atomic flags.
 struct UnixSocketServer::Client {
   Client(Fd f, std::uint64_t i, std::size_t buffer_bytes)
-      : fd(std::move(f)), id(i), out(buffer_bytes), in(new char[kInputBufferBytes]) {}
+      : fd(std::move(f)), id(i), in(new char[kInputBufferBytes]), out(buffer_bytes) {}
   Fd fd;
   std::uint64_t id;
   std::optional<std::int64_t> pid, uid;
-  ClientOutputBuffer out;
   std::unique_ptr<char[]> in;
   std::size_t in_start = 0;  // first byte of in not yet handled
   std::size_t in_used = 0;
-  bool watch = false;
+  bool deferred = false;           // requests left for a later turn (input not watched meanwhile)
+  std::uint32_t events = EPOLLIN;  // the epoll events requested now
+  std::string held_reply;          // a reply waiting for room in out (input paused meanwhile)
+
+  // Guards out, every send on fd and the fields below it; watch and closing change under it.
+  PriorityInheritanceMutex mutex;
+  ClientOutputBuffer out;
   std::uint32_t decimate = 1;
   std::uint32_t countdown = 0;        // RATE lines to skip before the next one is sent
-  bool closing = false;               // no more input; close once the output is flushed
-  bool dead = false;                  // to be removed by reapDeadClients()
-  bool deferred = false;              // requests left for a later turn (input not watched meanwhile)
-  std::uint32_t events = EPOLLIN;     // the epoll events requested now
-  std::string held_reply;             // a reply waiting for room in out (input paused meanwhile)
   std::int64_t last_progress_ns = 0;  // when a reply was held or output last left
   std::uint64_t lines_queued = 0;
   std::uint64_t lines_sent = 0;
+  std::size_t drop_line_bytes = 0;  // the line that did not fit (with drop_requested)
+
+  // Written by the loop's thread (watch and closing under mutex), read by the publishing one.
+  std::atomic<bool> watch{false};
+  std::atomic<bool> closing{false};  // no more input; close once the output is flushed
+  std::atomic<bool> dead{false};     // to be removed by reapDeadClients()
+  // Set by the publishing thread for the loop's thread (delivery_flags_fd_).
+  std::atomic<bool> drop_requested{false};  // a line did not fit: drop the client
+  std::atomic<bool> wants_output{false};    // bytes left in out: watch for EPOLLOUT
+  std::atomic<bool> send_failed{false};     // EPIPE, ECONNRESET: the client has gone
+
+  // Sends what out holds until the socket takes no more. Under mutex.
+  SendResult sendBuffered() {
+    std::array<iovec, 2> iov{};
+    bool progress = false;
+    SendResult result = SendResult::Drained;
+    while (!out.empty()) {
+      msghdr msg{};
+      msg.msg_iov = iov.data();
+      msg.msg_iovlen = static_cast<std::size_t>(out.pieces(iov));
+      const ssize_t n = ::sendmsg(fd.get(), &msg, MSG_NOSIGNAL | MSG_DONTWAIT);
+      if (n > 0) {
+        lines_sent += out.consume(static_cast<std::size_t>(n));
+        progress = true;
+        continue;
+      }
+      if (n < 0 && errno == EINTR) continue;
+      result = n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK) ? SendResult::Blocked : SendResult::Failed;
+      break;
+    }
+    if (progress) last_progress_ns = steadyNowNs();
+    return result;
+  }
 };
 
 UnixSocketServer::UnixSocketServer(EventLoop& loop, ListeningSocket listening, ServerContent& content,
@@ -72,17 +116,29 @@ UnixSocketServer::UnixSocketServer(EventLoop& loop, ListeningSocket listening, S
                                 std::to_string(options_.request_cpu_share));
   if (options_.max_requests_per_turn == 0)
     throw std::invalid_argument("the socket server needs at least 1 request per client per turn, got 0");
-  // Reserved once, so that adding and removing clients never reallocates the list.
+  // Reserved once, so that adding and removing clients never reallocates the lists.
   clients_.reserve(options_.max_clients);
+  reaped_.reserve(options_.max_clients);
+  delivery_flags_fd_ = Fd(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC));
+  if (!delivery_flags_fd_) throw errnoError("eventfd for the socket server");
   setNonBlockingCloseOnExec(listening_.fd.get());
   loop_.addFd(listening_.fd.get(), EPOLLIN, [this](std::uint32_t) { onListenerReadable(); });
+  loop_.addFd(delivery_flags_fd_.get(), EPOLLIN, [this](std::uint32_t) {
+    std::uint64_t count = 0;
+    [[maybe_unused]] const ssize_t n = ::read(delivery_flags_fd_.get(), &count, sizeof count);
+    serviceDeliveryFlags();
+  });
 }
 
 UnixSocketServer::~UnixSocketServer() {
   if (accept_pause_timer_) loop_.removeSource(*accept_pause_timer_);
   if (stall_check_timer_) loop_.removeSource(*stall_check_timer_);
   for (const auto& c : clients_) loop_.removeFd(c->fd.get());
-  clients_.clear();
+  {
+    const std::lock_guard list(clients_mutex_);
+    clients_.clear();
+  }
+  loop_.removeFd(delivery_flags_fd_.get());
   loop_.removeFd(listening_.fd.get());
   if (!listening_.path.empty()) {
     struct stat st {};
@@ -138,7 +194,10 @@ void UnixSocketServer::acceptClient(Fd fd) {
   }
   Client& c = *client;
   loop_.addFd(c.fd.get(), EPOLLIN, [this, &c](std::uint32_t events) { onClientEvents(c, events); });
-  clients_.push_back(std::move(client));
+  {
+    const std::lock_guard list(clients_mutex_);
+    clients_.push_back(std::move(client));
+  }
   spdlog::info("client {} connected (pid {}, uid {})", c.id, c.pid.value_or(-1), c.uid.value_or(-1));
   queueLine(c, versionLine(options_.release));
   reapDeadClients();
@@ -268,10 +327,7 @@ void UnixSocketServer::handleLine(Client& c, std::string_view line) {
   try {
     const Request request = parseRequest(line);
     if (const auto* w = std::get_if<WatchRequest>(&request)) {
-      c.watch = w->enable;
-      c.decimate = w->decimate;
-      c.countdown = 0;  // the next sample is sent, then every decimate-th
-      queueReply(c, watchLine(c.watch, c.decimate));
+      queueReply(c, watchLine(w->enable, w->decimate), w);
     } else if (std::holds_alternative<AllanRequest>(request)) {
       std::string reply;
       try {
@@ -302,71 +358,85 @@ namespace {
 bool replyFits(std::size_t reply_bytes, std::size_t free_bytes, std::size_t capacity, bool watching) {
   return reply_bytes + (watching ? capacity / 4 : 0) <= free_bytes;
 }
-std::int64_t steadyNowNs() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
 }  // namespace
 
-void UnixSocketServer::queueReply(Client& c, std::string reply) {
+void UnixSocketServer::queueReply(Client& c, std::string reply, const WatchRequest* watch) {
   if (c.dead) return;
-  // Only an empty buffer too small for the reply would hold it forever: drop at once then.
-  if (replyFits(reply.size(), c.out.free(), c.out.capacity(), c.watch) || reply.size() > c.out.capacity()) {
-    queueLine(c, reply);
-    return;
+  enum class Outcome { Queued, Held, TooLong } outcome = Outcome::Queued;
+  {
+    // A WATCH request changes what the publishing thread sends in the same step as its reply
+    // is queued: no RATE line comes before the reply to WATCH true, none after WATCH false.
+    const std::lock_guard lock(c.mutex);
+    if (watch) {
+      c.watch = watch->enable;
+      c.decimate = watch->decimate;
+      c.countdown = 0;  // the next sample is sent, then every decimate-th
+    }
+    if (replyFits(reply.size(), c.out.free(), c.out.capacity(), c.watch)) {
+      c.out.append(reply.data(), reply.size());
+      ++c.lines_queued;
+    } else if (reply.size() > c.out.capacity()) {
+      outcome = Outcome::TooLong;  // an empty buffer could not take it: dropped at once
+    } else {
+      c.last_progress_ns = steadyNowNs();
+      outcome = Outcome::Held;
+    }
+  }
+  switch (outcome) {
+    case Outcome::Queued:
+      if (!(c.events & EPOLLOUT)) flush(c);
+      return;
+    case Outcome::TooLong: dropSlowClient(c, reply.size()); return;
+    case Outcome::Held: break;
   }
   c.held_reply = std::move(reply);
-  c.last_progress_ns = steadyNowNs();
   updateInterest(c);
   if (!stall_check_timer_) armStallCheck(options_.stalled_reply_timeout);
 }
 
 void UnixSocketServer::queueLine(Client& c, const char* data, std::size_t size) {
   if (c.dead) return;
-  if (size > c.out.free()) {
+  bool fits = false;
+  {
+    const std::lock_guard lock(c.mutex);
+    fits = size <= c.out.free();
+    if (fits) {
+      c.out.append(data, size);
+      ++c.lines_queued;
+    }
+  }
+  if (!fits) {
     dropSlowClient(c, size);
     return;
   }
-  c.out.append(data, size);
-  ++c.lines_queued;
   // Write at once unless the socket is already known to be full (EPOLLOUT pending): most
   // lines then leave in the same wake-up, and the buffer only holds what the kernel refused.
   if (!(c.events & EPOLLOUT)) flush(c);
 }
 
 void UnixSocketServer::flush(Client& c) {
-  std::array<iovec, 2> iov{};
-  bool progress = false;
-  while (!c.out.empty()) {
-    msghdr msg{};
-    msg.msg_iov = iov.data();
-    msg.msg_iovlen = static_cast<std::size_t>(c.out.pieces(iov));
-    const ssize_t n = ::sendmsg(c.fd.get(), &msg, MSG_NOSIGNAL | MSG_DONTWAIT);
-    if (n > 0) {
-      c.lines_sent += c.out.consume(static_cast<std::size_t>(n));
-      progress = true;
-      continue;
-    }
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) break;
-    // EPIPE, ECONNRESET: the client has gone away.
-    c.dead = true;
-    return;
-  }
-  if (progress && !c.held_reply.empty()) {
-    c.last_progress_ns = steadyNowNs();
-    if (replyFits(c.held_reply.size(), c.out.free(), c.out.capacity(), c.watch)) {
+  bool failed = false;
+  bool released = false;  // the held reply went into the buffer
+  bool closed = false;    // closing, and everything sent
+  {
+    const std::lock_guard lock(c.mutex);
+    failed = c.sendBuffered() == SendResult::Failed;
+    if (!failed && !c.held_reply.empty() && replyFits(c.held_reply.size(), c.out.free(), c.out.capacity(), c.watch)) {
       // Room again: the held reply goes out and the client's requests resume next turn.
       c.out.append(c.held_reply.data(), c.held_reply.size());
       ++c.lines_queued;
       c.held_reply.clear();
-      deferRequests(c);
-      flush(c);
-      return;
+      released = true;
+      failed = c.sendBuffered() == SendResult::Failed;
     }
+    closed = c.closing && c.out.empty();
   }
-  if (c.closing && c.out.empty()) {
+  if (failed || closed) {  // failed: EPIPE, ECONNRESET, the client has gone away
     c.dead = true;
+    return;
+  }
+  if (released) {
+    deferRequests(c);  // updates the interest
     return;
   }
   updateInterest(c);
@@ -374,17 +444,30 @@ void UnixSocketServer::flush(Client& c) {
 
 void UnixSocketServer::updateInterest(Client& c) {
   const bool read_input = !c.closing && !c.deferred && c.held_reply.empty();
+  bool write_output = false;
+  {
+    // Bytes to send, or a held reply that fits now (the publishing thread may have sent the
+    // bytes it waited for): the flush on EPOLLOUT takes it.
+    const std::lock_guard lock(c.mutex);
+    write_output = !c.out.empty() ||
+                   (!c.held_reply.empty() && replyFits(c.held_reply.size(), c.out.free(), c.out.capacity(), c.watch));
+  }
   const std::uint32_t events =
-      (read_input ? std::uint32_t{EPOLLIN} : 0u) | (c.out.empty() ? 0u : std::uint32_t{EPOLLOUT});
+      (read_input ? std::uint32_t{EPOLLIN} : 0u) | (write_output ? std::uint32_t{EPOLLOUT} : 0u);
   if (events == c.events) return;
   loop_.modifyFd(c.fd.get(), events);
   c.events = events;
 }
 
 void UnixSocketServer::beginClose(Client& c) {
-  c.closing = true;
-  c.watch = false;
-  if (c.out.empty()) {
+  bool empty = false;
+  {
+    const std::lock_guard lock(c.mutex);  // no RATE line is queued after this
+    c.closing = true;
+    c.watch = false;
+    empty = c.out.empty();
+  }
+  if (empty) {
     c.dead = true;
     return;
   }
@@ -393,7 +476,11 @@ void UnixSocketServer::beginClose(Client& c) {
 
 void UnixSocketServer::dropSlowClient(Client& c, std::size_t line_size) {
   // Unsent lines, the one that did not fit and a held reply.
-  const std::uint64_t lost = c.lines_queued - c.lines_sent + 1 + (c.held_reply.empty() ? 0 : 1);
+  std::uint64_t lost = 0;
+  {
+    const std::lock_guard lock(c.mutex);
+    lost = c.lines_queued - c.lines_sent + 1 + (c.held_reply.empty() ? 0 : 1);
+  }
   ++clients_dropped_;
   lines_dropped_ += lost;
   spdlog::warn(
@@ -418,13 +505,20 @@ void UnixSocketServer::dropStalledClients() {
   for (const auto& client : clients_) {
     Client& c = *client;
     if (c.dead || c.held_reply.empty()) continue;
-    const std::int64_t due = c.last_progress_ns + timeout_ns;
+    std::int64_t last_progress_ns = 0;
+    std::uint64_t unsent = 0;
+    {
+      const std::lock_guard lock(c.mutex);
+      last_progress_ns = c.last_progress_ns;
+      unsent = c.lines_queued - c.lines_sent;
+    }
+    const std::int64_t due = last_progress_ns + timeout_ns;
     if (due > now) {
       next_due = std::min(next_due.value_or(due), due);
       continue;
     }
     ++clients_dropped_;
-    const std::uint64_t lost = c.lines_queued - c.lines_sent + 1;
+    const std::uint64_t lost = unsent + 1;
     lines_dropped_ += lost;
     spdlog::warn(
         "client {} (pid {}) is not reading: a reply has waited {} ms for room in its {} byte buffer; "
@@ -437,44 +531,101 @@ void UnixSocketServer::dropStalledClients() {
 }
 
 void UnixSocketServer::reapDeadClients() {
-  const auto first_dead = std::remove_if(clients_.begin(), clients_.end(), [this](const std::unique_ptr<Client>& c) {
-    if (!c->dead) return false;
+  // The list changes only here and in acceptClient, both on this thread: it is read without
+  // the list's mutex, and changed under it.
+  if (std::none_of(clients_.begin(), clients_.end(), [](const auto& c) { return c->dead.load(); })) return;
+  {
+    const std::lock_guard list(clients_mutex_);
+    for (auto& client : clients_)
+      if (client->dead) reaped_.push_back(std::move(client));
+    std::erase(clients_, nullptr);
+  }
+  // Out of the list: the publishing thread no longer sees them.
+  for (const auto& c : reaped_) {
     loop_.removeFd(c->fd.get());
     spdlog::info("client {} disconnected ({} lines sent)", c->id, c->lines_sent);
-    return true;
-  });
-  clients_.erase(first_dead, clients_.end());
+  }
+  reaped_.clear();
 }
 
 void UnixSocketServer::publishRate(const RateSample& sample) {
   std::array<char, kMaxRateLineBytes> line;
   const std::size_t n = formatRateLine(sample, line);
-  bool any_dead = false;
-  for (const auto& client : clients_) {
-    Client& c = *client;
-    if (!c.watch || c.dead) continue;
-    if (c.countdown > 0) {
-      --c.countdown;
-      continue;
-    }
-    c.countdown = c.decimate - 1;
-    queueLine(c, line.data(), n);
-    any_dead = any_dead || c.dead;
-  }
-  if (any_dead) reapDeadClients();
+  publishLine(line.data(), n, true);
 }
 
 void UnixSocketServer::publishGap(const GapEvent& gap) {
   std::array<char, kMaxGapLineBytes> line;
   const std::size_t n = formatGapLine(gap, line);
-  bool any_dead = false;
+  publishLine(line.data(), n, false);
+}
+
+void UnixSocketServer::publishLine(const char* data, std::size_t size, bool decimated) {
+  bool flagged = false;
+  {
+    const std::lock_guard list(clients_mutex_);
+    for (const auto& client : clients_) flagged = deliverLine(*client, data, size, decimated) || flagged;
+  }
+  if (!flagged) return;
+  if (!options_.publish_off_loop) {
+    serviceDeliveryFlags();
+    return;
+  }
+  const std::uint64_t one = 1;
+  [[maybe_unused]] const ssize_t n = ::write(delivery_flags_fd_.get(), &one, sizeof one);
+}
+
+// On the publishing thread, under the client list's mutex: nothing here calls into the loop.
+bool UnixSocketServer::deliverLine(Client& c, const char* data, std::size_t size, bool decimated) {
+  if (!c.watch.load(std::memory_order_relaxed) || c.dead.load(std::memory_order_relaxed) ||
+      c.drop_requested.load(std::memory_order_relaxed) || c.send_failed.load(std::memory_order_relaxed))
+    return false;
+  const std::lock_guard lock(c.mutex);
+  if (!c.watch || c.closing) return false;  // as the loop's thread left them under the mutex
+  if (decimated) {
+    if (c.countdown > 0) {
+      --c.countdown;
+      return false;
+    }
+    c.countdown = c.decimate - 1;
+  }
+  if (size > c.out.free()) {
+    c.drop_line_bytes = size;
+    c.drop_requested = true;
+    return true;
+  }
+  // Bytes already waiting mean the socket was full: they leave on EPOLLOUT, from the loop's
+  // thread, and this line after them.
+  const bool socket_full = !c.out.empty();
+  c.out.append(data, size);
+  ++c.lines_queued;
+  if (socket_full) return false;
+  switch (c.sendBuffered()) {
+    case SendResult::Drained: return false;
+    case SendResult::Blocked: c.wants_output = true; return true;
+    case SendResult::Failed: c.send_failed = true; return true;
+  }
+  return false;
+}
+
+void UnixSocketServer::serviceDeliveryFlags() {
   for (const auto& client : clients_) {
     Client& c = *client;
-    if (!c.watch || c.dead) continue;
-    queueLine(c, line.data(), n);
-    any_dead = any_dead || c.dead;
+    if (c.dead) continue;
+    if (c.send_failed) {
+      c.dead = true;
+    } else if (c.drop_requested) {
+      std::size_t line_bytes = 0;
+      {
+        const std::lock_guard lock(c.mutex);
+        line_bytes = c.drop_line_bytes;
+      }
+      dropSlowClient(c, line_bytes);
+    } else if (c.wants_output.exchange(false)) {
+      updateInterest(c);
+    }
   }
-  if (any_dead) reapDeadClients();
+  reapDeadClients();
 }
 
 ServerStatus UnixSocketServer::serverStatusFor(const Client* self) const {
@@ -490,10 +641,13 @@ ServerStatus UnixSocketServer::serverStatusFor(const Client* self) const {
     cs.pid = c->pid;
     cs.uid = c->uid;
     cs.watch = c->watch;
-    cs.decimate = c->decimate;
-    cs.lines_queued = c->lines_queued;
-    cs.lines_sent = c->lines_sent;
-    cs.buffered_bytes = c->out.size();
+    {
+      const std::lock_guard lock(c->mutex);
+      cs.decimate = c->decimate;
+      cs.lines_queued = c->lines_queued;
+      cs.lines_sent = c->lines_sent;
+      cs.buffered_bytes = c->out.size();
+    }
     cs.self = c.get() == self;
     s.client_list.push_back(cs);
   }

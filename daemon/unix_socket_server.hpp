@@ -23,11 +23,20 @@
 // A dropped client has received a prefix of its stream; its last line may be incomplete if
 // the kernel had taken part of it (docs/protocol.md: a line without its newline at EOF is
 // to be discarded).
+//
+// Threads: everything but publishRate and publishGap runs on the loop's thread. With
+// ServerOptions::publish_off_loop, those two run on another thread (gyrod's delivery thread)
+// and only move lines into the watching clients' buffers and sockets: each client's buffer,
+// counts and sends are guarded by a priority-inheritance mutex of its own, the client list by
+// another (held for one publish pass, and by the loop's thread while it adds or removes a
+// client). What a publish finds for the loop's thread to do (a client to drop for a full
+// buffer, a socket to watch for EPOLLOUT, a failed send) it flags on the client and signals
+// through an eventfd the loop watches; it never calls into the loop itself.
 #include <sys/types.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
-#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -35,6 +44,7 @@
 #include <vector>
 
 #include "daemon/event_loop.hpp"
+#include "daemon/priority_inheritance_mutex.hpp"
 #include "protocol/fd.hpp"
 #include "protocol/protocol.hpp"
 #include "protocol/socket_path.hpp"
@@ -109,6 +119,10 @@ struct ServerOptions {
   // A client whose reply has waited this long for room, with none of its output read
   // meanwhile, is dropped as not reading.
   std::chrono::milliseconds stalled_reply_timeout = std::chrono::seconds(10);
+  // publishRate and publishGap are called from another thread than the loop's: what they
+  // leave for the loop's thread reaches it through an eventfd. false: they are called on the
+  // loop's thread, and do it before they return.
+  bool publish_off_loop = false;
 };
 
 class UnixSocketServer {
@@ -122,17 +136,16 @@ class UnixSocketServer {
   UnixSocketServer& operator=(const UnixSocketServer&) = delete;
 
   // Per sample: formats one RATE line into a stack buffer and copies it into the buffer of
-  // each watching client whose decimation is due. Allocates nothing (a client dropped
-  // here for a full buffer frees its memory and logs, which are not the steady state).
+  // each watching client whose decimation is due, and sends it when that client's socket is
+  // not known to be full. Allocates nothing (a client dropped for a full buffer frees its
+  // memory and logs, on the loop's thread, which is not the steady state). On the loop's
+  // thread, or on one other thread with ServerOptions::publish_off_loop.
   void publishRate(const RateSample& sample);
   // A GAP line to every watching client, whatever its decimation. Throws
-  // std::invalid_argument for a malformed gap (see formatGapLine).
+  // std::invalid_argument for a malformed gap (see formatGapLine). As publishRate.
   void publishGap(const GapEvent& gap);
 
-  // Runs after each client's requests are served: gyrod publishes the samples that came
-  // meanwhile, so that a turn over many flooding clients does not hold the RATE lines back.
-  void runBetweenClients(std::function<void()> callback) { between_clients_ = std::move(callback); }
-
+  // The loop's thread only.
   ServerStatus serverStatus() const;
   std::size_t clientCount() const noexcept { return clients_.size(); }
   std::size_t watcherCount() const noexcept;
@@ -153,8 +166,9 @@ class UnixSocketServer {
   void deferRequests(Client& c);
   void serveDeferredRequests();
   void handleLine(Client& c, std::string_view line);
-  // A reply goes into c's buffer if it fits, else it is held and c's input pauses.
-  void queueReply(Client& c, std::string reply);
+  // A reply goes into c's buffer if it fits, else it is held and c's input pauses. A WATCH
+  // request's settings (`watch`) take effect in the same step as its reply is queued.
+  void queueReply(Client& c, std::string reply, const protocol::WatchRequest* watch = nullptr);
   // Appends a whole line to c's buffer, or drops c if it does not fit.
   void queueLine(Client& c, const char* data, std::size_t size);
   void queueLine(Client& c, const std::string& line) { queueLine(c, line.data(), line.size()); }
@@ -166,12 +180,22 @@ class UnixSocketServer {
   void dropStalledClients();
   void reapDeadClients();
   ServerStatus serverStatusFor(const Client* self) const;
+  // The publishing side: one line to every watching client; true when a client was flagged
+  // for the loop's thread.
+  void publishLine(const char* data, std::size_t size, bool decimated);
+  bool deliverLine(Client& c, const char* data, std::size_t size, bool decimated);
+  // The loop's thread: acts on what publishing flagged on the clients.
+  void serviceDeliveryFlags();
 
   EventLoop& loop_;
   ListeningSocket listening_;
   ServerContent& content_;
   ServerOptions options_;
+  // Written by the loop's thread under clients_mutex_, read by the publishing thread under it.
   std::vector<std::unique_ptr<Client>> clients_;
+  PriorityInheritanceMutex clients_mutex_;
+  std::vector<std::unique_ptr<Client>> reaped_;  // the loop's thread: removed, not yet destroyed
+  Fd delivery_flags_fd_;                         // eventfd: publishing flagged a client
   std::uint64_t next_client_id_ = 1;
   std::uint64_t clients_total_ = 0;
   std::uint64_t clients_dropped_ = 0;
@@ -180,7 +204,6 @@ class UnixSocketServer {
   std::optional<EventLoop::SourceId> stall_check_timer_;
   bool deferred_requests_pending_ = false;
   std::size_t deferred_pass_start_ = 0;
-  std::function<void()> between_clients_;
   static constexpr std::chrono::nanoseconds kMaxRequestTimeBanked = std::chrono::milliseconds(2);
   std::chrono::nanoseconds request_time_left_ = kMaxRequestTimeBanked;
   std::chrono::steady_clock::time_point request_time_refilled_ = std::chrono::steady_clock::now();

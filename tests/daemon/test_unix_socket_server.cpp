@@ -6,7 +6,9 @@
 #include <sys/wait.h>
 #include <systemd/sd-daemon.h>
 
+#include <atomic>
 #include <fstream>
+#include <thread>
 
 #include "server_fixture.hpp"
 
@@ -302,6 +304,157 @@ TEST_F(ServerTest, StalledClientIsDroppedWhileTheOthersReceiveEveryLine) {
   EXPECT_EQ(std::string(next_line.data(), next_size).substr(0, stalled->partial().size()), stalled->partial());
   // Counted exactly what it missed up to and including the sample that did not fit.
   EXPECT_EQ(got.size() + st.lines_dropped, *dropped_at + 1);
+}
+
+// gyrod's arrangement: the lines published from another thread (its delivery thread) while
+// the loop's thread serves requests, switches a watch on and off and drops a client that
+// never reads. Every line reaches each reading watcher once and in order, none comes before
+// the reply to WATCH true or after the reply to WATCH false, and only the deaf client is
+// dropped and counted.
+TEST_F(ServerTest, PublishingFromAnotherThreadLosesNothingAndDropsOnlyTheClientThatDoesNotRead) {
+  daemon::ServerOptions options;
+  options.client_buffer_bytes = 64 * 1024;
+  options.publish_off_loop = true;
+  startServer(options);
+  auto reader = watcher();
+  auto decimated = watcher(3);
+  auto deaf = watcher();  // never reads: its buffer fills, and it is dropped
+  auto requester = connect();
+  auto toggler = connect();
+
+  const std::uint64_t n = 6000;
+  const std::uint64_t gap_every = 500;
+  struct Expected {
+    bool gap;
+    std::uint64_t k;
+  };
+  std::vector<Expected> expected, expected_decimated;
+  for (std::uint64_t k = 0; k < n; ++k) {
+    expected.push_back({false, k});
+    if (k % 3 == 0) expected_decimated.push_back({false, k});
+    if (k % gap_every == gap_every - 1) {
+      expected.push_back({true, k});
+      expected_decimated.push_back({true, k});
+    }
+  }
+  auto gapFor = [](std::uint64_t k) { return protocol::GapEvent{5'000'000 + k, 2, "fifo_overflow"}; };
+
+  std::atomic<std::uint64_t> reader_lines{0};
+  std::atomic<bool> publishing{true};
+  std::thread publisher([&] {
+    std::uint64_t published_lines = 0;
+    const auto guard = std::chrono::steady_clock::now() + 4 * kHangGuard;
+    for (std::uint64_t k = 0; k < n; ++k) {
+      // At most 100 lines (25 KB) ahead of the reader, so that only the deaf client fills its
+      // buffer.
+      while (published_lines > reader_lines.load() + 100 && std::chrono::steady_clock::now() < guard)
+        std::this_thread::sleep_for(100us);
+      server_->publishRate(syntheticSample(k));
+      ++published_lines;
+      if (k % gap_every == gap_every - 1) {
+        server_->publishGap(gapFor(k));
+        ++published_lines;
+      }
+    }
+    publishing = false;
+  });
+
+  std::vector<std::string> reader_got, decimated_got;
+  std::size_t status_sent = 0, status_got = 0, watch_cycles = 0;
+  enum class Toggle { Off, On, AwaitOff } toggle = Toggle::Off;
+  std::uint64_t toggler_seq = 0;  // the last RATE seq the toggler got, after toggler_rates > 0
+  std::size_t toggler_rates = 0;
+  std::string toggler_problem;
+  toggler->send("{\"cmd\":\"watch\",\"enable\":true}\n");
+  const auto deadline = std::chrono::steady_clock::now() + 4 * kHangGuard;
+  while (std::chrono::steady_clock::now() < deadline) {
+    loop_.runOnce(1ms);
+    reader->drain();
+    for (auto& l : reader->takeLines()) reader_got.push_back(std::move(l));
+    reader_lines = reader_got.size();
+    decimated->drain();
+    for (auto& l : decimated->takeLines()) decimated_got.push_back(std::move(l));
+    requester->drain();
+    for (const auto& l : requester->takeLines()) {
+      EXPECT_EQ(parse(l).value("class", ""), "STATUS") << l;
+      ++status_got;
+    }
+    if (status_got == status_sent && publishing) {
+      std::string batch;
+      for (int i = 0; i < 20; ++i) batch += "{\"cmd\":\"status\"}\n";
+      requester->send(batch);
+      status_sent += 20;
+    }
+    toggler->drain();
+    for (const auto& l : toggler->takeLines()) {
+      const json j = parse(l);
+      const std::string cls = j.value("class", "");
+      if (toggle == Toggle::Off) {  // the reply to WATCH true comes first, nothing before it
+        if (cls != "WATCH" || !j.value("enable", false)) {
+          if (toggler_problem.empty()) toggler_problem = "before the reply to WATCH true: " + l;
+          continue;
+        }
+        toggle = Toggle::On;
+        toggler_rates = 0;
+        continue;
+      }
+      if (cls == "WATCH") {
+        if (toggle != Toggle::AwaitOff || j.value("enable", true)) {
+          if (toggler_problem.empty()) toggler_problem = "unexpected " + l;
+          continue;
+        }
+        toggle = Toggle::Off;  // nothing more until the next WATCH true is answered
+        ++watch_cycles;
+        if (publishing) toggler->send("{\"cmd\":\"watch\",\"enable\":true}\n");
+        continue;
+      }
+      if (cls != "RATE") continue;
+      const auto seq = j["seq"].get<std::uint64_t>();
+      if (toggler_rates > 0 && seq != toggler_seq + 1 && toggler_problem.empty())
+        toggler_problem = "seq " + std::to_string(seq) + " after " + std::to_string(toggler_seq);
+      toggler_seq = seq;
+      if (++toggler_rates == 50 && toggle == Toggle::On) {
+        toggler->send("{\"cmd\":\"watch\",\"enable\":false}\n");
+        toggle = Toggle::AwaitOff;
+      }
+    }
+    if (!publishing && reader_got.size() >= expected.size() && decimated_got.size() >= expected_decimated.size() &&
+        status_got == status_sent && server_->clientCount() == 4)
+      break;
+  }
+  publisher.join();
+
+  auto check = [](const std::vector<std::string>& got, const std::vector<Expected>& want, const char* who) {
+    ASSERT_EQ(got.size(), want.size()) << who;
+    for (std::size_t i = 0; i < got.size(); ++i) {
+      if (want[i].gap) {
+        const json j = json::parse(got[i]);
+        ASSERT_EQ(j.value("class", ""), "GAP") << who << " line " << i << ": " << got[i];
+        EXPECT_EQ(j["seq"].get<std::uint64_t>(), 5'000'000 + want[i].k) << who;
+      } else {
+        expectRateLineCarries(got[i], syntheticSample(want[i].k));
+      }
+    }
+  };
+  check(reader_got, expected, "reader");
+  check(decimated_got, expected_decimated, "decimated watcher");
+  EXPECT_EQ(status_got, status_sent);
+  EXPECT_GT(status_sent, 0u);
+  EXPECT_TRUE(toggler_problem.empty()) << toggler_problem;
+  EXPECT_GE(watch_cycles, 2u);
+  EXPECT_EQ(server_->clientCount(), 4u);
+  const protocol::ServerStatus st = server_->serverStatus();
+  EXPECT_EQ(st.clients_dropped, 1u);
+  EXPECT_GT(st.lines_dropped, 0u);
+  // The deaf client got the start of the stream, in order, then EOF; what it missed is counted.
+  const auto deaf_got = deaf->readUntilClosed(loop_);
+  EXPECT_TRUE(deaf->closedByServer());
+  ASSERT_FALSE(deaf_got.empty());
+  ASSERT_LT(deaf_got.size(), expected.size());
+  check(deaf_got,
+        std::vector<Expected>(expected.begin(), expected.begin() + static_cast<std::ptrdiff_t>(deaf_got.size())),
+        "deaf client");
+  EXPECT_LE(deaf_got.size() + st.lines_dropped, expected.size());
 }
 
 TEST_F(ServerTest, ClientLeavingMidStreamHurtsNobody) {

@@ -129,9 +129,10 @@ void floodAndCheck(const FloodSetup& setup) {
   const auto log = d.path() / "log.txt";
   // gyrod runs SCHED_FIFO as its systemd unit runs it (CPUSchedulingPolicy=fifo): what is
   // measured is then the loop's own turns, not how long a loaded test machine leaves it
-  // unscheduled (SCHED_OTHER at load 6: one 235 ms turn, 235 samples lost). Its client thread
+  // unscheduled (SCHED_OTHER at load 6: one 235 ms turn, 235 samples lost). Its delivery thread
+  // runs SCHED_FIFO one step below and only moves the lines to the clients; its client thread
   // is never real-time and its requests take at most half a CPU, so however hard it is flooded
-  // the sample thread stays light and far from the kernel's real-time throttling.
+  // the real-time threads stay light and far from the kernel's real-time throttling.
   // Where real-time scheduling is refused (no CAP_SYS_NICE, no RLIMIT_RTPRIO) it runs as it
   // can, and the test says so.
   GyrodProcess gyrod({"--config", cfg.string()}, log, [] {
@@ -211,13 +212,15 @@ void floodAndCheck(const FloodSetup& setup) {
       << text;
   ASSERT_TRUE(std::regex_search(text, turn, std::regex(R"(longest loop turn (\d+) us)"))) << text;
   const bool real_time = text.find("event loop scheduling: SCHED_FIFO") != std::string::npos;
+  const bool delivery_real_time = text.find("delivery thread scheduling: SCHED_FIFO") != std::string::npos;
   const double p50 = percentile(latency_ms, 0.5), p99 = percentile(latency_ms, 0.99);
   std::cout << setup.rate_hz << " Hz flood, " << std::chrono::duration_cast<std::chrono::seconds>(kFloodTime).count()
             << " s: watcher got " << rates << " RATE lines, " << gaps << " GAP lines, edge -> watcher p50 " << p50
             << " ms, p99 " << p99 << " ms; gyrod published " << m[1] << " samples, " << m[2] << " gaps, " << m[3]
             << " samples lost, longest loop turn " << turn[1] << " us; " << allan_replies << " ALLAN, "
             << status_replies << " STATUS, " << pipelined_replies << " pipelined replies; gyrod "
-            << (real_time ? "SCHED_FIFO" : "not real-time (refused)") << ", watcher "
+            << (real_time ? "SCHED_FIFO" : "not real-time (refused)") << ", its delivery thread "
+            << (delivery_real_time ? "SCHED_FIFO" : "not real-time") << ", watcher "
             << (watcher_real_time ? "SCHED_FIFO" : "not real-time") << "; load average before " << load_before
             << ", after " << loadAverage() << "\n";
   ::testing::Test::RecordProperty("samples_published", m[1].str());
@@ -259,9 +262,8 @@ void floodAndCheck(const FloodSetup& setup) {
     // limit that matters: past it a turn loses samples.
     const double fifo_ms = 1024.0 / 14.0 / setup.rate_hz * 1e3;
     EXPECT_LT(std::stod(turn[1].str()) * 1e-3, std::min(20.0, fifo_ms)) << text;
-    // The edge -> watcher p99 is reported, not asserted: the client thread runs at normal
-    // priority, and beside the rest of the suite its wake-ups wait for other tasks (1.5-2.2 ms
-    // with the flood alone, 4.5-5.6 ms beside ctest -j2 here, 62 ms once on the CI machine).
+    // The edge -> watcher p99 is reported, not asserted: it depends on the machine's load and
+    // on the watcher's own wake-ups (docs/driver.md "Under a flood of requests").
     ::testing::Test::RecordProperty("latency_p50_ms", std::to_string(p50));
   }
 }
