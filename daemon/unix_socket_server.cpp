@@ -27,6 +27,14 @@ namespace gyrod::daemon {
 using namespace protocol;
 namespace {
 
+// The CPU time this thread has used: what the requests are charged, so that the time the
+// thread waits (preempted by the real-time threads, or for a client's mutex) is not counted.
+std::chrono::nanoseconds threadCpuTime() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return std::chrono::seconds(ts.tv_sec) + std::chrono::nanoseconds(ts.tv_nsec);
+}
+
 constexpr int kMaxAcceptsPerWake = 16;
 constexpr int kMaxReadsPerWake = 8;
 constexpr std::size_t kMinClientBufferBytes = 4096;
@@ -227,11 +235,9 @@ bool UnixSocketServer::requestTimeLeft() {
 
 void UnixSocketServer::serveRequests(Client& c) {
   if (!requestTimeLeft()) return deferRequests(c);
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = threadCpuTime();
   answerRequests(c);
-  if (options_.request_cpu_share < 1.0)
-    request_time_left_ -=
-        std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start);
+  if (options_.request_cpu_share < 1.0) request_time_left_ -= threadCpuTime() - start;
 }
 
 void UnixSocketServer::answerRequests(Client& c) {

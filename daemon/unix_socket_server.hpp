@@ -17,9 +17,9 @@
 //    ServerOptions::max_requests_per_turn requests answered; the rest of its input is read
 //    and answered on later turns (EventLoop::defer).
 //  - Requests together take at most ServerOptions::request_cpu_share of a CPU over time
-//    (a token bucket of request time, at most kMaxRequestTimeBanked banked): past it, they
-//    wait for a timer while RATE and GAP lines go on, and a flood never takes the whole CPU
-//    the server's thread runs on.
+//    (a token bucket of the loop thread's CPU time spent answering, at most
+//    kMaxRequestTimeBanked banked): past it, they wait for a timer while RATE and GAP lines
+//    go on, and a flood never takes the whole CPU the server's thread runs on.
 // A dropped client has received a prefix of its stream; its last line may be incomplete if
 // the kernel had taken part of it (docs/protocol.md: a line without its newline at EOF is
 // to be discarded).
