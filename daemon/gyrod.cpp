@@ -647,12 +647,17 @@ void Gyrod::deliveryThreadMain(int sample_policy, int sample_priority) {
   }
 }
 
-void Gyrod::stopDeliveryThread() {
-  if (!delivery_thread_.joinable()) return;
+namespace {
+// Signals a thread's stop eventfd and waits for the thread to end (nothing if it never started).
+void signalAndJoin(std::thread& thread, const Fd& stop_fd) {
+  if (!thread.joinable()) return;
   const std::uint64_t one = 1;
-  [[maybe_unused]] const ssize_t n = ::write(stop_delivery_fd_.get(), &one, sizeof one);
-  delivery_thread_.join();
+  [[maybe_unused]] const ssize_t n = ::write(stop_fd.get(), &one, sizeof one);
+  thread.join();
 }
+}  // namespace
+
+void Gyrod::stopDeliveryThread() { signalAndJoin(delivery_thread_, stop_delivery_fd_); }
 
 void Gyrod::clientThreadMain() {
   // Never real-time, whatever gyrod runs as. A flood of requests keeps this thread busy; a busy
@@ -671,12 +676,7 @@ void Gyrod::clientThreadMain() {
   }
 }
 
-void Gyrod::stopClientThread() {
-  if (!client_thread_.joinable()) return;
-  const std::uint64_t one = 1;
-  [[maybe_unused]] const ssize_t n = ::write(stop_clients_fd_.get(), &one, sizeof one);
-  client_thread_.join();
-}
+void Gyrod::stopClientThread() { signalAndJoin(client_thread_, stop_clients_fd_); }
 
 void Gyrod::onStatus(const driver::DeviceStatus& status) {
   if (status.state == driver::DeviceState::Streaming) notifyReadyOnce();
