@@ -612,18 +612,18 @@ void Gyrod::deliveryThreadMain(int sample_policy, int sample_priority) {
   // other tasks nor for the flooded client thread, and never outranks the samples. The thread
   // only copies lines and sends them (a few microseconds per watcher), so it stays far from the
   // kernel's real-time limit, which a thread serving requests reaches.
-  std::string note;
+  std::string note = "SCHED_OTHER, as the sample thread is not real-time above priority 1";
+  bool real_time = false;
   if ((sample_policy == SCHED_FIFO || sample_policy == SCHED_RR) && sample_priority > 1) {
     sched_param fifo{};
     fifo.sched_priority = sample_priority - 1;
-    if (const int rc = ::pthread_setschedparam(::pthread_self(), SCHED_FIFO, &fifo); rc == 0)
-      note = fmt::format("SCHED_FIFO priority {}, one below the sample thread", fifo.sched_priority);
-    else
-      note = fmt::format("SCHED_OTHER (SCHED_FIFO priority {} refused: {})", fifo.sched_priority, std::strerror(rc));
-  } else {
-    note = "SCHED_OTHER, as the sample thread is not real-time above priority 1";
+    const int rc = ::pthread_setschedparam(::pthread_self(), SCHED_FIFO, &fifo);
+    real_time = rc == 0;
+    note = real_time ? fmt::format("SCHED_FIFO priority {}, one below the sample thread", fifo.sched_priority)
+                     : fmt::format("SCHED_OTHER (SCHED_FIFO priority {} refused: {})", fifo.sched_priority,
+                                   std::strerror(rc));
   }
-  if (!note.starts_with("SCHED_FIFO")) {
+  if (!real_time) {  // a thread starts with its creator's policy: the sample thread's
     const sched_param normal{};
     ::pthread_setschedparam(::pthread_self(), SCHED_OTHER, &normal);
   }
