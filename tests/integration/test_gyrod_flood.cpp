@@ -6,7 +6,10 @@
 //  - 8 kHz (DLPF 0) with a 60 s window: the FIFO lasts ~9 ms.
 // Any sample-loop turn longer than that loses samples, which a watching client sees as a GAP
 // line. Asserts none, contiguous sequence numbers, a loop turn far inside the FIFO, and the
-// watcher's edge → line latency.
+// watcher's edge → line latency. A loss is gyrod's unless the machine itself stopped for more
+// than half the FIFO just before it: probes above gyrod's priority time each CPU
+// (machine_stall_probe.hpp), and on a virtual machine with both CPUs busy the host stops a CPU
+// for 5-15 ms now and then (docs/driver.md "Under a flood of requests").
 //
 // Real time (mock speed 1), because the accelerated mock slows its virtual clock down when
 // the loop is late instead of overflowing the FIFO. The window cannot fill in the test's
@@ -31,6 +34,7 @@
 
 #include "binary_command.hpp"
 #include "gyrod_process.hpp"
+#include "machine_stall_probe.hpp"
 #include "tools/run_command.hpp"
 
 using namespace gyrod::test;
@@ -124,6 +128,8 @@ double percentile(std::vector<double> v, double p) {
 
 void floodAndCheck(const FloodSetup& setup) {
   const RealTimeTurn turn_of_this_test;
+  const double fifo_ms = 1024.0 / 14.0 / setup.rate_hz * 1e3;
+  const MachineStallProbe machine;
   ScratchDir d;
   const auto cfg = d.write("gyrod.toml", floodConfig(d.path(), setup));
   const auto log = d.path() / "log.txt";
@@ -168,7 +174,10 @@ void floodAndCheck(const FloodSetup& setup) {
 
   std::uint64_t rates = 0, gaps = 0;
   std::optional<std::uint64_t> first_seq, last_seq;
-  std::string first_problem;
+  std::string first_problem;  // a silent break in the sequence, or silence
+  std::vector<std::string> gap_lines;
+  std::vector<double> gap_arrivals_s;
+  bool after_gap = false;
   std::vector<double> latency_ms;
   latency_ms.reserve(static_cast<std::size_t>(setup.rate_hz) * 13);
   const std::string load_before = loadAverage();
@@ -182,12 +191,15 @@ void floodAndCheck(const FloodSetup& setup) {
     }
     const json j = json::parse(*line);
     if (j["class"] == "GAP") {
-      if (first_problem.empty()) first_problem = "GAP: " + *line;
+      gap_lines.push_back(*line);
+      gap_arrivals_s.push_back(arrived_s);
+      after_gap = true;
       ++gaps;
     } else if (j["class"] == "RATE") {
       const auto seq = j["seq"].get<std::uint64_t>();
-      if (last_seq && seq != *last_seq + 1 && first_problem.empty())
-        first_problem = "seq " + std::to_string(seq) + " after " + std::to_string(*last_seq);
+      if (last_seq && seq != *last_seq + 1 && !after_gap && first_problem.empty())
+        first_problem = "seq " + std::to_string(seq) + " after " + std::to_string(*last_seq) + " with no GAP line";
+      after_gap = false;
       if (!first_seq) first_seq = seq;
       last_seq = seq;
       latency_ms.push_back((arrived_s - j["t"].get<double>()) * 1e3);
@@ -214,6 +226,11 @@ void floodAndCheck(const FloodSetup& setup) {
   const bool real_time = text.find("event loop scheduling: SCHED_FIFO") != std::string::npos;
   const bool delivery_real_time = text.find("delivery thread scheduling: SCHED_FIFO") != std::string::npos;
   const double p50 = percentile(latency_ms, 0.5), p99 = percentile(latency_ms, 0.99);
+  // Each GAP line against the probes: a stall of over half the FIFO ending in the 0.5 s before it.
+  std::string gyrods_gaps;
+  for (std::size_t i = 0; i < gap_lines.size(); ++i)
+    if (!machine.stalledBefore(gap_arrivals_s[i], 0.5, fifo_ms / 2)) gyrods_gaps += gap_lines[i] + "\n";
+  const auto stalls = machine.stalls();
   std::cout << setup.rate_hz << " Hz flood, " << std::chrono::duration_cast<std::chrono::seconds>(kFloodTime).count()
             << " s: watcher got " << rates << " RATE lines, " << gaps << " GAP lines, edge -> watcher p50 " << p50
             << " ms, p99 " << p99 << " ms; gyrod published " << m[1] << " samples, " << m[2] << " gaps, " << m[3]
@@ -222,7 +239,12 @@ void floodAndCheck(const FloodSetup& setup) {
             << (real_time ? "SCHED_FIFO" : "not real-time (refused)") << ", its delivery thread "
             << (delivery_real_time ? "SCHED_FIFO" : "not real-time") << ", watcher "
             << (watcher_real_time ? "SCHED_FIFO" : "not real-time") << "; load average before " << load_before
-            << ", after " << loadAverage() << "\n";
+            << ", after " << loadAverage() << "; the machine stopped "
+            << (machine.running() ? std::to_string(stalls.size()) + " times for 2 ms or more, at most " +
+                                        std::to_string(machine.longestMs()) + " ms"
+                                  : "(not timed: the probes could not run real-time)")
+            << "\n";
+  ::testing::Test::RecordProperty("machine_longest_stall_ms", std::to_string(machine.longestMs()));
   ::testing::Test::RecordProperty("samples_published", m[1].str());
   ::testing::Test::RecordProperty("samples_lost", m[3].str());
   ::testing::Test::RecordProperty("longest_loop_turn_us", turn[1].str());
@@ -249,9 +271,13 @@ void floodAndCheck(const FloodSetup& setup) {
                  << pipelined_replies << " pipelined in 12 s";
   }
   EXPECT_TRUE(first_problem.empty()) << first_problem << "\n" << text;
-  EXPECT_EQ(gaps, 0u);
-  EXPECT_EQ(m[2].str(), "0") << text;
-  EXPECT_EQ(m[3].str(), "0") << text;
+  // No gap came without the machine stopping, and each one gyrod counted reached the watcher.
+  EXPECT_TRUE(gyrods_gaps.empty()) << "lost with no stall of the machine over " << fifo_ms / 2 << " ms before:\n"
+                                   << gyrods_gaps << text;
+  EXPECT_EQ(m[2].str(), std::to_string(gaps)) << text;
+  if (gaps == 0) {
+    EXPECT_EQ(m[3].str(), "0") << text;
+  }
   EXPECT_GT(rates, static_cast<std::uint64_t>(setup.rate_hz) * 8);  // the watcher was served: 8 of the 12 s
   EXPECT_GT(allan_replies.load(), 1000u);
   EXPECT_GT(status_replies.load(), 1000u);
@@ -260,8 +286,8 @@ void floodAndCheck(const FloodSetup& setup) {
     // The targets are a 10 ms turn and a 2 ms p99 (measured by hand: docs/driver.md "Latency");
     // the test shares its machine with other tests, hence the margin. What the FIFO holds is the
     // limit that matters: past it a turn loses samples.
-    const double fifo_ms = 1024.0 / 14.0 / setup.rate_hz * 1e3;
-    EXPECT_LT(std::stod(turn[1].str()) * 1e-3, std::min(20.0, fifo_ms)) << text;
+    // A turn the machine's own stall explains (the CPU stopped mid-turn) is not gyrod's.
+    EXPECT_LT(std::stod(turn[1].str()) * 1e-3, std::max(std::min(20.0, fifo_ms), machine.longestMs() + 2.0)) << text;
     // The edge -> watcher p99 is reported, not asserted: it depends on the machine's load and
     // on the watcher's own wake-ups (docs/driver.md "Under a flood of requests").
     ::testing::Test::RecordProperty("latency_p50_ms", std::to_string(p50));
