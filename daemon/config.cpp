@@ -95,6 +95,15 @@ void readDevice(const Section& s, DeviceConfig& d) {
     const char* which = s.has("dlpf") ? "dlpf" : "rate_hz";
     s.fail(*s.node(which), "rate_hz", req.str(), shortest(d.rate_hz) + ", the default");
   }
+  // The accelerometer's output rate is 1 kHz (Register Map rev 4.2, SMPLRT_DIV): faster, the
+  // FIFO repeats each accel sample, and at 8 kHz its 1024 bytes hold 9 ms of 14-byte frames
+  // (16 ms of the gyro's 8-byte ones). rate_hz is above 1000 only when written, so it is the
+  // key to name.
+  if (d.accel && d.rate_hz > driver::mpu6050::kAccelOutputRateHz)
+    s.failValue("rate_hz",
+                "must be at most 1000 Hz with device.accel = true: the accelerometer's output rate is "
+                "1 kHz, so faster frames repeat its samples and fill the FIFO in 9 ms at 8 kHz; set "
+                "device.accel = false for a gyro-only rate above 1 kHz");
 }
 
 void readGpio(const Section& s, GpioConfig& g) {

@@ -187,6 +187,9 @@ constexpr double temperatureDegCFromRaw(std::int16_t raw) {
 constexpr double gyroOutputRateHz(int dlpf_cfg) {
   return (dlpf_cfg == 0 || dlpf_cfg == kDlpfCfgReserved) ? 8000.0 : 1000.0;
 }
+// The accelerometer's output rate (RM §4.2 p.11): at a faster sample rate the FIFO and the
+// registers get the same accel sample more than once.
+inline constexpr double kAccelOutputRateHz = 1000.0;
 
 namespace fifo {
 

@@ -264,7 +264,9 @@ TEST(ConfigValues, EveryRateTheChipCanProduceIsAcceptedAndNoOther) {
       std::ostringstream toml;
       toml.precision(17);
       // A 1 min Allan window: the default hour at 8 kHz is over the default memory budget.
-      toml << "[device]\ndlpf = " << dlpf << "\nrate_hz = " << internal / n << "\n[allan]\nwindow_s = 60\n";
+      // Gyro-only frames: with the accel, rates above its 1 kHz output rate are refused (below).
+      toml << "[device]\ndlpf = " << dlpf << "\naccel = false\nrate_hz = " << internal / n
+           << "\n[allan]\nwindow_s = 60\n";
       EXPECT_EQ(errorOf(toml.str()), "") << toml.str();
     }
     for (double bad : {internal / 256.0 * 0.999, internal * 1.001, internal / 2.5, 47.0 * internal / 1000.0 + 0.3}) {
@@ -274,6 +276,20 @@ TEST(ConfigValues, EveryRateTheChipCanProduceIsAcceptedAndNoOther) {
       EXPECT_NE(errorOf(toml.str()).find("key 'device.rate_hz'"), std::string::npos) << toml.str();
     }
   }
+}
+
+TEST(ConfigValues, TheAccelIsRefusedAboveItsOutputRate) {
+  // RM rev 4.2 §4.2: the accelerometer's output rate is 1 kHz. 1000 Hz with DLPF 0 (8 kHz / 8)
+  // is the fastest rate with the accel; 8000/7 Hz is the next one up.
+  EXPECT_EQ(errorOf("[device]\ndlpf = 0\nrate_hz = 1000\n[allan]\nwindow_s = 60\n"), "");
+  for (const char* rate : {"1142.857142857143", "2000", "8000"}) {
+    const std::string e = errorOf(std::string("[device]\ndlpf = 0\nrate_hz = ") + rate + "\n[allan]\nwindow_s = 60\n");
+    EXPECT_EQ(e.rfind("x.toml:3: key 'device.rate_hz': must be at most 1000 Hz with device.accel = true", 0), 0u) << e;
+    EXPECT_NE(e.find(std::string("(got ") + rate + ")"), std::string::npos) << e;
+    EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+  }
+  // Gyro-only, 8 kHz is the chip's.
+  EXPECT_EQ(errorOf("[device]\ndlpf = 0\naccel = false\nrate_hz = 8000\n[allan]\nwindow_s = 60\n"), "");
 }
 
 // ---- error messages ---------------------------------------------------------------------

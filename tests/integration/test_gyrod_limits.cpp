@@ -82,6 +82,23 @@ TEST(GyrodLimits, AnAllanWindowBeyondTheMemoryBudgetExits78WithOneLine) {
   }
 }
 
+// 8 kHz with the accel: the accelerometer's output rate is 1 kHz, and its 14-byte frames would
+// fill the FIFO in 9 ms; gyrod refuses to start rather than lose samples whenever its machine
+// stops that long (docs/driver.md "Under a flood of requests").
+TEST(GyrodLimits, EightKilohertzWithTheAccelExits78WithOneLine) {
+  ScratchDir d;
+  const auto cfg =
+      d.write("fast.toml", "[device]\nbackend = \"mock\"\ndlpf = 0\nrate_hz = 8000\n[allan]\nwindow_s = 60\n");
+  GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt");
+  EXPECT_EQ(gyrod.waitExit(5000ms), std::optional<int>(78));
+  const std::string log = readWholeFile(d.path() / "log.txt");
+  EXPECT_EQ(lineCount(log), 1u) << log;
+  EXPECT_NE(log.find(cfg.string() + ":4: key 'device.rate_hz': must be at most 1000 Hz with device.accel = true"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("(got 8000)"), std::string::npos) << log;
+}
+
 TEST(GyrodLimits, WhatTheKernelWouldRefuseExits78NamingRlimitAs) {
 #if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space: no RLIMIT_AS under it";
