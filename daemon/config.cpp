@@ -104,6 +104,23 @@ void readDevice(const Section& s, DeviceConfig& d) {
                 "must be at most 1000 Hz with device.accel = true: the accelerometer's output rate is "
                 "1 kHz, so faster frames repeat its samples and fill the FIFO in 9 ms at 8 kHz; set "
                 "device.accel = false for a gyro-only rate above 1 kHz");
+  // On a real bus the FIFO's frames alone must fit in what I2C carries at the chip's fastest
+  // clock; reading them costs more (addresses, FIFO_COUNT), so this refuses only what can
+  // never stream. The mock's bus has no clock.
+  if (d.backend == DeviceBackend::I2c) {
+    namespace chip = driver::mpu6050;
+    const double frame_bytes = d.accel ? 14.0 : 8.0;
+    const double bits_per_s = d.rate_hz * frame_bytes * chip::kI2cClocksPerByte;
+    if (bits_per_s > chip::kMaxI2cClockHz) {
+      std::ostringstream req;
+      req << "must keep the FIFO's " << frame_bytes << "-byte frames within what the I2C bus carries at the "
+          << "MPU6050's fastest clock, 400 kHz: " << shortest(d.rate_hz) << " Hz needs "
+          << std::llround(bits_per_s / 1000.0) << " kbit/s; the fastest rate that fits is "
+          << shortest(internal / std::ceil(internal * frame_bytes * chip::kI2cClocksPerByte / chip::kMaxI2cClockHz))
+          << " Hz";
+      s.failValue("rate_hz", req.str());
+    }
+  }
 }
 
 void readGpio(const Section& s, GpioConfig& g) {

@@ -190,6 +190,10 @@ constexpr double gyroOutputRateHz(int dlpf_cfg) {
 // The accelerometer's output rate (RM §4.2 p.11): at a faster sample rate the FIFO and the
 // registers get the same accel sample more than once.
 inline constexpr double kAccelOutputRateHz = 1000.0;
+// The fastest I2C clock the chip supports (product spec: Fast-mode, 400 kHz): a byte on the wire
+// takes 9 clocks (8 bits and the acknowledge).
+inline constexpr double kMaxI2cClockHz = 400'000.0;
+inline constexpr double kI2cClocksPerByte = 9.0;
 
 namespace fifo {
 

@@ -265,7 +265,7 @@ TEST(ConfigValues, EveryRateTheChipCanProduceIsAcceptedAndNoOther) {
       toml.precision(17);
       // A 1 min Allan window: the default hour at 8 kHz is over the default memory budget.
       // Gyro-only frames: with the accel, rates above its 1 kHz output rate are refused (below).
-      toml << "[device]\ndlpf = " << dlpf << "\naccel = false\nrate_hz = " << internal / n
+      toml << "[device]\nbackend = \"mock\"\ndlpf = " << dlpf << "\naccel = false\nrate_hz = " << internal / n
            << "\n[allan]\nwindow_s = 60\n";
       EXPECT_EQ(errorOf(toml.str()), "") << toml.str();
     }
@@ -288,8 +288,22 @@ TEST(ConfigValues, TheAccelIsRefusedAboveItsOutputRate) {
     EXPECT_NE(e.find(std::string("(got ") + rate + ")"), std::string::npos) << e;
     EXPECT_EQ(e.find('\n'), std::string::npos) << e;
   }
-  // Gyro-only, 8 kHz is the chip's.
-  EXPECT_EQ(errorOf("[device]\ndlpf = 0\naccel = false\nrate_hz = 8000\n[allan]\nwindow_s = 60\n"), "");
+  // Gyro-only, 8 kHz is the chip's (on the mock: a real bus cannot carry it, below).
+  EXPECT_EQ(errorOf("[device]\nbackend = \"mock\"\ndlpf = 0\naccel = false\nrate_hz = 8000\n[allan]\nwindow_s = 60\n"),
+            "");
+}
+
+TEST(ConfigValues, ARateWhoseFramesTheI2cBusCannotCarryIsRefused) {
+  // 8-byte frames x 9 clocks a byte at 8 kHz: 576 kbit/s, above the chip's 400 kHz clock.
+  const std::string e = errorOf("[device]\ndlpf = 0\naccel = false\nrate_hz = 8000\n[allan]\nwindow_s = 60\n");
+  EXPECT_EQ(e.rfind("x.toml:4: key 'device.rate_hz': must keep the FIFO's 8-byte frames within what the I2C bus", 0),
+            0u)
+      << e;
+  EXPECT_NE(e.find("8000 Hz needs 576 kbit/s; the fastest rate that fits is 4000 Hz (got 8000)"), std::string::npos)
+      << e;
+  // 4 kHz gyro-only (288 kbit/s) and 1 kHz with the accel (126 kbit/s) fit.
+  EXPECT_EQ(errorOf("[device]\ndlpf = 0\naccel = false\nrate_hz = 4000\n[allan]\nwindow_s = 60\n"), "");
+  EXPECT_EQ(errorOf("[device]\ndlpf = 1\nrate_hz = 1000\n[allan]\nwindow_s = 60\n"), "");
 }
 
 // ---- error messages ---------------------------------------------------------------------

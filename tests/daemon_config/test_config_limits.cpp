@@ -50,13 +50,17 @@ TEST(ConfigLimits, AWindowOfATrillionSecondsNamesTheKeyTheFigureAndTheBudget) {
 }
 
 TEST(ConfigLimits, EightKilohertzWithTheDefaultWindowIsNamedAtTheRate) {
-  const std::string e = limitsErrorOf("[device]\ndlpf = 0\naccel = false\nrate_hz = 8000\n");
-  EXPECT_TRUE(contains(e, "x.toml:4: key 'allan.window_s':")) << e;
+  const std::string e = limitsErrorOf("[device]\nbackend = \"mock\"\ndlpf = 0\naccel = false\nrate_hz = 8000\n");
+  EXPECT_TRUE(contains(e, "x.toml:5: key 'allan.window_s':")) << e;
   EXPECT_TRUE(contains(e, "9 streams x 2.88e+07 samples x 16 B")) << e;
   EXPECT_TRUE(contains(e, "(3600, the default)")) << e;
   // A shorter window, or a larger budget, is accepted.
-  EXPECT_EQ(limitsErrorOf("[device]\ndlpf = 0\naccel = false\nrate_hz = 8000\n[allan]\nwindow_s = 600\n"), "");
-  EXPECT_EQ(limitsErrorOf("[device]\ndlpf = 0\naccel = false\nrate_hz = 8000\n[limits]\nmemory_mb = 6000\n"), "");
+  EXPECT_EQ(
+      limitsErrorOf("[device]\nbackend = \"mock\"\ndlpf = 0\naccel = false\nrate_hz = 8000\n[allan]\nwindow_s = 600\n"),
+      "");
+  EXPECT_EQ(limitsErrorOf(
+                "[device]\nbackend = \"mock\"\ndlpf = 0\naccel = false\nrate_hz = 8000\n[limits]\nmemory_mb = 6000\n"),
+            "");
 }
 
 TEST(ConfigLimits, TheLargestConsumerIsNamed) {
@@ -65,9 +69,9 @@ TEST(ConfigLimits, TheLargestConsumerIsNamed) {
   EXPECT_TRUE(contains(e, "x.toml:2: key 'socket.client_buffer_kib':")) << e;
   EXPECT_TRUE(contains(e, "32 clients x 65536 KiB")) << e;
   const std::string still = limitsErrorOf(
-      "[device]\ndlpf = 0\naccel = false\nrate_hz = 8000\n[bias]\nstill_seconds = 3600\n"
+      "[device]\nbackend = \"mock\"\ndlpf = 0\naccel = false\nrate_hz = 8000\n[bias]\nstill_seconds = 3600\n"
       "[allan]\nwindow_s = 60\n[limits]\nmemory_mb = 500\n");
-  EXPECT_TRUE(contains(still, "x.toml:6: key 'bias.still_seconds':")) << still;
+  EXPECT_TRUE(contains(still, "x.toml:7: key 'bias.still_seconds':")) << still;
   // With the budget at its line when the key is not in the file.
   const std::string at_budget = limitsErrorOf("[limits]\nmemory_mb = 16\n");
   EXPECT_TRUE(contains(at_budget, "x.toml:2: key 'allan.window_s':")) << at_budget;
