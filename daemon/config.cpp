@@ -15,6 +15,7 @@
 #include "daemon/memory_budget.hpp"
 #include "daemon/recorder.hpp"
 #include "daemon/sample_pipeline.hpp"
+#include "driver/fifo_frame.hpp"
 #include "driver/mock/replay_clock.hpp"
 #include "driver/mpu6050_config.hpp"
 #include "formats/input_file.hpp"
@@ -109,7 +110,7 @@ void readDevice(const Section& s, DeviceConfig& d) {
   // never stream. The mock's bus has no clock.
   if (d.backend == DeviceBackend::I2c) {
     namespace chip = driver::mpu6050;
-    const double frame_bytes = d.accel ? 14.0 : 8.0;
+    const auto frame_bytes = static_cast<double>(driver::frameBytesFor(d.accel));
     const double bits_per_s = d.rate_hz * frame_bytes * chip::kI2cClocksPerByte;
     if (bits_per_s > chip::kMaxI2cClockHz) {
       std::ostringstream req;
