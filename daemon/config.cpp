@@ -32,7 +32,7 @@ using Section = formats::TomlSection;
 using formats::shortest;
 
 const std::vector<std::string_view> kSections = {"device", "gpio", "bias", "filter", "allan", "socket",
-                                                 "record", "log",  "mock", "limits", "mqtt"};
+                                                 "record", "log",  "mock", "limits", "mqtt",  "state"};
 const std::vector<std::string_view> kBiasSourceNames = {"estimate", "model", "config"};
 const std::vector<std::string_view> kMockSourceNames = {"simulator", "replay"};
 
@@ -376,6 +376,17 @@ void readRecord(const Section& s, RecordConfig& r) {
   }
 }
 
+void readState(const Section& s, StateConfig& st) {
+  if (auto v = s.string("directory")) {
+    if (hasControlCharacter(*v)) s.failValue("directory", "must be a path without control characters");
+    st.directory = *v;
+  }
+  if (auto v = s.number("save_interval_s")) {
+    if (!(*v >= 1.0 && *v <= 86400.0)) s.failValue("save_interval_s", "must be between 1 and 86400 s");
+    st.save_interval_s = *v;
+  }
+}
+
 void readLimits(const Section& s, LimitsConfig& l) {
   if (auto v = s.number("memory_mb")) {
     if (!(*v >= 16.0 && *v <= 1e9)) s.failValue("memory_mb", "must be 16..1e9 MB (10^6 bytes)");
@@ -664,6 +675,7 @@ GyrodConfig readConfig(const formats::TomlDocument& doc, ReferenceChecks checks)
       "mqtt", {"url", "prefix", "qos", "client_id", "rate_every", "username", "password_file", "buffer_messages",
                "ca_file", "cert_file", "key_file", "home_assistant", "home_assistant_prefix"});
   readMqtt(mqtt, config.mqtt);
+  readState(section("state", {"directory", "save_interval_s"}), config.state);
   if (checks == ReferenceChecks::On) {
     checkReferences(filter, socket, mock, config);
     checkMqttFiles(mqtt, config.mqtt);

@@ -194,6 +194,13 @@ struct MockConfig {
   bool operator==(const MockConfig&) const = default;
 };
 
+// Where gyrod keeps what it learns across restarts (daemon/calibration_keeper.hpp).
+struct StateConfig {
+  std::string directory;           // empty: systemd's $STATE_DIRECTORY when set, else none
+  double save_interval_s = 600.0;  // data time between writes of the calibration state
+  bool operator==(const StateConfig&) const = default;
+};
+
 struct GyrodConfig {
   DeviceConfig device;
   GpioConfig gpio;
@@ -206,6 +213,7 @@ struct GyrodConfig {
   MockConfig mock;
   LimitsConfig limits;
   MqttConfig mqtt;
+  StateConfig state;
   bool operator==(const GyrodConfig&) const = default;
 };
 

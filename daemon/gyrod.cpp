@@ -29,6 +29,7 @@
 #include "driver/fifo_frame.hpp"
 #include "driver/mpu6050_config.hpp"
 #include "formats/calibration.hpp"
+#include "formats/calibration_state.hpp"
 #include "formats/input_file.hpp"
 #include "formats/model_toml.hpp"
 #include "formats/recording_header.hpp"
@@ -166,6 +167,33 @@ recording::SampleValues recordedSample(const RateSample& r, std::int64_t wall_ns
 
 }  // namespace
 
+namespace {
+
+// The state the rate stream started from, in the recording's header (empty: none).
+void appendCalibrationStateHeader(std::vector<std::string>& comments, const std::string& started_from) {
+  if (started_from.empty()) return;
+  comments.push_back(
+      "the rate stream started from this calibration state (docs/calibration-state.md; gyroctl filter reads it):");
+  for (std::string& line : recording::calibrationStateHeaderComments(started_from)) comments.push_back(std::move(line));
+}
+
+}  // namespace
+
+// With a state directory: the keeper, and the rate stream started from what it restores. Returns
+// that state as the recording's header carries it (with the time since it was written already in
+// its variances, so that `gyroctl filter --model` starts from the same bits), or "".
+std::string Gyrod::startCalibrationKeeper() {
+  const std::string dir = calibrationStateDirectory(config_.state.directory);
+  if (dir.empty()) return {};
+  calibration_ = std::make_unique<CalibrationKeeper>(loop_, dir, rate_model_.fingerprint, config_.device.rate_hz,
+                                                     config_.state.save_interval_s);
+  if (pipeline_.rateModel() != RateModel::SensorModel) return {};
+  std::optional<RestoredCalibration> restored = calibration_->restore();
+  if (!restored || !pipeline_.startRateFrom(restored->residual, restored->elapsed_s)) return {};
+  restored->state.residual = pipeline_.rateEstimator()->learned();
+  return formats::calibrationStateToToml(restored->state);
+}
+
 // The rate stream's parameters from filter.model, exactly as `gyroctl filter --model` builds
 // them (rateEstimatorParameters of readSensorModelToml), at the device's rate, with
 // filter.rate_low_pass_hz over the model's low-pass when set.
@@ -197,6 +225,7 @@ LoadedRateModel Gyrod::loadRateModel(const GyrodConfig& c) {
   std::ostringstream identity;
   identity << f.model << '\n' << f.rate_low_pass_hz.value_or(-1.0) << '\n' << recording::sensorModelToToml(model);
   loaded.identity = identity.str();
+  loaded.fingerprint = formats::biasModelFingerprint(*loaded.params);
   return loaded;
 }
 
@@ -257,6 +286,7 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
   loop_.guardTurnsWith(&state_mutex_);
   held_.reserve(static_cast<std::size_t>(std::ceil(0.5 * config.device.rate_hz)) + 16);  // as the pipeline's
   if (!rate_model_.warning.empty()) spdlog::warn("{}", rate_model_.warning);
+  const std::string started_from = startCalibrationKeeper();
   start_real_ns_ = monotonicNowNs();
   last_pump_real_ns_ = start_real_ns_;
   max_virtual_step_ns_ = maxVirtualStepNs(device_.driver_config);
@@ -289,6 +319,7 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
     if (rate_model_.params)  // the recording holds what the rate stream was fed, at full precision
       options.header_comments.push_back("recompute them: gyroctl filter FILE --model " + config_.filter.model +
                                         " --rate " + formats::shortest(config_.device.rate_hz));
+    appendCalibrationStateHeader(options.header_comments, started_from);
     options.columns.time = true;
     options.columns.rate = true;
     recorder_ = std::make_unique<Recorder>(options);
@@ -387,6 +418,8 @@ int Gyrod::run() {
   stopDeliveryThread();
   stopClientThread();
   ::sd_notify(0, "STOPPING=1");
+  if (calibration_)
+    if (const processing::RateEstimator* estimator = pipeline_.rateEstimator()) calibration_->writeAtStop(*estimator);
   std::string recording;
   if (recorder_) {
     // The last writes and the fdatasync of the file: the step of the exit that waits for the
@@ -541,6 +574,9 @@ void Gyrod::publish(const driver::GyroSample& s, const ProcessedSample& out) {
   line.rate = r;
   queueForClients(line);
   if (recorder_) recorder_->pushSample(recordedSample(r, s.wall_ns));
+  if (calibration_)
+    if (const processing::RateEstimator* estimator = pipeline_.rateEstimator())
+      calibration_->onSample(out.t_s, *estimator);
   ++samples_published_;
   last_temp_c_ = r.temp_c;
   last_t_s_ = r.t_s;
@@ -716,6 +752,7 @@ void Gyrod::applyReload(ReloadedFilter&& reloaded) {
     const bool new_rate_model = rate_model.identity != rate_model_.identity;
     if (new_rate_model) {
       pipeline_.reloadRateModel(rate_model.params);
+      if (calibration_) calibration_->setFingerprint(rate_model.fingerprint);
       rate_model_ = std::move(rate_model);
     }
     config_.filter = f;

@@ -28,6 +28,7 @@
 #include <thread>
 
 #include "daemon/allan_reply_cache.hpp"
+#include "daemon/calibration_keeper.hpp"
 #include "daemon/client_handover.hpp"
 #include "daemon/config.hpp"
 #include "daemon/device_backend.hpp"
@@ -51,7 +52,8 @@ namespace gyrod::daemon {
 struct LoadedRateModel {
   std::optional<processing::RateEstimatorParameters> params;
   std::string identity;
-  std::string warning;  // for the log, written by the loop thread (the load may run on another)
+  std::string fingerprint;  // formats::biasModelFingerprint: the calibration state's key
+  std::string warning;      // for the log, written by the loop thread (the load may run on another)
 };
 
 // What a SIGHUP reads and checks off the loop: the [filter] section and its rate model.
@@ -88,6 +90,7 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   static LoadedRateModel loadRateModel(const GyrodConfig& config);
   static PipelineSettings pipelineSettings(const GyrodConfig& config, const LoadedRateModel& rate_model);
   std::string rateModelDescription() const;
+  std::string startCalibrationKeeper();
   void logStillPeriodVerdict();
   void serviceDriver();
   void rearmDriverTimer();
@@ -125,6 +128,7 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   DeviceParts device_;
   std::unique_ptr<driver::Mpu6050Driver> driver_;
   SamplePipeline pipeline_;
+  std::unique_ptr<CalibrationKeeper> calibration_;  // with a state directory
   NoiseRefitWorker noise_refit_;
   AllanReplyCache allan_reply_;
   std::unique_ptr<UnixSocketServer> server_;

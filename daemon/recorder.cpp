@@ -25,7 +25,8 @@ namespace {
 namespace fs = std::filesystem;
 
 // Header and a first line (RecordingLine, 512 bytes) fit in one page of any size (≥ 4096): written in one write().
-constexpr std::size_t kMaxHeaderBytes = 2048;
+// A calibration state the rate stream started from takes about 1.2 KiB of it.
+constexpr std::size_t kMaxHeaderBytes = 4096 - 512;
 
 std::int64_t steadyNowNs() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())

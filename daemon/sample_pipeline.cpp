@@ -345,6 +345,12 @@ void SamplePipeline::reloadRateModel(const std::optional<processing::RateEstimat
   rate_ = std::move(fresh);
 }
 
+bool SamplePipeline::startRateFrom(const processing::LearnedResidual& learned, double elapsed_s) {
+  if (!rate_ || processed_ > 0) return false;
+  rate_->startFrom(learned, elapsed_s);
+  return true;
+}
+
 AllanStreams SamplePipeline::allanSnapshot() const {
   AllanStreams s;
   s.tau0_s = 1.0 / settings_.rate_hz;

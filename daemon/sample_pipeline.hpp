@@ -205,6 +205,9 @@ class SamplePipeline {
   // Validated before anything changes; throws std::invalid_argument.
   void reloadRateModel(const std::optional<processing::RateEstimatorParameters>& rate_model);
   RateModel rateModel() const { return rate_ ? RateModel::SensorModel : RateModel::ConstantBias; }
+  // The rate estimator begins from what an earlier run learned (processing::RateEstimator::
+  // startFrom), before the first sample; false without a sensor model or after a sample.
+  bool startRateFrom(const processing::LearnedResidual& learned, double elapsed_s);
   const processing::RateEstimator* rateEstimator() const { return rate_ ? &*rate_ : nullptr; }
 
   // Not per sample (allocates): the Allan curves of the window and since start.

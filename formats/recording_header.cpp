@@ -1,5 +1,6 @@
 #include "formats/recording_header.hpp"
 
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -83,6 +84,7 @@ std::string acquisitionHeaderComment(int dlpf_cfg, int fs_sel, double rate_hz, i
 AcquisitionHeader parseAcquisitionHeader(std::string_view text, const std::string& path) {
   AcquisitionHeader h;
   std::size_t pos = 0, line = 0;
+  bool seen_columns = false;
   while (pos < text.size()) {
     std::size_t end = text.find('\n', pos);
     if (end == std::string_view::npos) end = text.size();
@@ -90,10 +92,36 @@ AcquisitionHeader parseAcquisitionHeader(std::string_view text, const std::strin
     if (!l.empty() && l.back() == '\r') l.remove_suffix(1);
     ++line;
     pos = end + 1;
-    if (l.empty() || l.front() != '#') break;
+    // The header is the comments before the first sample: before the column line, and after it
+    // where gyrod writes them (docs/recording-format.md: line 1 is the column line).
+    if (l.empty()) break;
+    if (l.front() != '#') {
+      const bool column_line = !seen_columns && std::isalpha(static_cast<unsigned char>(l.front()));
+      if (!column_line) break;
+      seen_columns = true;
+      continue;
+    }
     if (l.starts_with(kDevicePrefix)) parseDeviceLine(l.substr(kDevicePrefix.size()), path, line, h);
+    if (l.size() >= 2 && l.substr(2).starts_with(kCalibrationStatePrefix)) {
+      if (h.calibration_state_line == 0) h.calibration_state_line = line;
+      h.calibration_state_toml += std::string(l.substr(2 + kCalibrationStatePrefix.size())) + "\n";
+    }
   }
   return h;
+}
+
+std::vector<std::string> calibrationStateHeaderComments(std::string_view toml) {
+  std::vector<std::string> out;
+  std::size_t pos = 0;
+  while (pos < toml.size()) {
+    std::size_t end = toml.find('\n', pos);
+    if (end == std::string_view::npos) end = toml.size();
+    const std::string_view l = toml.substr(pos, end - pos);
+    pos = end + 1;
+    if (l.empty() || l.front() == '#') continue;
+    out.push_back(std::string(kCalibrationStatePrefix) + std::string(l));
+  }
+  return out;
 }
 
 AcquisitionHeader readAcquisitionHeader(const std::string& path) {

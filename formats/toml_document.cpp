@@ -108,8 +108,9 @@ TomlSection::TomlSection(const std::string& file, const toml::table& table, std:
     if (std::find(keys_.begin(), keys_.end(), key.str()) != keys_.end()) continue;
     std::ostringstream s;
     // quotedValue: a key is text from the file as well ('name' when short and printable).
-    s << location(key.source()) << "unknown key " << quotedValue(key.str()) << " in [" << name_
-      << "] (valid keys: " << joinedNames(keys_) << ")" << didYouMean(key.str(), keys_);
+    s << location(key.source()) << "unknown key " << quotedValue(key.str())
+      << (name_.empty() ? std::string(" at the top level") : " in [" + name_ + "]")
+      << " (valid keys: " << joinedNames(keys_) << ")" << didYouMean(key.str(), keys_);
     throw TomlError(s.str());
   }
 }

@@ -65,7 +65,10 @@ class TomlSection {
 
   const std::string& file() const { return file_; }
   const std::string& name() const { return name_; }
-  std::string qualified(std::string_view key) const { return name_ + "." + std::string(key); }
+  // "section.key"; the key alone for the top level (an empty name).
+  std::string qualified(std::string_view key) const {
+    return name_.empty() ? std::string(key) : name_ + "." + std::string(key);
+  }
   const toml::node* node(std::string_view key) const { return table_.get(key); }
   bool has(std::string_view key) const { return node(key) != nullptr; }
   std::string location(const toml::source_region& r) const { return tomlLocation(file_, r); }

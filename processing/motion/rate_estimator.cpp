@@ -91,6 +91,33 @@ RateEstimator::RateEstimator(const RateEstimatorParameters& params)
   reset();
 }
 
+void validateLearnedResidual(const LearnedResidual& learned) {
+  requireFinite(learned.temperature_origin_c, "temperature_origin_c");
+  requireFinite(learned.temperature_c, "temperature_c");
+  const bool no_range = std::isnan(learned.still_temperature_min_c) && std::isnan(learned.still_temperature_max_c);
+  if (!no_range) {
+    requireFinite(learned.still_temperature_min_c, "still_temperature_min_c");
+    requireFinite(learned.still_temperature_max_c, "still_temperature_max_c");
+    if (learned.still_temperature_min_c > learned.still_temperature_max_c)
+      throw std::invalid_argument("still_temperature_min_c must not exceed still_temperature_max_c, got " +
+                                  std::to_string(learned.still_temperature_min_c) + " > " +
+                                  std::to_string(learned.still_temperature_max_c));
+  }
+  for (std::size_t a = 0; a < kMotionAxes; ++a) {
+    const LearnedResidualAxis& x = learned.axes[a];
+    const std::string w = axisPrefix(a);
+    requireFinite(x.offset_dps, w + "offset_dps");
+    requireFinite(x.slope_dps_per_c, w + "slope_dps_per_c");
+    requireNonNegative(x.var_offset, w + "var_offset");
+    requireNonNegative(x.var_slope, w + "var_slope");
+    requireFinite(x.cov_offset_slope, w + "cov_offset_slope");
+    // A covariance matrix: |cov| ≤ √(var·var) (a little slack for the rounding of a file).
+    if (x.cov_offset_slope * x.cov_offset_slope > x.var_offset * x.var_slope * (1.0 + 1e-9) + 1e-300)
+      throw std::invalid_argument(w + "cov_offset_slope must satisfy cov^2 <= var_offset * var_slope, got " +
+                                  std::to_string(x.cov_offset_slope));
+  }
+}
+
 void RateEstimator::reset() {
   detector_.reset();
   for (std::size_t a = 0; a < kMotionAxes; ++a) {
@@ -104,6 +131,33 @@ void RateEstimator::reset() {
   started_ = false;
   low_pass_primed_ = false;
   updates_ = 0;
+  updates_before_ = 0;
+  still_temperature_min_ = still_temperature_max_ = std::numeric_limits<double>::quiet_NaN();
+  start_from_.reset();
+}
+
+void RateEstimator::startFrom(const LearnedResidual& learned, double elapsed_s) {
+  if (started_) throw std::logic_error("RateEstimator::startFrom after the first sample");
+  validateLearnedResidual(learned);
+  requireNonNegative(elapsed_s, "elapsed_s");
+  start_from_ = learned;
+  for (std::size_t a = 0; a < kMotionAxes; ++a)  // the walk while nobody followed it
+    start_from_->axes[a].var_offset += axes_[a].q_per_sample * params_.rate_hz * elapsed_s;
+}
+
+LearnedResidual RateEstimator::learned() const {
+  if (!started_ && start_from_) return *start_from_;
+  LearnedResidual l;
+  for (std::size_t a = 0; a < kMotionAxes; ++a) {
+    const AxisState& s = axes_[a];
+    l.axes[a] = {s.offset, s.slope, s.p_oo, s.p_os, s.p_ss};
+  }
+  l.temperature_origin_c = temperature_start_;
+  l.temperature_c = temperature_;
+  l.still_temperature_min_c = still_temperature_min_;
+  l.still_temperature_max_c = still_temperature_max_;
+  l.still_samples = updates_before_ + updates_;
+  return l;
 }
 
 double RateEstimator::residual(std::size_t axis) const {
@@ -137,6 +191,23 @@ RateSample RateEstimator::update(double t_s, const AngularRate& raw_dps, double 
     started_ = true;
     t_first_ = t_s;
     temperature_ = temperature_start_ = temperature_c;
+    if (start_from_) {  // carried to this temperature: [offset, slope] ← J·[offset, slope], P ← J·P·Jᵀ
+      const LearnedResidual& l = *start_from_;
+      const double d = temperature_start_ - l.temperature_origin_c;
+      for (std::size_t a = 0; a < kMotionAxes; ++a) {
+        const LearnedResidualAxis& x = l.axes[a];
+        AxisState& s = axes_[a];
+        s.offset = x.offset_dps + x.slope_dps_per_c * d;
+        s.slope = x.slope_dps_per_c;
+        s.p_oo = x.var_offset + 2.0 * d * x.cov_offset_slope + d * d * x.var_slope;
+        s.p_os = x.cov_offset_slope + d * x.var_slope;
+        s.p_ss = x.var_slope;
+      }
+      updates_before_ = l.still_samples;
+      still_temperature_min_ = l.still_temperature_min_c;
+      still_temperature_max_ = l.still_temperature_max_c;
+      start_from_.reset();
+    }
   } else {
     temperature_ += temperature_alpha_ * (temperature_c - temperature_);
   }
@@ -153,6 +224,9 @@ RateSample RateEstimator::update(double t_s, const AngularRate& raw_dps, double 
   if (still) {
     for (std::size_t a = 0; a < kMotionAxes; ++a) measure(a, corrected[a]);
     ++updates_;
+    // fmin/fmax ignore the NaN of "none yet"
+    still_temperature_min_ = std::fmin(still_temperature_min_, temperature_);
+    still_temperature_max_ = std::fmax(still_temperature_max_, temperature_);
   }
   RateSample out;
   out.still = still;

@@ -34,6 +34,7 @@
 // update() allocates nothing; storage (the detector's ring) is sized at construction.
 #include <array>
 #include <cstddef>
+#include <limits>
 #include <optional>
 
 #include "processing/base/noise_terms.hpp"
@@ -69,6 +70,28 @@ struct RateEstimatorParameters {
 // Throws std::invalid_argument naming the parameter (and axis) for a bad value.
 void validateRateEstimatorParameters(const RateEstimatorParameters& p);
 
+// What the residual filter has learned (per axis r̂ = offset + slope·(T − temperature_origin_c)
+// and the covariance of [offset, slope]), so that a restart begins from it rather than from the
+// model's prior (docs/calibration-state.md). Plain numbers: the state file carries them.
+struct LearnedResidualAxis {
+  double offset_dps = 0.0;
+  double slope_dps_per_c = 0.0;
+  double var_offset = 0.0, cov_offset_slope = 0.0, var_slope = 0.0;
+  bool operator==(const LearnedResidualAxis&) const = default;
+};
+struct LearnedResidual {
+  std::array<LearnedResidualAxis, kMotionAxes> axes{};
+  double temperature_origin_c = 0.0;  // where offset is the residual
+  double temperature_c = 0.0;         // the smoothed temperature when it was taken
+  // The temperatures of the still samples that taught it (NaN, NaN: none yet).
+  double still_temperature_min_c = std::numeric_limits<double>::quiet_NaN();
+  double still_temperature_max_c = std::numeric_limits<double>::quiet_NaN();
+  std::size_t still_samples = 0;  // the samples that updated it, over every run it carries
+};
+// Throws std::invalid_argument naming the value when a number is not finite, a variance is
+// negative or the covariance is not positive semi-definite.
+void validateLearnedResidual(const LearnedResidual& learned);
+
 struct RateSample {
   AngularRate rate_dps{};  // the stream
   AngularRate bias_dps{};  // b̂ = model + residual
@@ -92,6 +115,15 @@ class RateEstimator {
   double residualVariance(std::size_t axis) const;
   double processNoisePerSecond(std::size_t axis) const { return axes_.at(axis).q_per_sample * params_.rate_hz; }
   std::size_t updates() const { return updates_; }  // samples that updated the residual
+  // What has been learned so far (before the first sample: the model's prior, or what
+  // startFrom() was given, unmoved).
+  LearnedResidual learned() const;
+  // Begin from `learned` instead of the model's prior: at the first sample the residual is
+  // carried to that sample's temperature (offset + slope·ΔT, the covariance with it), and each
+  // offset's variance grows by the random walk's q over `elapsed_s` (the time it was not
+  // followed). Only before the first sample (std::logic_error after it); validated
+  // (std::invalid_argument). reset() returns to the model's prior.
+  void startFrom(const LearnedResidual& learned, double elapsed_s);
   const RateEstimatorParameters& parameters() const { return params_; }
 
  private:
@@ -114,7 +146,11 @@ class RateEstimator {
   double temperature_start_ = 0.0;  // of the first sample: the slope's origin
   double temperature_alpha_ = 1.0;  // EMA weight of a new sample
   std::size_t updates_ = 0;
-  double lp_b0_ = 1.0, lp_a1_ = 0.0;  // y = b0·(x + x1) − a1·y1
+  std::size_t updates_before_ = 0;  // still samples the state it started from had seen
+  double still_temperature_min_ = std::numeric_limits<double>::quiet_NaN();
+  double still_temperature_max_ = std::numeric_limits<double>::quiet_NaN();
+  std::optional<LearnedResidual> start_from_;  // applied at the first sample
+  double lp_b0_ = 1.0, lp_a1_ = 0.0;           // y = b0·(x + x1) − a1·y1
 };
 
 }  // namespace gyrod::processing

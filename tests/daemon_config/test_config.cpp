@@ -330,10 +330,10 @@ TEST(ConfigErrors, UnknownKeyNamesFileLineKeyAndTheValidKeys) {
 TEST(ConfigErrors, UnknownSectionAndTopLevelKey) {
   EXPECT_EQ(errorOf("[log]\nlevel = \"info\"\n\n[devise]\nbackend = \"mock\"\n"),
             "x.toml:4: unknown section [devise] (valid sections: device, gpio, bias, filter, allan, socket, record, "
-            "log, mock, limits, mqtt); did you mean 'device'?");
+            "log, mock, limits, mqtt, state); did you mean 'device'?");
   EXPECT_EQ(errorOf("rate_hz = 50\n"),
             "x.toml:1: unknown key 'rate_hz' at top level (keys belong in a section: device, gpio, bias, filter, "
-            "allan, socket, record, log, mock, limits, mqtt)");
+            "allan, socket, record, log, mock, limits, mqtt, state)");
   EXPECT_EQ(errorOf("device = 5\n"), "x.toml:1: key 'device': must be a section [device] (got integer 5)");
 }
 
@@ -703,4 +703,17 @@ TEST(ConfigMqtt, TlsFilesMustBeRegularFilesWhenLoadingAFile) {
       EXPECT_EQ(std::string(e.what()).rfind(f + line + "key 'mqtt." + key + "': " + path, 0), 0u) << e.what();
     }
   }
+}
+
+TEST(ConfigValues, TheStateDirectoryAndItsSaveInterval) {
+  const GyrodConfig defaults = parseConfig("", "x.toml");
+  EXPECT_EQ(defaults.state.directory, "");  // systemd's $STATE_DIRECTORY, if any, at start
+  EXPECT_EQ(defaults.state.save_interval_s, 600.0);
+  const GyrodConfig c = parseConfig("[state]\ndirectory = \"/var/lib/gyrod\"\nsave_interval_s = 60\n", "x.toml");
+  EXPECT_EQ(c.state.directory, "/var/lib/gyrod");
+  EXPECT_EQ(c.state.save_interval_s, 60.0);
+  EXPECT_EQ(errorOf("[state]\nsave_interval_s = 0.5\n"),
+            "x.toml:2: key 'state.save_interval_s': must be between 1 and 86400 s (got 0.5)");
+  EXPECT_EQ(errorOf("[state]\ndirectory = 3\n"), "x.toml:2: key 'state.directory': must be a string (got integer 3)");
+  EXPECT_EQ(errorOf("[state]\ndir = \"/tmp\"\n").rfind("x.toml:2: unknown key 'dir' in [state]", 0), 0u);
 }

@@ -22,8 +22,13 @@ TEST(RecordingHeader, WhatGyrodWritesReadsBack) {
   EXPECT_EQ(h.rate_hz, 50.0);
 }
 
-TEST(RecordingHeader, NoneUnknownKeysAndCommentsAfterTheColumnsAreSkipped) {
-  EXPECT_EQ(parseAcquisitionHeader("t,gx\n# device dlpf_cfg=4\n", "f").line, 0u);
+TEST(RecordingHeader, NoneUnknownKeysAndCommentsAfterTheFirstSampleAreSkipped) {
+  // gyrod's own order: the column line first, its header comments after it.
+  const AcquisitionHeader gyrods = parseAcquisitionHeader("t,gx\n# device dlpf_cfg=4\n1.0,0.5\n", "f");
+  EXPECT_EQ(gyrods.line, 2u);
+  EXPECT_EQ(gyrods.dlpf_cfg, 4);
+  EXPECT_EQ(parseAcquisitionHeader("t,gx\n1.0,0.5\n# device dlpf_cfg=4\n", "f").line, 0u);
+  EXPECT_EQ(parseAcquisitionHeader("1.0,0.5\n# device dlpf_cfg=4\n", "f").line, 0u);
   EXPECT_FALSE(parseAcquisitionHeader("# a comment\nt,gx\n", "f").dlpf_cfg);
   const AcquisitionHeader h = parseAcquisitionHeader("# device fs_sel=2 future=7\r\nt,gx\n", "f");
   EXPECT_EQ(h.fs_sel, 2);

@@ -501,3 +501,122 @@ TEST(RateEstimator, BadParametersNameTheParameter) {
   bad.axes[0].bias_std_dps = -1.0;
   EXPECT_NE(message(bad).find("axis x: bias_std_dps"), std::string::npos);
 }
+
+namespace {
+
+// The bias the simulator's model puts in at temperature T (its drift terms, a few mdps/h, aside).
+double modelBias(const SimulationModel& m, std::size_t a, double temperature_c) {
+  const AxisNoiseModel& x = m.axes[a];
+  return x.bias_dps + x.extra.temperature_coefficient_dps_per_c * (temperature_c - x.extra.temperature_reference_c);
+}
+
+// A calibration whose bias is 0.2 °/s off on every axis (stated as 1σ 0.3) and whose
+// temperature coefficient is 50 % off: what the residual filter has to learn.
+RateEstimatorParameters offCalibration() {
+  RateEstimatorParameters p = calibrate({0.5, -0.5, 0.5});
+  for (std::size_t a = 0; a < 3; ++a) {
+    p.axes[a].bias_dps += a == 1 ? -0.2 : 0.2;
+    p.axes[a].bias_std_dps = 0.3;
+  }
+  return p;
+}
+
+}  // namespace
+
+// Two hours at rest through a 15 °C warm-up teach the residual filter the bias and the
+// coefficient's error. A restart ten minutes later that begins from what the first run learned:
+// - warm (the board still at 40 °C, the daemon restarted): its first sample's bias error is
+//   within 2× the first run's RMS error over its last ten minutes, where one that begins from
+//   the model has the calibration's whole error;
+// - cold (25 °C again): the learned slope carries the residual back down the warm-up; the
+//   error stays within 3σ of the uncertainty it states for itself.
+TEST(RateEstimator, WhatOneRunLearnedStartsTheNext) {
+  const SimulationModel warm_up = paperSensor(25.0, 40.0, 900.0);
+  const RateEstimatorParameters params = offCalibration();
+  NoiseSimulator first_run(warm_up, 7200.0, 21);
+  RateEstimator first(params);
+  std::array<double, 3> squared_error{};
+  std::size_t last_ten_minutes = 0;
+  for (std::size_t i = 0; i < first_run.sampleCount(); ++i) {
+    const SimulatedSample s = first_run.next();
+    const RateSample out = first.update(s.t_s, s.rate_dps, s.temperature_c);
+    if (s.t_s < 6600.0) continue;
+    ++last_ten_minutes;
+    for (std::size_t a = 0; a < 3; ++a)
+      squared_error[a] += std::pow(out.bias_dps[a] - modelBias(warm_up, a, s.temperature_c), 2);
+  }
+  const LearnedResidual learned = first.learned();
+  EXPECT_GT(learned.still_samples, first_run.sampleCount() / 2);
+  EXPECT_NEAR(learned.still_temperature_min_c, 25.0, 0.5);
+  EXPECT_NEAR(learned.still_temperature_max_c, 40.0, 0.5);
+
+  for (const bool warm : {true, false}) {
+    const SimulationModel board = warm ? paperSensor(40.0, 40.0, 900.0) : warm_up;
+    NoiseSimulator second_run(board, 60.0, 22);
+    RateEstimator restarted(params), fresh(params);
+    restarted.startFrom(learned, 600.0);
+    const SimulatedSample s = second_run.next();
+    const RateSample from_learned = restarted.update(s.t_s, s.rate_dps, s.temperature_c);
+    const RateSample from_model = fresh.update(s.t_s, s.rate_dps, s.temperature_c);
+    for (std::size_t a = 0; a < 3; ++a) {
+      const double truth = modelBias(board, a, s.temperature_c);
+      const double before = std::sqrt(squared_error[a] / static_cast<double>(last_ten_minutes));
+      const double after = std::fabs(from_learned.bias_dps[a] - truth);
+      const double from_scratch = std::fabs(from_model.bias_dps[a] - truth);
+      const double stated = std::sqrt(restarted.residualVariance(a));
+      std::printf(
+          "%s restart at %.1f C, axis %zu: bias error %.4f deg/s (RMS over the last 10 min before: %.4f; "
+          "stated 1 sigma %.4f; from the model: %.4f)\n",
+          warm ? "warm" : "cold", s.temperature_c, a, after, before, stated, from_scratch);
+      if (warm) EXPECT_LE(after, 2.0 * before) << "axis " << a;
+      EXPECT_LE(after, 3.0 * stated) << "axis " << a;
+      EXPECT_GE(from_scratch, 5.0 * after) << "axis " << a;
+    }
+    // The state it carries moved to the first sample's temperature (no still window yet, so
+    // no update), its offset's variance grown by the walk's q over 600 s and one sample.
+    ASSERT_EQ(restarted.updates(), 0u);
+    EXPECT_EQ(restarted.learned().still_samples, learned.still_samples);
+    const double d = s.temperature_c - learned.temperature_origin_c;
+    for (std::size_t a = 0; a < 3; ++a) {
+      const LearnedResidualAxis& x = learned.axes[a];
+      EXPECT_NEAR(restarted.residual(a), x.offset_dps + x.slope_dps_per_c * d, 1e-12);
+      const double carried = x.var_offset + 2.0 * d * x.cov_offset_slope + d * d * x.var_slope;
+      EXPECT_NEAR(restarted.residualVariance(a), carried + restarted.processNoisePerSecond(a) * (600.0 + kTau0),
+                  1e-9 * carried);
+    }
+  }
+}
+
+TEST(RateEstimator, StartFromRefusesABadStateAndALateCall) {
+  const RateEstimatorParameters params = offCalibration();
+  RateEstimator e(params);
+  LearnedResidual good;
+  good.temperature_origin_c = good.temperature_c = 30.0;
+  for (auto& x : good.axes) x = {0.1, 0.01, 1e-4, 1e-6, 1e-6};
+  EXPECT_NO_THROW(e.startFrom(good, 0.0));
+  auto message = [&](const LearnedResidual& l, double elapsed = 0.0) -> std::string {
+    RateEstimator r(params);
+    try {
+      r.startFrom(l, elapsed);
+    } catch (const std::invalid_argument& ex) {
+      return ex.what();
+    }
+    return "";
+  };
+  LearnedResidual bad = good;
+  bad.axes[1].offset_dps = std::nan("");
+  EXPECT_NE(message(bad).find("axis y: offset_dps"), std::string::npos) << message(bad);
+  bad = good;
+  bad.axes[2].var_slope = -1.0;
+  EXPECT_NE(message(bad).find("axis z: var_slope"), std::string::npos) << message(bad);
+  bad = good;
+  bad.axes[0].cov_offset_slope = 1e-3;  // > √(1e-4 · 1e-6)
+  EXPECT_NE(message(bad).find("axis x: cov_offset_slope"), std::string::npos) << message(bad);
+  bad = good;
+  bad.still_temperature_min_c = 40.0;
+  bad.still_temperature_max_c = 30.0;
+  EXPECT_NE(message(bad).find("still_temperature_min_c"), std::string::npos) << message(bad);
+  EXPECT_NE(message(good, -1.0).find("elapsed_s"), std::string::npos);
+  e.update(0.0, {0.0, 0.0, 0.0}, 30.0);
+  EXPECT_THROW(e.startFrom(good, 0.0), std::logic_error);
+}

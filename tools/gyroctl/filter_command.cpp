@@ -12,7 +12,9 @@
 #include <string>
 
 #include "formats/calibration.hpp"
+#include "formats/calibration_state.hpp"
 #include "formats/output_file.hpp"
+#include "formats/recording_header.hpp"
 #include "processing/base/detrend.hpp"
 #include "processing/motion/rate_estimator.hpp"
 #include "processing/motion/still_detector.hpp"
@@ -81,6 +83,7 @@ class RateColumns {
     }
     has_accel_ = std::all_of(rec.accel_g.begin(), rec.accel_g.end(), [&](const auto& c) { return !c.empty(); });
     estimator_.emplace(p);
+    startFromTheHeadersState(opt.file, p);
   }
   bool usesAccel() const { return has_accel_; }
   static void appendHeader(std::string& out, const recording::Recording& rec) {
@@ -105,6 +108,30 @@ class RateColumns {
   std::size_t stillSamples() const { return estimator_->updates(); }
 
  private:
+  // A recording gyrod made after a restart says in its header which calibration state its rate
+  // stream started from (docs/calibration-state.md): start from the same, so that the stream is
+  // recomputed bit for bit. A state for another bias model than --model's is left out, said.
+  void startFromTheHeadersState(const std::string& file, const processing::RateEstimatorParameters& p) {
+    const recording::AcquisitionHeader header = recording::readAcquisitionHeader(file);
+    if (header.calibration_state_line == 0) return;
+    const std::string where = file + ":" + std::to_string(header.calibration_state_line);
+    formats::CalibrationState state;
+    try {
+      state = formats::parseCalibrationStateToml(header.calibration_state_toml, where + " (calibration-state lines)");
+    } catch (const formats::CalibrationStateError& e) {
+      throw recording::RecordingError(e.what());
+    }
+    if (state.model != formats::biasModelFingerprint(p)) {
+      std::fprintf(stderr,
+                   "%s: the rate stream was started from a calibration state learned with another bias model "
+                   "(fingerprint %s, --model's %s): starting from the model instead\n",
+                   where.c_str(), state.model.c_str(), formats::biasModelFingerprint(p).c_str());
+      return;
+    }
+    estimator_->startFrom(state.residual, 0.0);  // its variances already hold the time since it was written
+    std::fprintf(stderr, "%s: the rate stream starts from the calibration state gyrod started from\n", where.c_str());
+  }
+
   const recording::Recording& rec_;
   double dt_;
   std::array<const std::vector<double>*, kMotionAxes> columns_{};
