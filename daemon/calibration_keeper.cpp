@@ -21,7 +21,7 @@ void writeState(const std::string& path, formats::CalibrationState state, std::m
   state.saved_unix_s = unixNow();
   const std::string text = formats::calibrationStateToToml(state);
   const std::lock_guard lock(file_mutex);
-  formats::writeFileAtomically(path, text);
+  formats::replaceStateFile(path, text);
 }
 
 }  // namespace

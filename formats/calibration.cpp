@@ -29,6 +29,21 @@ processing::RateEstimatorParameters rateEstimatorParameters(const SensorModel& m
   return p;
 }
 
+SensorModel withLearnedResidual(SensorModel model, const processing::LearnedResidual& learned) {
+  processing::validateLearnedResidual(learned);
+  for (std::size_t a = 0; a < processing::kMotionAxes; ++a) {
+    AxisCalibration c = model.calibration[a].value_or(AxisCalibration{});
+    const processing::LearnedResidualAxis& x = learned.axes[a];
+    const double d = c.temperature_reference_c - learned.temperature_origin_c;
+    model.simulation.axes[a].bias_dps += x.offset_dps + x.slope_dps_per_c * d;
+    c.temperature_coefficient_dps_per_c += x.slope_dps_per_c;
+    c.bias_std_dps = std::sqrt(x.var_offset + 2.0 * d * x.cov_offset_slope + d * d * x.var_slope);
+    c.temperature_coefficient_std_dps_per_c = std::sqrt(x.var_slope);
+    model.calibration[a] = c;
+  }
+  return model;
+}
+
 std::vector<double> secondsFromStart(const Recording& rec, double rate_hz) {
   std::vector<double> s(rec.size());
   for (std::size_t i = 0; i < s.size(); ++i)

@@ -37,4 +37,14 @@ struct AxisCalibrationFit {
 AxisCalibrationFit calibrateAxis(std::span<const double> secs, std::span<const double> rate_dps,
                                  std::span<const double> temp_c);
 
+// The model with what a board learned on top of it folded in (docs/calibration-state.md): per
+// axis, with r(T) = offset + slope·(T − T_origin) the learned residual and T_ref the axis's
+// reference temperature (the model's, or 25 °C when it has no [x.calibration]),
+//   bias_dps' = bias_dps + r(T_ref),  coefficient' = coefficient + slope,
+//   bias_std' = √(var r(T_ref)),  coefficient_std' = √var(slope)
+// (the learned covariance is the posterior, the model's own uncertainty already in it; the
+// covariance of bias' and coefficient' is not kept, as the file has no place for it). The noise
+// terms, the warm-up shape and everything else stay the model's.
+SensorModel withLearnedResidual(SensorModel model, const processing::LearnedResidual& learned);
+
 }  // namespace gyrod::recording

@@ -160,7 +160,7 @@ CalibrationState readCalibrationStateToml(const std::string& path) {
   return parseCalibrationStateToml(readInputFile(path, kCalibrationStateInput), path);
 }
 
-void writeFileAtomically(const std::string& path, std::string_view bytes) {
+void replaceStateFile(const std::string& path, std::string_view bytes) {
   const std::string temp = path + ".tmp";
   auto fail = [&](const std::string& step) {
     const int error = errno;

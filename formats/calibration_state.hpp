@@ -2,7 +2,7 @@
 // gyrod's calibration state (docs/calibration-state.md): what the rate stream's residual filter
 // has learned on this board (processing::LearnedResidual), with the sensor model it is relative
 // to and when it was written, as a small TOML file in gyrod's state directory. gyrod writes it
-// atomically (writeFileAtomically) and reads it back at its start; a file that is not one, or
+// atomically (replaceStateFile) and reads it back at its start; a file that is not one, or
 // is one for another model or rate, is refused with one line and gyrod starts without it.
 #include <cstdint>
 #include <stdexcept>
@@ -52,6 +52,8 @@ CalibrationState readCalibrationStateToml(const std::string& path);
 // Replaces `path` by `bytes` so that a reader sees the old file or the new one, never a part:
 // written to `path.tmp`, fsync'd, renamed over `path`, and the directory fsync'd. Throws
 // std::system_error naming the step and the path; the temporary file is removed on failure.
-void writeFileAtomically(const std::string& path, std::string_view bytes);
+// Not formats::AtomicOutputFile, gyroctl's: that one installs signal handlers to remove its
+// temporaries, where gyrod takes its signals through its event loop.
+void replaceStateFile(const std::string& path, std::string_view bytes);
 
 }  // namespace gyrod::formats

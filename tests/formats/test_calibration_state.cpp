@@ -132,9 +132,9 @@ TEST(CalibrationState, TheFileIsReplacedWholeAndReadOnlyAsARegularFile) {
   std::filesystem::create_directories(dir);
   const std::string path = (dir / "calibration.toml").string();
   CalibrationState s = sampleState();
-  writeFileAtomically(path, calibrationStateToToml(s));
+  replaceStateFile(path, calibrationStateToToml(s));
   s.residual.axes[0].offset_dps = 0.25;
-  writeFileAtomically(path, calibrationStateToToml(s));
+  replaceStateFile(path, calibrationStateToToml(s));
   EXPECT_EQ(readCalibrationStateToml(path).residual.axes[0].offset_dps, 0.25);
   EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
   // A directory where the state should be, and a FIFO: refused by name, never opened or written.
@@ -142,7 +142,7 @@ TEST(CalibrationState, TheFileIsReplacedWholeAndReadOnlyAsARegularFile) {
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   EXPECT_THROW(readCalibrationStateToml(fifo), InputFileError);
   EXPECT_THROW(readCalibrationStateToml(dir.string()), InputFileError);
-  EXPECT_THROW(writeFileAtomically((dir / "no-such-dir" / "calibration.toml").string(), "x"), std::system_error);
+  EXPECT_THROW(replaceStateFile((dir / "no-such-dir" / "calibration.toml").string(), "x"), std::system_error);
   // Too large for a state file.
   {
     std::ofstream big(dir / "big.toml");

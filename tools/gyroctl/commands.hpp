@@ -24,6 +24,8 @@ void addSimulateCommand(CLI::App& app, CommandRunner& run);
 // watch, allan, status: talk to a running gyrod over its socket.
 void addClientCommands(CLI::App& app, CommandRunner& run);
 void addModelCheckCommand(CLI::App& app, CommandRunner& run);
+// model: a sensor model's calibration, with what a board learned on top of it.
+void addModelCommand(CLI::App& app, CommandRunner& run);
 // fleet: every gyrod on an MQTT broker.
 void addFleetCommand(CLI::App& app, CommandRunner& run);
 
