@@ -52,7 +52,15 @@ CalibrationKeeper::CalibrationKeeper(EventLoop& loop, const std::string& directo
             last_error_ = why;
           }) {}
 
-std::optional<RestoredCalibration> CalibrationKeeper::restore() const {
+std::string CalibrationKeeper::keepAside() {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(std::filesystem::symlink_status(path_, ec))) return {};
+  const std::string aside = path_ + ".refused";
+  std::filesystem::rename(path_, aside, ec);
+  return ec ? std::string() : " (kept as " + aside + ")";
+}
+
+std::optional<RestoredCalibration> CalibrationKeeper::restore() {
   std::error_code ec;
   if (!std::filesystem::exists(std::filesystem::symlink_status(path_, ec))) {
     spdlog::info("calibration state: none yet at {}: the rate stream starts from the sensor model", path_);
@@ -62,22 +70,24 @@ std::optional<RestoredCalibration> CalibrationKeeper::restore() const {
   try {
     r.state = formats::readCalibrationStateToml(path_);
   } catch (const std::exception& e) {  // unreadable, not a state file, or values out of range
-    spdlog::warn("calibration state: {}: not used, the rate stream starts from the sensor model", e.what());
+    spdlog::warn("calibration state: {}: not used{}, the rate stream starts from the sensor model", e.what(),
+                 keepAside());
     return std::nullopt;
   }
   if (r.state.model != fingerprint_) {
     spdlog::warn(
-        "calibration state: {}: learned with another sensor model (fingerprint {}, this one {}): not used, the "
+        "calibration state: {}: learned with another sensor model (fingerprint {}, this one {}): not used{}, the "
         "rate stream starts from the sensor model",
-        path_, r.state.model, fingerprint_);
+        path_, r.state.model, fingerprint_, keepAside());
     return std::nullopt;
   }
   if (std::fabs(r.state.rate_hz - rate_hz_) > 1e-9 * rate_hz_) {
-    spdlog::warn("calibration state: {}: learned at {} Hz, the device runs at {} Hz: not used", path_, r.state.rate_hz,
-                 rate_hz_);
+    spdlog::warn("calibration state: {}: learned at {} Hz, the device runs at {} Hz: not used{}", path_,
+                 r.state.rate_hz, rate_hz_, keepAside());
     return std::nullopt;
   }
   r.residual = r.state.residual;
+  restored_ = true;
   r.elapsed_s = std::max(0.0, unixNow() - r.state.saved_unix_s);
   const processing::LearnedResidual& l = r.residual;
   spdlog::info(
@@ -120,9 +130,11 @@ void CalibrationKeeper::writeAtStop(const processing::RateEstimator& estimator) 
   try {
     writeState(path_, snapshot(estimator), *file_mutex_);
     ++writes_;
+    last_error_.clear();
     spdlog::info("calibration state: written to {} ({} still samples learned from)", path_,
                  estimator.learned().still_samples);
   } catch (const std::exception& e) {
+    last_error_ = e.what();
     spdlog::error("calibration state: not written at the stop: {}", e.what());
   }
 }

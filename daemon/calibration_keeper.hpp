@@ -44,7 +44,9 @@ class CalibrationKeeper {
   const std::string& path() const { return path_; }
   // Reads the file (if any) and says in one log line what came of it: nullopt when there is
   // none, it cannot be read, it is not a state file, or it belongs to another model or rate.
-  std::optional<RestoredCalibration> restore() const;
+  // A refused regular file is renamed to calibration.toml.refused (replacing an older one), so
+  // that the next write does not destroy what it held.
+  std::optional<RestoredCalibration> restore();
   // The sensor model changed (SIGHUP): what is learned from now on is relative to this one.
   void setFingerprint(std::string fingerprint) { fingerprint_ = std::move(fingerprint); }
   // Per sample on the loop: starts a write when save_interval_s of data time has passed since
@@ -53,9 +55,13 @@ class CalibrationKeeper {
   // At a clean stop, on the loop's thread after the loop ended: writes now and logs it.
   void writeAtStop(const processing::RateEstimator& estimator);
   std::uint64_t writes() const { return writes_; }
+  bool restored() const { return restored_; }
+  const std::string& lastError() const { return last_error_; }
 
  private:
   formats::CalibrationState snapshot(const processing::RateEstimator& estimator) const;
+  // Renames a refused regular file aside; the words for the log line ("" when nothing was moved).
+  std::string keepAside();
 
   std::string path_;
   std::string fingerprint_;
@@ -66,6 +72,7 @@ class CalibrationKeeper {
   OffLoopJob<std::string> job_;
   std::string last_error_;  // logged once until it changes
   std::uint64_t writes_ = 0;
+  bool restored_ = false;
 };
 
 }  // namespace gyrod::daemon

@@ -935,6 +935,9 @@ StatusReport Gyrod::statusReport() {
                                           recorder_->lastError()};
   }
   if (mqtt) r.mqtt = protocol::MqttStatus{mqtt->connected, mqtt->buffered, mqtt->dropped, std::move(mqtt->last_error)};
+  if (calibration_ && pipeline_.rateModel() == RateModel::SensorModel)
+    r.calibration_state = protocol::CalibrationStateStatus{calibration_->path(), calibration_->restored(),
+                                                           calibration_->writes(), calibration_->lastError()};
   return r;
 }
 

@@ -204,7 +204,8 @@ constexpr std::string_view kStatusFields[] = {"class",
                                               "mqtt_connected",
                                               "mqtt_buffered",
                                               "mqtt_dropped",
-                                              "mqtt_last_error"};
+                                              "mqtt_last_error",
+                                              "calibration_state"};
 
 StatusReply statusOf(const json& j) {
   constexpr std::string_view cls = "STATUS";
@@ -242,6 +243,13 @@ StatusReply statusOf(const json& j) {
     m.buffered = count(j, cls, "mqtt_buffered");
     m.dropped = count(j, cls, "mqtt_dropped");
     m.last_error = optionalText(j, cls, "mqtt_last_error").value_or("");
+  }
+  if (const json* state = field(j, cls, "calibration_state", &json::is_object, "an object")) {
+    CalibrationStateStatus& c = d.calibration_state.emplace();
+    c.file = required(field(*state, cls, "file", &json::is_string, "a string"), cls, "calibration_state.file");
+    c.restored = optionalFlag(*state, cls, "restored").value_or(false);
+    c.writes = count(*state, cls, "writes");
+    c.last_error = optionalText(*state, cls, "last_error").value_or("");
   }
   if (const json* counters = field(j, cls, "counters", &json::is_object, "an object")) {
     for (auto it = counters->begin(); it != counters->end(); ++it) {

@@ -290,6 +290,13 @@ std::string statusLine(const StatusReport& d, const ServerStatus& s) {
     j["mqtt_dropped"] = d.mqtt->dropped;
     if (!d.mqtt->last_error.empty()) j["mqtt_last_error"] = d.mqtt->last_error;
   }
+  if (d.calibration_state) {
+    json state = {{"file", d.calibration_state->file},
+                  {"restored", d.calibration_state->restored},
+                  {"writes", d.calibration_state->writes}};
+    if (!d.calibration_state->last_error.empty()) state["last_error"] = d.calibration_state->last_error;
+    j["calibration_state"] = std::move(state);
+  }
   if (!d.device_counters.empty()) {
     json counters = json::object();
     for (const NamedCount& c : d.device_counters) counters[c.name] = c.value;

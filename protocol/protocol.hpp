@@ -23,7 +23,7 @@
 namespace gyrod::protocol {
 
 inline constexpr int kProtocolMajor = 1;  // incompatible changes
-inline constexpr int kProtocolMinor = 5;  // compatible additions (new classes, new fields)
+inline constexpr int kProtocolMinor = 6;  // compatible additions (new classes, new fields)
 
 // A client line longer than this (not counting the '\n' and an optional '\r') is refused
 // with an ERROR and the client is disconnected.
@@ -165,6 +165,15 @@ struct MqttStatus {
   bool operator==(const MqttStatus&) const = default;
 };
 
+// gyrod's calibration state (docs/calibration-state.md), with a state directory and a sensor model.
+struct CalibrationStateStatus {
+  std::string file;          // <state directory>/calibration.toml
+  bool restored = false;     // the rate stream started from it
+  std::uint64_t writes = 0;  // written since start
+  std::string last_error;    // why the last write failed; empty (omitted) when it did not
+  bool operator==(const CalibrationStateStatus&) const = default;
+};
+
 // The verdict on the start-up still period (STATUS "still_check", docs/protocol.md).
 enum class StillCheck {
   Pending,        // the still period is being collected
@@ -196,6 +205,7 @@ struct StatusReport {
   std::optional<std::string> recording;           // file being recorded to
   std::optional<RecorderStatus> recorder;         // the recorder's counts, while recording
   std::optional<MqttStatus> mqtt;                 // the MQTT publisher, when configured
+  std::optional<CalibrationStateStatus> calibration_state;  // with a state directory and a sensor model
 };
 
 // What the server knows about its clients; added to every STATUS line.

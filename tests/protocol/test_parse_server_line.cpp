@@ -157,6 +157,7 @@ TEST(ParseServerLine, StatusRoundTripsEveryField) {
   d.bias_source = "config [0, 0, 0] deg/s";
   d.recording = "/var/lib/gyrod/gyro.csv";
   d.mqtt = MqttStatus{true, 12, 3, "TLS handshake failed: certificate verify failed"};
+  d.calibration_state = CalibrationStateStatus{"/var/lib/gyrod/calibration.toml", true, 7, ""};
   ServerStatus s;
   s.clients = 2;
   s.clients_total = 5;
@@ -174,6 +175,7 @@ TEST(ParseServerLine, StatusRoundTripsEveryField) {
   EXPECT_EQ(back.daemon.device_retrying, d.device_retrying);
   EXPECT_EQ(back.daemon.rate_hz, d.rate_hz);
   EXPECT_EQ(back.daemon.mqtt, d.mqtt);
+  EXPECT_EQ(back.daemon.calibration_state, d.calibration_state);
   EXPECT_EQ(back.server.client_list.size(), 2u);
   EXPECT_EQ(back.server.client_list[0].pid, 4242);
   EXPECT_FALSE(back.server.client_list[1].pid.has_value());

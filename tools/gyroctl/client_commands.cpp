@@ -435,6 +435,10 @@ void printStatus(const protocol::StatusReply& status) {
     printField("mqtt", std::string(m->connected ? "connected" : "not connected") + ", " + count(m->buffered) +
                            " kept for the broker, " + count(m->dropped) + " dropped" +
                            (m->last_error.empty() ? "" : "; last error: " + m->last_error));
+  if (const auto& c = d.calibration_state)
+    printField("calibration_state", c->file + (c->restored ? " (the rate stream started from it)" : "") + ", " +
+                                        count(c->writes) + " writes" +
+                                        (c->last_error.empty() ? "" : "; last error: " + c->last_error));
   printField("clients", count(s.clients));
   printField("clients_total", count(s.clients_total));
   printField("clients_dropped", count(s.clients_dropped));
