@@ -53,6 +53,21 @@ fetch() { # NAME [VERSION] → the .deb's path (downloaded once into build/vm/de
   fi
   echo "$f"
 }
+# NAME at VERSION, else the newest NAME of the same upstream version: the archive can move a
+# package on by a Debian revision while the image stays (linux-kbuild-6.1 went from 6.1.192-2 to
+# -3 with linux-image 6.1.192-2 still current), and within one upstream version the build tools
+# and sources are the same kernel's.
+fetch_same_upstream() { # NAME VERSION → the .deb's path
+  local v
+  if ls "$debs"/"$1"_"${2%-*}"-*.deb >/dev/null 2>&1 || ! apt-cache madison "$1" | awk '{print $3}' | grep -x "$2" >/dev/null; then
+    v=$(apt-cache madison "$1" | awk -v up="${2%-*}-" 'index($3, up) == 1 {print $3; exit}')
+    [ -n "$v" ] || { echo "$1: neither $2 nor another ${2%-*}-* in the archive" >&2; exit 1; }
+    [ "$v" = "$2" ] || echo "$1 $2 is no longer in the archive: using $v (the same upstream version)" >&2
+    fetch "$1" "$v"
+  else
+    fetch "$1" "$2"
+  fi
+}
 image_deb=$(fetch linux-image-$kver)
 busybox_deb=$(fetch busybox-static)
 kpkg_ver=$(dpkg-deb -f "$image_deb" Version)
@@ -76,12 +91,12 @@ if [ ! -f "$gpio_sim/gpio-sim-oot.ko" ]; then
   if [ ! -d "$hdr/usr/src/linux-headers-$kver" ]; then
     rm -rf "$hdr" && mkdir -p "$hdr"
     for p in linux-headers-$kver linux-headers-${kver%-amd64}-common linux-kbuild-6.1; do
-      dpkg -x "$(fetch "$p" "$kpkg_ver")" "$hdr"
+      dpkg -x "$(fetch_same_upstream "$p" "$kpkg_ver")" "$hdr"
     done
     # The headers' Makefile includes the -common tree by an absolute /usr/src path.
     sed -i "s|/usr/src/|$hdr/usr/src/|" "$hdr/usr/src/linux-headers-$kver/Makefile"
   fi
-  src_deb=$(fetch linux-source-6.1 "$kpkg_ver")
+  src_deb=$(fetch_same_upstream linux-source-6.1 "$kpkg_ver")
   rm -rf "$gpio_sim" && mkdir -p "$gpio_sim"
   dpkg-deb --fsys-tarfile "$src_deb" | tar -xO ./usr/src/linux-source-6.1.tar.xz | xz -d |
     tar -x -C "$gpio_sim" --strip-components=3 linux-source-6.1/drivers/gpio/gpio-sim.c \
