@@ -22,12 +22,18 @@ class MachineStallProbe {
   struct Stall {
     double end_s = 0.0;  // CLOCK_MONOTONIC, when the probe ran again
     double length_ms = 0.0;
+    unsigned cpu = 0;
   };
 
   // Stalls shorter than `report_ms` are not kept. Starts nothing when real-time scheduling is
   // refused (then running() is false and every question is answered with "no stall").
   explicit MachineStallProbe(double report_ms = 2.0) : report_ms_(report_ms) {
-    const unsigned cpus = std::max(1u, std::thread::hardware_concurrency());
+    timespec real{}, mono{};
+    ::clock_gettime(CLOCK_REALTIME, &real);
+    ::clock_gettime(CLOCK_MONOTONIC, &mono);
+    realtime_minus_monotonic_s_ = seconds(real) - seconds(mono);
+    cpus_ = std::max(1u, std::thread::hardware_concurrency());
+    const unsigned cpus = cpus_;
     for (unsigned cpu = 0; cpu < cpus; ++cpu) threads_.emplace_back([this, cpu] { probe(cpu); });
     // Each thread reports whether it became real-time before it starts timing.
     while (started_.load() < static_cast<int>(cpus)) std::this_thread::yield();
@@ -56,6 +62,22 @@ class MachineStallProbe {
       if (s.length_ms >= min_ms && s.end_s <= t_s && s.end_s >= t_s - before_s) return true;
     return false;
   }
+  // The most time one CPU stood still in [t_s - window_s, t_s], in ms: what the host took from
+  // a thread that ran there. Many short stops add up: on a busy host a CPU stopped 2-7 ms a
+  // hundred times a second, each stop below any one-stop threshold, and together they cost a
+  // thread a full FIFO.
+  double stolenMsBefore(double t_s, double window_s) const {
+    std::vector<double> per_cpu(cpus_, 0.0);
+    const double from = t_s - window_s;
+    for (const Stall& s : stalls()) {
+      const double start = s.end_s - s.length_ms * 1e-3;
+      const double overlap = std::min(s.end_s, t_s) - std::max(start, from);
+      if (overlap > 0.0 && s.cpu < per_cpu.size()) per_cpu[s.cpu] += overlap * 1e3;
+    }
+    return per_cpu.empty() ? 0.0 : *std::max_element(per_cpu.begin(), per_cpu.end());
+  }
+  // A CLOCK_REALTIME instant (a log line's time stamp) on the probes' CLOCK_MONOTONIC.
+  double monotonicFromRealtime(double realtime_s) const { return realtime_s - realtime_minus_monotonic_s_; }
 
  private:
   static double seconds(const timespec& t) {
@@ -88,13 +110,15 @@ class MachineStallProbe {
       const double late_ms = (seconds(now) - seconds(next)) * 1e3;
       if (late_ms >= report_ms_) {
         const std::lock_guard lock(mutex_);
-        stalls_.push_back({seconds(now), late_ms});
+        stalls_.push_back({seconds(now), late_ms, cpu});
       }
       if (late_ms > 1.0) next = now;  // no burst of catch-up wake-ups after a stall
     }
   }
 
   double report_ms_;
+  double realtime_minus_monotonic_s_ = 0.0;
+  unsigned cpus_ = 1;
   std::atomic<bool> stop_{false};
   std::atomic<int> started_{0}, real_time_{0};
   mutable std::mutex mutex_;

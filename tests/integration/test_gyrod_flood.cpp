@@ -7,10 +7,11 @@
 //    temperature + gyro frames; with the accel gyrod refuses rates above its 1 kHz output rate).
 // Any sample-loop turn longer than that loses samples, which a watching client sees as a GAP
 // line. Asserts none, contiguous sequence numbers, a loop turn far inside the FIFO, and the
-// watcher's edge → line latency. A loss is gyrod's unless the machine itself stopped for more
-// than half the FIFO just before it: probes above gyrod's priority time each CPU
-// (machine_stall_probe.hpp), and on a virtual machine with both CPUs busy the host stops a CPU
-// for 5-15 ms now and then (docs/driver.md "Under a flood of requests").
+// watcher's edge → line latency. A loss is gyrod's unless one CPU of the machine itself stood
+// still for half a FIFO or more in the two FIFOs' time before it, in one stop or in many:
+// probes above gyrod's priority time each CPU (machine_stall_probe.hpp), and on a virtual
+// machine with both CPUs busy the host stops a CPU for 5-15 ms now and then, or, on a crowded
+// host, for 2-7 ms a hundred times a second (docs/driver.md "Under a flood of requests").
 //
 // Real time (mock speed 1), because the accelerated mock slows its virtual clock down when
 // the loop is late instead of overflowing the FIFO. The window cannot fill in the test's
@@ -26,6 +27,7 @@
 #include <algorithm>
 #include <atomic>
 #include <csignal>
+#include <ctime>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -66,6 +68,36 @@ std::string floodConfig(const std::filesystem::path& dir, const FloodSetup& setu
     << "[socket]\npath = \"" << (dir / "gyrod.sock").string() << "\"\n"
     << "[mock]\nspeed = 1\nseed = 5\n";
   return c.str();
+}
+
+// gyrod's log lines for a FIFO overflow ("2026-11-28 20:13:06.403 warning FIFO overflow on ...")
+// that the machine does not explain. The overflow happened in the two FIFOs' time before the
+// line; it is the machine's when one CPU stood still for half a FIFO or more of that time, in
+// one stop or in many short ones (MachineStallProbe::stolenMsBefore), gyrod's otherwise. The
+// stamp is local wall-clock time to the millisecond, as gyrod's log writes it.
+std::string overflowsTheMachineDoesNotExplain(const std::string& log_text, const MachineStallProbe& machine,
+                                              double fifo_ms) {
+  static const std::regex kOverflow(R"(^(\d{4})-(\d{2})-(\d{2}) (\d{2}):(\d{2}):(\d{2})\.(\d{3}) \S+ FIFO overflow)");
+  std::string unexplained;
+  std::istringstream lines(log_text);
+  for (std::string line; std::getline(lines, line);) {
+    std::smatch m;
+    if (!std::regex_search(line, m, kOverflow)) continue;
+    std::tm tm{};
+    tm.tm_year = std::stoi(m[1]) - 1900;
+    tm.tm_mon = std::stoi(m[2]) - 1;
+    tm.tm_mday = std::stoi(m[3]);
+    tm.tm_hour = std::stoi(m[4]);
+    tm.tm_min = std::stoi(m[5]);
+    tm.tm_sec = std::stoi(m[6]);
+    tm.tm_isdst = -1;
+    const double logged_s = static_cast<double>(std::mktime(&tm)) + std::stoi(m[7]) * 1e-3;
+    const double at_s = machine.monotonicFromRealtime(logged_s) + 0.002;  // the stamp's truncation, and rounding
+    const double stolen_ms = machine.stolenMsBefore(at_s, 2 * fifo_ms * 1e-3);
+    if (stolen_ms < fifo_ms / 2)
+      unexplained += line + " (one CPU stood still " + std::to_string(stolen_ms) + " ms before it)\n";
+  }
+  return unexplained;
 }
 
 std::string repeated(const std::string& line, std::size_t times) {
@@ -180,8 +212,6 @@ void floodAndCheck(const FloodSetup& setup) {
   std::uint64_t rates = 0, gaps = 0;
   std::optional<std::uint64_t> first_seq, last_seq;
   std::string first_problem;  // a silent break in the sequence, or silence
-  std::vector<std::string> gap_lines;
-  std::vector<double> gap_arrivals_s;
   bool after_gap = false;
   std::vector<double> latency_ms;
   latency_ms.reserve(static_cast<std::size_t>(setup.rate_hz) * 13);
@@ -196,8 +226,6 @@ void floodAndCheck(const FloodSetup& setup) {
     }
     const json j = json::parse(*line);
     if (j["class"] == "GAP") {
-      gap_lines.push_back(*line);
-      gap_arrivals_s.push_back(arrived_s);
       after_gap = true;
       ++gaps;
     } else if (j["class"] == "RATE") {
@@ -231,10 +259,7 @@ void floodAndCheck(const FloodSetup& setup) {
   const bool real_time = text.find("event loop scheduling: SCHED_FIFO") != std::string::npos;
   const bool delivery_real_time = text.find("delivery thread scheduling: SCHED_FIFO") != std::string::npos;
   const double p50 = percentile(latency_ms, 0.5), p99 = percentile(latency_ms, 0.99);
-  // Each GAP line against the probes: a stall of over half the FIFO ending in the 0.5 s before it.
-  std::string gyrods_gaps;
-  for (std::size_t i = 0; i < gap_lines.size(); ++i)
-    if (!machine.stalledBefore(gap_arrivals_s[i], 0.5, fifo_ms / 2)) gyrods_gaps += gap_lines[i] + "\n";
+  const std::string gyrods_gaps = overflowsTheMachineDoesNotExplain(text, machine, fifo_ms);
   const auto stalls = machine.stalls();
   std::cout << setup.rate_hz << " Hz flood, " << std::chrono::duration_cast<std::chrono::seconds>(kFloodTime).count()
             << " s: watcher got " << rates << " RATE lines, " << gaps << " GAP lines, edge -> watcher p50 " << p50
@@ -277,7 +302,8 @@ void floodAndCheck(const FloodSetup& setup) {
   }
   EXPECT_TRUE(first_problem.empty()) << first_problem << "\n" << text;
   // No gap came without the machine stopping, and each one gyrod counted reached the watcher.
-  EXPECT_TRUE(gyrods_gaps.empty()) << "lost with no stall of the machine over " << fifo_ms / 2 << " ms before:\n"
+  EXPECT_TRUE(gyrods_gaps.empty()) << "lost while no CPU stood still for " << fifo_ms / 2
+                                   << " ms in the two FIFOs' time before:\n"
                                    << gyrods_gaps << text;
   EXPECT_EQ(m[2].str(), std::to_string(gaps)) << text;
   if (gaps == 0) {
@@ -356,7 +382,13 @@ TEST(GyrodStartUp, At8kHzTheStillWindowEndsOffTheLoopAndTheMockAtRestIsStill) {
   constexpr bool kSlowedDown = false;
 #endif
   if (gyrod::test::underEmulator() || kSlowedDown) GTEST_SKIP() << "at 8 kHz: " << m[3] << " samples lost";
-  EXPECT_EQ(m[3].str(), "0") << text;
+  // No sample lost that the machine's own stops do not explain (as above).
+  EXPECT_EQ(overflowsTheMachineDoesNotExplain(text, machine, 1024.0 / 8.0 / 8000 * 1e3), "") << text;
+  const auto count = [&text](const char* pattern) {
+    const std::regex re(pattern);
+    return std::distance(std::sregex_iterator(text.begin(), text.end(), re), std::sregex_iterator());
+  };
+  EXPECT_EQ(count(R"(lost \d+ samples \(seq)"), count("FIFO overflow on the")) << text;  // every loss an overflow
   if (text.find("event loop scheduling: SCHED_FIFO") != std::string::npos) {
     EXPECT_LT(std::stod(turn[1].str()) * 1e-3, std::max(5.0, machine.longestMs() + 2.0)) << text;
   }
