@@ -275,7 +275,7 @@ void checkExtendedModel(const ExtensionInputs& in, const Context& c, const Model
     g.innovation_var_base_held_out = g.innovation_var_extended_held_out = held.variance;
     g.ljung_box_p_base_held_out = g.ljung_box_p_extended_held_out = held.ljung_box_p;
     checkUnexplained(ext_allan, *in.measured_log_adev, false, c, o.replicas, out);
-    out.misfit = judgeMisfit(in.xd, out.allan_base, in.base_allan->whiteness_q, c.rate, out);
+    out.misfit = judgeMisfit(in.xd, out.allan_base, *in.base_allan, c.rate, out);
     return;
   }
   const std::vector<double> z = withoutDeterministic(in, c);
@@ -301,10 +301,10 @@ void checkExtendedModel(const ExtensionInputs& in, const Context& c, const Model
   out.verdict = judgeExtension(g, outliers_alone);
   if (out.verdict.accepted) {
     checkUnexplained(ext_allan, *in.measured_log_adev, true, c, o.replicas, out);
-    out.misfit = judgeMisfit(in.xc, out.allan_extended, in.base_allan->whiteness_q, c.rate, out);
+    out.misfit = judgeMisfit(in.xc, out.allan_extended, *in.base_allan, c.rate, out);
     return;
   }
-  out.misfit = judgeMisfit(in.xd, out.allan_base, in.base_allan->whiteness_q, c.rate, out);
+  out.misfit = judgeMisfit(in.xd, out.allan_base, *in.base_allan, c.rate, out);
   // Not accepted: the named effects were seen but do not explain the data, and what is
   // unexplained is judged against the base model (the extension's band is not a model held).
   for (DetectedEffect& e : out.effects)

@@ -143,6 +143,89 @@ HeldOutWhiteness heldOutWhiteness(std::span<const double> fit, std::span<const d
   return out;
 }
 
+namespace {
+
+// Hann-windowed Welch power (50 % overlap) of x with its mean removed, bins 0..seg/2.
+std::vector<double> welchPower(std::span<const double> x, std::size_t seg) {
+  std::vector<double> power(seg / 2 + 1, 0.0);
+  if (x.size() < seg) return power;
+  double mean = 0.0;
+  for (double v : x) mean += v;
+  mean /= static_cast<double>(x.size());
+  std::vector<double> w(seg), in(seg);
+  for (std::size_t i = 0; i < seg; ++i)
+    w[i] = 0.5 - 0.5 * std::cos(2.0 * std::numbers::pi * static_cast<double>(i) / static_cast<double>(seg));
+  std::vector<std::complex<double>> spec;
+  Eigen::FFT<double> fft;
+  fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);
+  for (std::size_t s = 0; s + seg <= x.size(); s += seg / 2) {
+    for (std::size_t i = 0; i < seg; ++i) in[i] = w[i] * (x[s + i] - mean);
+    fft.fwd(spec, in);
+    for (std::size_t k = 0; k <= seg / 2; ++k) power[k] += std::norm(spec[k]);
+  }
+  return power;
+}
+
+// Sample autocorrelation of x at lags 1..lags.
+std::vector<double> autocorrelation(const std::vector<double>& x, std::size_t lags) {
+  std::vector<double> r(lags, 0.0);
+  double c0 = 0.0;
+  for (double v : x) c0 += v * v;
+  if (!(c0 > 0.0)) return r;
+  for (std::size_t k = 1; k <= lags && k < x.size(); ++k) {
+    double ck = 0.0;
+    for (std::size_t i = k; i < x.size(); ++i) ck += x[i] * x[i - k];
+    r[k - 1] = ck / c0;
+  }
+  return r;
+}
+
+}  // namespace
+
+HalvesChange halvesChange(std::span<const double> x, double rate_hz) {
+  HalvesChange out;
+  const std::size_t h = x.size() / 2;
+  if (h < 128) return out;  // also more than 4 · kHalvesLags
+  std::vector<double> a(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(h));
+  std::vector<double> b(x.begin() + static_cast<std::ptrdiff_t>(h), x.begin() + static_cast<std::ptrdiff_t>(2 * h));
+  removeLinearTrend(a, 1.0);
+  removeLinearTrend(b, 1.0);
+  const std::vector<double> ra = autocorrelation(a, kHalvesLags), rb = autocorrelation(b, kHalvesLags);
+  double sum = 0.0;
+  for (std::size_t k = 0; k < kHalvesLags; ++k) sum += (ra[k] - rb[k]) * (ra[k] - rb[k]);
+  out.colour_q = sum * static_cast<double>(h) / 2.0;
+  out.lag1_first = ra[0];
+  out.lag1_second = rb[0];
+  std::size_t seg = 64;
+  while (seg * 2 <= h / 16 && seg < 1024) seg *= 2;
+  if (h < 16 * seg) return out;
+  const std::vector<double> pa = welchPower(a, seg), pb = welchPower(b, seg);
+  double best = -1.0;
+  for (std::size_t k = 1; k < seg / 2; ++k) {  // DC and Nyquist left out (half the degrees of freedom)
+    if (!(pa[k] > 0.0 && pb[k] > 0.0)) continue;
+    const double d = std::fabs(std::log(pb[k] / pa[k]));
+    if (d > best) {
+      best = d;
+      out.spectrum_hz = static_cast<double>(k) * rate_hz / static_cast<double>(seg);
+      out.spectrum_ratio = pb[k] / pa[k];
+    }
+  }
+  if (best >= 0.0) out.spectrum_stat = best;
+  return out;
+}
+
+double gumbelNullP(double v, const std::vector<double>& null) {
+  if (null.size() < 8 || !std::isfinite(v)) return std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> sorted = null;
+  std::sort(sorted.begin(), sorted.end());
+  const double q50 = model_check_detail::sortedQuantile(sorted, 0.5);
+  const double q90 = model_check_detail::sortedQuantile(sorted, 0.9);
+  const double beta = (q90 - q50) / 1.8839;  // as whiteNullP
+  if (!(beta > 0.0)) return v > sorted.back() ? 0.0 : 1.0;
+  const double mu = q50 - 0.3665 * beta;
+  return -std::expm1(-std::exp(-(v - mu) / beta));
+}
+
 double whiteNullP(double q, const std::vector<double>& null_q, std::size_t lags) {
   if (null_q.size() < 8) return 1.0 - chiSquareCdf(q, static_cast<double>(lags));
   std::vector<double> sorted = null_q;
@@ -221,11 +304,25 @@ void placeInSpectrum(const AxisModelCheck& s, ModelMisfit& m) {
   m.power_against_replicas = true;
 }
 
+// The halves' change against the base replicas' (ModelMisfit::halves_*).
+void judgeHalves(std::span<const double> residual, const AllanNull& base_null, double rate_hz, ModelMisfit& m) {
+  const HalvesChange h = halvesChange(residual, rate_hz);
+  m.halves_lag1_first = h.lag1_first;
+  m.halves_lag1_second = h.lag1_second;
+  m.halves_colour_p = std::isfinite(h.colour_q) ? whiteNullP(h.colour_q, base_null.halves_colour_q, kHalvesLags)
+                                                : std::numeric_limits<double>::quiet_NaN();
+  m.halves_spectrum_p = gumbelNullP(h.spectrum_stat, base_null.halves_spectrum_stat);
+  m.halves_spectrum_hz = h.spectrum_hz;
+  m.halves_spectrum_ratio = h.spectrum_ratio;
+  m.halves_differ = m.halves_colour_p < kHalvesAlpha / 2 || m.halves_spectrum_p < kHalvesAlpha / 2;
+}
+
 }  // namespace
 
-ModelMisfit judgeMisfit(std::span<const double> residual, const AllanBand& band, const std::vector<double>& null_q,
+ModelMisfit judgeMisfit(std::span<const double> residual, const AllanBand& band, const AllanNull& base_null,
                         double rate_hz, const AxisModelCheck& spectra) {
   ModelMisfit m;
+  const std::vector<double>& null_q = base_null.whiteness_q;
   const std::size_t half = residual.size() / 2;
   const HeldOutWhiteness w = heldOutWhiteness(residual.first(half), residual.subspan(half));
   m.ljung_box_p_held_out = w.errors.empty() ? 1.0 : whiteNullP(w.test.q, null_q);
@@ -278,6 +375,7 @@ ModelMisfit judgeMisfit(std::span<const double> residual, const AllanBand& band,
     }
   }
   if (!m.fails() && !m.marginal) return m;
+  judgeHalves(residual, base_null, rate_hz, m);
   const SpectralExcess excess = innovationSpectralExcess(w.errors, rate_hz);
   if (excess.found) {
     m.freq_lo_hz = excess.freq_lo_hz;

@@ -243,6 +243,19 @@ struct ModelMisfit {
   bool chain_fails = false;
   double chain_reduced_chi2 = std::numeric_limits<double>::quiet_NaN();  // best, per axis
   bool marginal = false;  // fits, but below kMarginalWhitenessP or kMarginalInBand (placed as a misfit is)
+  // Whether the record itself changes between its halves (looked at when a misfit or a
+  // marginal fit is stated; halvesChange): its colour (the halves' autocorrelation at lags
+  // 1–kHalvesLags) and its spectrum bin by bin (a line that moves, grows or fades), each
+  // against the same statistic of the base model's replicas, which are stationary by
+  // construction. A stationary model fitted to one half cannot whiten the other half of a
+  // record that changed, whatever effects it holds. NaN when not looked at.
+  double halves_colour_p = std::numeric_limits<double>::quiet_NaN();
+  double halves_lag1_first = std::numeric_limits<double>::quiet_NaN();
+  double halves_lag1_second = std::numeric_limits<double>::quiet_NaN();
+  double halves_spectrum_p = std::numeric_limits<double>::quiet_NaN();
+  double halves_spectrum_hz = std::numeric_limits<double>::quiet_NaN();     // the bin that changed most
+  double halves_spectrum_ratio = std::numeric_limits<double>::quiet_NaN();  // its power, second half / first
+  bool halves_differ = false;  // the smaller p below kHalvesAlpha / 2 (two tests)
   bool fails() const { return whiteness_fails || band_fails || chain_fails; }
 };
 
@@ -410,6 +423,26 @@ HeldOutWhiteness heldOutWhiteness(std::span<const double> fit, std::span<const d
 // is a little conservative against χ²(lags) in the tail (its 1e-3 point ≈ 67 against 60 at 30
 // lags). Without at least 8 replicas: χ²(lags).
 double whiteNullP(double q, const std::vector<double>& null_q, std::size_t lags = 30);
+
+// How a series changes between its halves (each half with its own line removed): the colour
+// statistic (h/2)·Σ_k (r₁(k) − r₂(k))² over lags 1..kHalvesLags, h the half's length and r the
+// halves' sample autocorrelations (χ²(kHalvesLags) for white noise: each difference has
+// variance 2/h), and the spectrum statistic max_j |ln(P₁(j)/P₂(j))| over the Welch bins
+// (Hann, 50 % overlap, the largest power of two segment up to h/16 in [64, 1024]) with the
+// bin's frequency and P₂/P₁ there. The misfit reads both against the base replicas'.
+inline constexpr std::size_t kHalvesLags = 10;
+inline constexpr double kHalvesAlpha = 0.01;
+struct HalvesChange {
+  double colour_q = std::numeric_limits<double>::quiet_NaN();
+  double lag1_first = std::numeric_limits<double>::quiet_NaN(), lag1_second = std::numeric_limits<double>::quiet_NaN();
+  double spectrum_stat = std::numeric_limits<double>::quiet_NaN();
+  double spectrum_hz = std::numeric_limits<double>::quiet_NaN();
+  double spectrum_ratio = std::numeric_limits<double>::quiet_NaN();
+};
+HalvesChange halvesChange(std::span<const double> x, double rate_hz);
+// The upper tail of `v` under a Gumbel through the median and 90 % point of `null` (as
+// whiteNullP); NaN with fewer than 8 values in `null`.
+double gumbelNullP(double v, const std::vector<double>& null);
 
 // Robust z of each sample against its neighbours: (x_i − mean of the h neighbours on each
 // side) / (1.4826·MAD of those differences).

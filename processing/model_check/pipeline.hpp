@@ -121,7 +121,8 @@ struct SeriesStats {
   std::vector<double> step_scale_max, step_scale_ms;
   double gm_statistic = kNaN;
   std::vector<double> psd, psd_max;
-  double whiteness_q = kNaN;  // Ljung–Box Q of heldOutWhiteness (the misfit's null)
+  double whiteness_q = kNaN;                                   // Ljung–Box Q of heldOutWhiteness (the misfit's null)
+  double halves_colour_q = kNaN, halves_spectrum_stat = kNaN;  // halvesChange (the misfit's null)
 };
 
 SeriesStats measureSeries(std::span<const double> xd, const Context& c, unsigned mask);
@@ -161,7 +162,8 @@ struct AllanNull {
   AllanBand band;
   std::vector<double> median_log, spread_log;
   NullSummary max_z;
-  std::vector<double> whiteness_q;  // the replicas' held-out Ljung–Box Q (when measured)
+  std::vector<double> whiteness_q;                            // the replicas' held-out Ljung–Box Q (when measured)
+  std::vector<double> halves_colour_q, halves_spectrum_stat;  // the replicas' halvesChange
 };
 AllanNull allanNull(const std::vector<SeriesStats>& reps, const std::vector<double>& measured_log, const Context& c,
                     double alpha);
@@ -304,9 +306,10 @@ struct ExtensionInputs {
 // The misfit of the final model (misfit.cpp): the whiteness of what it leaves (`residual`:
 // the detrended series, or the cleaned one when the extension is accepted), fitted on the
 // first half and scored on the second; the share of its Allan curve in the simultaneous band.
-// The whiteness p is the measured Q's tail under a scaled χ² fitted to `null_q` (the base
-// replicas' Q: whiteNullP).
-ModelMisfit judgeMisfit(std::span<const double> residual, const AllanBand& band, const std::vector<double>& null_q,
+// The whiteness p is the measured Q's tail under a Gumbel fitted to the base replicas' Q
+// (`base_null`, whiteNullP), and where a misfit is stated the halves' change is read against
+// the replicas' (halvesChange).
+ModelMisfit judgeMisfit(std::span<const double> residual, const AllanBand& band, const AllanNull& base_null,
                         double rate_hz, const AxisModelCheck& spectra);
 
 // Replicas of the extended model: its Allan band, what it leaves unexplained, and the gain

@@ -260,8 +260,11 @@ AllanNull allanNull(const std::vector<SeriesStats>& reps, const std::vector<doub
   std::vector<double> maxes(reps.size());
   for (std::size_t r = 0; r < reps.size(); ++r) maxes[r] = maxAbsZ(reps[r].log_adev, a.median_log, a.spread_log);
   a.max_z = summarizeNull(maxes, alpha, false);
-  for (const SeriesStats& r : reps)
+  for (const SeriesStats& r : reps) {
     if (std::isfinite(r.whiteness_q)) a.whiteness_q.push_back(r.whiteness_q);
+    if (std::isfinite(r.halves_colour_q)) a.halves_colour_q.push_back(r.halves_colour_q);
+    if (std::isfinite(r.halves_spectrum_stat)) a.halves_spectrum_stat.push_back(r.halves_spectrum_stat);
+  }
   return a;
 }
 

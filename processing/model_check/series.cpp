@@ -126,8 +126,12 @@ SeriesStats measureSeries(std::span<const double> xd, const Context& c, unsigned
     if ((mask & kStatTemperature) && !c.temp_blocks.empty()) s.temp_slope = temperatureSlope(y, c.temp_blocks);
     if (mask & kStatSteps) measureStepScales(y, c, s);
   }
-  if (mask & kStatWhiteness)
+  if (mask & kStatWhiteness) {
     s.whiteness_q = heldOutWhiteness(xd.first(xd.size() / 2), xd.subspan(xd.size() / 2)).test.q;
+    const HalvesChange h = halvesChange(xd, c.rate);
+    s.halves_colour_q = h.colour_q;
+    s.halves_spectrum_stat = h.spectrum_stat;
+  }
   return s;
 }
 

@@ -232,6 +232,84 @@ TEST(ModelCheckMisfit, BlockLjungBoxIsChiSquareOnWhiteNoise) {
   EXPECT_NEAR(mean, 30.0, 3.0 * std::sqrt(60.0 / static_cast<double>(series)));
 }
 
+// The halves' colour statistic on white noise has the mean of χ²(kHalvesLags), within 3
+// standard errors over 200 series; the spectrum statistic is finite and at a frequency inside
+// (0, Nyquist).
+TEST(ModelCheckMisfit, HalvesColourIsChiSquareOnWhiteNoise) {
+  double sum = 0.0;
+  const std::size_t series = 200;
+  for (std::uint64_t seed = 1; seed <= series; ++seed) {
+    NormalGenerator normal(seed + 7000);
+    std::vector<double> x(8000);
+    for (double& v : x) v = normal.next();
+    const HalvesChange h = halvesChange(x, kMisfitRate);
+    sum += h.colour_q;
+    ASSERT_TRUE(std::isfinite(h.spectrum_stat));
+    EXPECT_GT(h.spectrum_hz, 0.0);
+    EXPECT_LT(h.spectrum_hz, kMisfitRate / 2);
+  }
+  const double lags = static_cast<double>(kHalvesLags);
+  EXPECT_NEAR(sum / static_cast<double>(series), lags, 3.0 * std::sqrt(2.0 * lags / static_cast<double>(series)));
+}
+
+// A series whose second half is coloured (AR(1), φ 0.15) and one whose line moves from 9 to
+// 9.6 Hz halfway: each stands far outside white noise's own statistics (40 series), on the
+// statistic that sees it, and names the change (the lag-1 autocorrelations; the bin).
+TEST(ModelCheckMisfit, AColourChangeAndAMovingLineAreSeenBetweenHalves) {
+  const std::size_t n = 12000;
+  std::vector<double> null_colour, null_spectrum;
+  for (std::uint64_t seed = 1; seed <= 40; ++seed) {
+    NormalGenerator normal(seed + 9000);
+    std::vector<double> x(n);
+    for (double& v : x) v = normal.next();
+    const HalvesChange h = halvesChange(x, kMisfitRate);
+    null_colour.push_back(h.colour_q);
+    null_spectrum.push_back(h.spectrum_stat);
+  }
+  NormalGenerator normal(77);
+  std::vector<double> coloured(n), moving(n);
+  double previous = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double e = normal.next();
+    coloured[i] = i < n / 2 ? e : 0.15 * previous + e;
+    previous = coloured[i];
+    const double f = i < n / 2 ? 9.0 : 9.6;
+    moving[i] = normal.next() + 0.3 * std::sin(2.0 * std::numbers::pi * f * static_cast<double>(i) / kMisfitRate);
+  }
+  const HalvesChange c = halvesChange(coloured, kMisfitRate);
+  EXPECT_LT(gumbelNullP(c.colour_q, null_colour), 1e-4) << c.colour_q;
+  EXPECT_NEAR(c.lag1_first, 0.0, 0.05);
+  EXPECT_NEAR(c.lag1_second, 0.15, 0.05);
+  const HalvesChange m = halvesChange(moving, kMisfitRate);
+  EXPECT_LT(gumbelNullP(m.spectrum_stat, null_spectrum), 1e-4) << m.spectrum_stat;
+  const double bin = kMisfitRate / 256.0;  // the segment for 6000-sample halves
+  const bool at_a_line = std::fabs(m.spectrum_hz - 9.0) <= bin || std::fabs(m.spectrum_hz - 9.6) <= bin;
+  EXPECT_TRUE(at_a_line) << m.spectrum_hz;
+  EXPECT_GT(gumbelNullP(c.spectrum_stat, null_spectrum), 1e-4);  // a colour change of 0.15 is no line
+}
+
+// A generated record whose noise turns coloured halfway (AR(1), φ 0.15, on axis 0): what the
+// first half's model leaves of the second is not white, and the misfit says the record
+// changed between its halves.
+TEST(ModelCheckMisfit, ARecordThatChangesColourIsToldApart) {
+  GeneratedRecording g = HiddenEffectGenerator(601).generate(kMisfitDuration, kMisfitRate, {});
+  std::vector<double>& x = g.axes[0];
+  double mean = 0.0;
+  for (std::size_t i = x.size() / 2; i < x.size(); ++i) mean += x[i];
+  mean /= static_cast<double>(x.size() - x.size() / 2);
+  double previous = 0.0;  // the filter runs on the deviations: the level stays, no step
+  for (std::size_t i = x.size() / 2; i < x.size(); ++i) {
+    previous = (x[i] - mean) + 0.15 * previous;
+    x[i] = mean + previous;
+  }
+  const AxisModelCheck r = checkAxisModel({x, g.rate_hz, g.temp, g.t, {}}, misfitOptions(601));
+  const std::string what = describeMisfit(r) + "; halves colour p " + std::to_string(r.misfit.halves_colour_p);
+  EXPECT_TRUE(r.misfit.fails() || r.misfit.marginal) << what;
+  EXPECT_TRUE(r.misfit.halves_differ) << what;
+  EXPECT_LT(r.misfit.halves_colour_p, kHalvesAlpha / 2) << what;
+  EXPECT_GT(r.misfit.halves_lag1_second - r.misfit.halves_lag1_first, 0.05) << what;
+}
+
 // A band of noise 4 Hz wide (not in the catalogue) of the axis's rms on one axis: the model
 // does not fit, placed in frequency around the band. The AR model of the whiteness test
 // whitens a stationary bump largely, so the band test and the spectrum against the replicas

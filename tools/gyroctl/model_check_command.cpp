@@ -264,7 +264,14 @@ json misfitJson(const ModelMisfit& m) {
           {"power_ratio", numberOrNull(m.power_ratio)},
           {"power_ratio_against", std::isfinite(m.power_ratio)
                                       ? json(m.power_against_replicas ? "replicas_median" : "white_level")
-                                      : json(nullptr)}};
+                                      : json(nullptr)},
+          {"halves_differ", m.halves_differ},
+          {"halves_colour_p", numberOrNull(m.halves_colour_p)},
+          {"halves_lag1_first", numberOrNull(m.halves_lag1_first)},
+          {"halves_lag1_second", numberOrNull(m.halves_lag1_second)},
+          {"halves_spectrum_p", numberOrNull(m.halves_spectrum_p)},
+          {"halves_spectrum_hz", numberOrNull(m.halves_spectrum_hz)},
+          {"halves_spectrum_ratio", numberOrNull(m.halves_spectrum_ratio)}};
 }
 
 std::string percent(double share) { return fmt("%.3g", 100.0 * share) + " %"; }
@@ -297,6 +304,24 @@ std::string whereText(const ModelMisfit& m) {
   return "misfit at " + where.front() + (where.size() > 1 ? " and " + where.back() : "");
 }
 
+// When the record itself changed between its halves: "; the record changes between its halves
+// (lag-1 autocorrelation +0.034 -> -0.036, p 0.0021): no stationary model fitted to one half
+// whitens the other". Empty when it did not.
+std::string halvesText(const ModelMisfit& m) {
+  if (!m.halves_differ) return "";
+  std::vector<std::string> what;
+  if (m.halves_colour_p < kHalvesAlpha / 2)
+    what.push_back("lag-1 autocorrelation " + fmt("%+.3f", m.halves_lag1_first) + " -> " +
+                   fmt("%+.3f", m.halves_lag1_second) + ", lags 1-" + std::to_string(kHalvesLags) + " p " +
+                   fmt("%.2g", m.halves_colour_p));
+  if (m.halves_spectrum_p < kHalvesAlpha / 2)
+    what.push_back("power at " + sig4(m.halves_spectrum_hz) + " Hz " + fmt("%.3g", m.halves_spectrum_ratio) +
+                   " x the first half's, p " + fmt("%.2g", m.halves_spectrum_p));
+  std::string s = "; the record changes between its halves (";
+  for (std::size_t i = 0; i < what.size(); ++i) s += (i ? "; " : "") + what[i];
+  return s + "): no stationary model fitted to one half whitens the other";
+}
+
 // Why and where the model does not fit: "what it leaves is not white on the held-back half
 // (Ljung-Box p 3.1e-05 < 0.001); ...; misfit at tau 0.02–0.16 s (up to 1.6 x the replicas'
 // median) and 31.2–31.6 Hz (12 x white)".
@@ -314,7 +339,7 @@ std::string misfitText(const ModelMisfit& m) {
                   percent(m.in_band_replica_median) + "; p " + fmt("%.2g", m.band_p) + ")");
   std::string s;
   for (const std::string& w : why) s += (s.empty() ? "" : "; ") + w;
-  return s + "; " + whereText(m);
+  return s + "; " + whereText(m) + halvesText(m);
 }
 
 // A model that fits but only just: "marginal: held-out whiteness p 0.0069 (< 0.01); weakest at
@@ -331,7 +356,7 @@ std::string marginalText(const ModelMisfit& m) {
   for (std::size_t i = 0; i < why.size(); ++i) s += (i ? " and " : "") + why[i];
   std::string where = whereText(m);
   where.replace(0, where.find(' '), "weakest");  // "misfit at ..." → "weakest at ..."
-  return s + "; " + where;
+  return s + "; " + where + halvesText(m);
 }
 
 json termsJson(const NoiseTerms& t) {
