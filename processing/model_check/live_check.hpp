@@ -1,0 +1,146 @@
+#pragma once
+// The live check: what is new on a running board against its own baseline (docs/live-check.md).
+// gyrod hands it one interval of still samples at a time (data time; a few minutes); the
+// first `baseline_s` of them become the board's baseline, and every later interval is
+// compared with it:
+//  - a line: the Hann periodogram of the last interval and of the last two, at every Fourier
+//    bin, over the baseline's Welch level there (a bin over a Welch estimate of ν degrees of
+//    freedom is F(2, ν), ν = 36K²/(19K − 1) for K Hann segments at 50 % overlap, Percival &
+//    Walden eq. 292b). A whole-window periodogram, not a Welch average, because a weak steady
+//    line gains power over the noise with every sample it spans (a line of amplitude 0.1 σ
+//    stands 25 × the noise in 300 s at 50 Hz; Welch's 512-sample segments hold it at 1.9 ×).
+//    A run of bins above the family threshold is a line, with its centre, width and rms, and
+//    its onset from the power at its centre in 10 s blocks;
+//  - an outlier burst: samples whose robust z against their neighbours (localOutlierScores)
+//    exceeds kLiveOutlierZ, counted against the baseline's rate (Poisson).
+// Each detector's threshold is set from a false-alarm budget per board-week
+// (LiveCheckSettings::false_alarms_per_week, shared by the detectors and the axes) and the
+// number of intervals in a week. An effect is reported once when first named ("new") and
+// once when an interval no longer shows it ("gone").
+// Pure: no clock, no I/O; the caller supplies data time.
+#include <array>
+#include <cstddef>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace gyrod::processing {
+
+inline constexpr double kLiveOutlierZ = 8.0;
+inline constexpr double kLiveLineGrowth = 2.0;
+
+struct LiveCheckSettings {
+  double rate_hz = 0.0;
+  double interval_s = 300.0;   // one examination per interval of still data
+  double baseline_s = 1800.0;  // the first still data, rounded up to whole intervals
+  // Expected false EFFECT lines per week of clean data, all detectors and axes together.
+  double false_alarms_per_week = 0.25;
+};
+
+enum class LiveEffectKind { Line, OutlierBurst };
+const char* liveEffectName(LiveEffectKind kind);  // "line", "outlier_burst"
+
+struct LiveInterval95 {
+  double lo = 0.0, hi = 0.0;
+};
+
+struct LiveEffect {
+  LiveEffectKind kind = LiveEffectKind::Line;
+  std::size_t axis = 0;
+  bool gone = false;  // false: newly named; true: no longer seen
+  double t = 0.0;     // data time of the interval's end
+  double onset_t = 0.0;
+  LiveInterval95 onset_95;
+  // Line: centre_hz, width_hz (the run of bins above the lower threshold, the window's own
+  // spread of about two bins included), rms_dps (the power above the baseline's over that
+  // run), power_ratio (interval/baseline at the peak bin).
+  // Outlier burst: count, expected (the baseline's rate times the interval), largest_z.
+  double centre_hz = 0.0, width_hz = 0.0, rms_dps = 0.0, power_ratio = 0.0;
+  LiveInterval95 centre_hz_95, rms_dps_95;
+  double baseline_rms_dps = 0.0;  // a line the baseline had, grown: its rms there (else 0)
+  std::size_t count = 0;
+  double expected = 0.0, largest_z = 0.0;
+  std::string evidence;  // one sentence: the statistic against its threshold
+};
+
+class LiveCheck {
+ public:
+  // Throws std::invalid_argument naming the setting when a value is out of range (rate and
+  // interval > 0, an interval of at least 8 segments of 64 samples, baseline ≥ interval,
+  // budget > 0).
+  explicit LiveCheck(const LiveCheckSettings& settings);
+
+  // One interval: per axis the still samples (°/s) at the settings' rate, the interval's
+  // data time [t0, t0 + n/rate). Intervals of other lengths are refused (returns nothing).
+  // Returns what changed: effects newly named and effects gone.
+  std::vector<LiveEffect> examine(const std::array<std::vector<double>, 3>& axes, double t0);
+
+  bool baselineReady() const { return baseline_intervals_ >= baseline_needed_; }
+  const std::vector<LiveEffect>& current() const { return current_; }
+  std::size_t samplesPerInterval() const { return interval_samples_; }
+  std::size_t segment() const { return segment_; }
+  // The per-interval, per-axis false-alarm probability each detector runs at.
+  double alphaPerTest() const { return alpha_; }
+
+ private:
+  // A line the board had all through its baseline (the chip's own, a fan that was running):
+  // not new; named only when it grows past kLiveLineGrowth times its rms.
+  struct BaselineLine {
+    double centre_hz = 0.0, width_hz = 0.0, rms_dps = 0.0;
+  };
+  struct AxisBaseline {
+    std::vector<double> power;  // summed Welch periodograms (bins 0..L/2)
+    std::size_t segments = 0;
+    // Welch's level per segment with the lines taken out: a running median over 9 bins.
+    std::vector<double> background;
+    std::vector<BaselineLine> lines;
+    std::vector<std::vector<double>> intervals;  // the baseline's own (cleaned), until it is ready
+    double outliers = 0.0, samples = 0.0;
+  };
+  // One axis's interval: outliers replaced by their neighbours' mean (for the spectrum), its
+  // scores and its Welch power (mean over segments).
+  struct AxisInterval {
+    std::vector<double> cleaned, scores, power;
+    std::size_t segments = 0;
+  };
+
+  AxisInterval prepare(std::span<const double> x) const;
+  double baselineLevel(std::size_t axis, double f_hz, double sum_w2) const;
+  // At the end of the baseline: its background, and the lines in its own intervals.
+  void finishBaseline();
+  const BaselineLine* baselineLine(std::size_t axis, const LiveEffect& e) const;
+  // Lines in the periodogram of `window` (data time t0 at its first sample) at family alpha.
+  std::vector<LiveEffect> findLines(std::size_t axis, std::span<const double> window, double t0, double alpha) const;
+  // `contiguous`: the interval before ended at t0 (its outliers may be the burst's start).
+  std::optional<LiveEffect> findOutlierBurst(std::size_t axis, const AxisInterval& in, double t0,
+                                             bool contiguous) const;
+  bool stillShows(const LiveEffect& e, const AxisInterval& in) const;
+  double outlierRate(std::size_t axis) const;
+
+  LiveCheckSettings settings_;
+  std::size_t interval_samples_ = 0, segment_ = 0;
+  std::size_t baseline_needed_ = 0, baseline_intervals_ = 0;
+  double alpha_ = 0.0;
+  double segment_w2_ = 0.0;  // Σw² of the Welch segment's Hann window
+  std::array<AxisBaseline, 3> baseline_;
+  // The interval before (cleaned), for the two-interval window; its start, NaN when none.
+  std::array<std::vector<double>, 3> previous_;
+  double previous_t0_ = 0.0;
+  bool have_previous_ = false;
+  std::array<double, 3> previous_first_outlier_t_{};  // NaN: the interval before had none
+  std::vector<LiveEffect> current_;
+  // Effects said gone at the last two examinations: the two-interval window still holds the
+  // interval before their end, and must not name them again from it.
+  std::vector<LiveEffect> recently_gone_;
+};
+
+// Welch's power of x (Hann, 50 % overlap, each segment's mean removed), bins 0..seg/2, summed
+// over segments; `segments` receives their number.
+std::vector<double> welchPowerSum(std::span<const double> x, std::size_t seg, std::size_t* segments);
+// P(F > f) for F ~ F(d1, d2), by Paulson's normal approximation (Abramowitz & Stegun 26.6.15).
+double fUpperTail(double f, double d1, double d2);
+// The f with fUpperTail(f, d1, d2) = p (bisection on ln f).
+double fUpperQuantile(double p, double d1, double d2);
+
+}  // namespace gyrod::processing
