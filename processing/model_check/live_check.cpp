@@ -399,25 +399,20 @@ std::optional<LiveEffect> LiveCheck::findOutlierBurst(std::size_t axis, const Ax
   return e;
 }
 
-bool LiveCheck::stillShows(const LiveEffect& e, const AxisInterval& in) const {
-  if (e.kind == LiveEffectKind::OutlierBurst) {
-    std::size_t count = 0;
-    for (double z : in.scores) count += std::fabs(z) > kLiveOutlierZ ? 1 : 0;
-    return poissonUpperTail(count, outlierRate(e.axis) * static_cast<double>(in.scores.size())) < kGoneAlpha;
-  }
+bool LiveCheck::lineShowsIn(const LiveEffect& e, std::span<const double> x) const {
   if (e.baseline_rms_dps > 0.0) {
     // A grown baseline line: still over kLiveLineGrowth times its old rms.
-    for (const LiveEffect& now : findLines(e.axis, in.cleaned, 0.0, kGoneAlpha))
+    for (const LiveEffect& now : findLines(e.axis, x, 0.0, kGoneAlpha))
       if (std::fabs(now.centre_hz - e.centre_hz) <= 0.5 * (now.width_hz + e.width_hz) + kSameLineHz &&
           now.rms_dps_95.hi > kLiveLineGrowth * e.baseline_rms_dps)
         return true;
     return false;
   }
-  // A new line: the interval's periodogram still stands out at its bins (kGoneAlpha over
-  // those bins alone: a line the check named once is not said gone on a weak interval).
+  // A new line: the periodogram still stands out at its bins (kGoneAlpha over those bins
+  // alone: a line the check named once is not said gone on a weak interval).
   double w2 = 0.0;
-  const std::vector<double> p = hannPeriodogram(in.cleaned, &w2);
-  const double df = settings_.rate_hz / static_cast<double>(in.cleaned.size());
+  const std::vector<double> p = hannPeriodogram(x, &w2);
+  const double df = settings_.rate_hz / static_cast<double>(x.size());
   const double half = std::max(0.5 * e.width_hz, 3.0 * df);
   const auto lo = std::max<std::size_t>(1, static_cast<std::size_t>(std::floor((e.centre_hz - half) / df)));
   const auto hi = std::min(p.size() - 2, static_cast<std::size_t>(std::ceil((e.centre_hz + half) / df)));
@@ -429,6 +424,17 @@ bool LiveCheck::stillShows(const LiveEffect& e, const AxisInterval& in) const {
     if (level > 0.0 && p[k] / level > threshold) return true;
   }
   return false;
+}
+
+bool LiveCheck::stillShows(const LiveEffect& e, const AxisInterval& in, const std::vector<double>* both) const {
+  if (e.kind == LiveEffectKind::OutlierBurst) {
+    std::size_t count = 0;
+    for (double z : in.scores) count += std::fabs(z) > kLiveOutlierZ ? 1 : 0;
+    return poissonUpperTail(count, outlierRate(e.axis) * static_cast<double>(in.scores.size())) < kGoneAlpha;
+  }
+  // A line is gone when neither the last interval nor the last two show it: a weak line's one
+  // weak interval does not end it (at the cost of saying it an interval later).
+  return lineShowsIn(e, in.cleaned) || (both != nullptr && lineShowsIn(e, *both));
 }
 
 std::vector<LiveEffect> LiveCheck::examine(const std::array<std::vector<double>, 3>& axes, double t0) {
@@ -469,8 +475,14 @@ std::vector<LiveEffect> LiveCheck::examine(const std::array<std::vector<double>,
   }
   const double t_end = t0 + length_s;
   std::erase_if(recently_gone_, [t0](const LiveEffect& e) { return e.t < t0 - 1e-6; });
+  std::array<std::vector<double>, 3> both;  // the last two intervals, when contiguous
+  if (contiguous)
+    for (std::size_t a = 0; a < axes.size(); ++a) {
+      both[a] = previous_[a];
+      both[a].insert(both[a].end(), in[a].cleaned.begin(), in[a].cleaned.end());
+    }
   for (auto it = current_.begin(); it != current_.end();) {
-    if (stillShows(*it, in[it->axis])) {
+    if (stillShows(*it, in[it->axis], contiguous ? &both[it->axis] : nullptr)) {
       ++it;
       continue;
     }
@@ -493,9 +505,7 @@ std::vector<LiveEffect> LiveCheck::examine(const std::array<std::vector<double>,
     // Two windows, each at half the family's alpha: the last two intervals (a line that began
     // in the one before shows over both) and the last one.
     if (contiguous) {
-      std::vector<double> both = previous_[a];
-      both.insert(both.end(), in[a].cleaned.begin(), in[a].cleaned.end());
-      found = findLines(a, both, previous_t0_, alpha_ / 2);
+      found = findLines(a, both[a], previous_t0_, alpha_ / 2);
       std::erase_if(found, [&](const LiveEffect& e) {
         return std::any_of(recently_gone_.begin(), recently_gone_.end(), [&](const LiveEffect& g) {
           return g.axis == a && g.kind == e.kind &&

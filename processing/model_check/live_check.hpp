@@ -115,7 +115,10 @@ class LiveCheck {
   // `contiguous`: the interval before ended at t0 (its outliers may be the burst's start).
   std::optional<LiveEffect> findOutlierBurst(std::size_t axis, const AxisInterval& in, double t0,
                                              bool contiguous) const;
-  bool stillShows(const LiveEffect& e, const AxisInterval& in) const;
+  // Whether an effect named before still shows in this interval (`both`: the last two
+  // intervals, when contiguous).
+  bool stillShows(const LiveEffect& e, const AxisInterval& in, const std::vector<double>* both) const;
+  bool lineShowsIn(const LiveEffect& e, std::span<const double> x) const;
   double outlierRate(std::size_t axis) const;
 
   LiveCheckSettings settings_;

@@ -28,5 +28,7 @@ void addModelCheckCommand(CLI::App& app, CommandRunner& run);
 void addModelCommand(CLI::App& app, CommandRunner& run);
 // fleet: every gyrod on an MQTT broker.
 void addFleetCommand(CLI::App& app, CommandRunner& run);
+// live-check: the live check over a recording (docs/live-check.md).
+void addLiveCheckCommand(CLI::App& app, CommandRunner& run);
 
 }  // namespace gyrod::gyroctl

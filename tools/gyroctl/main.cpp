@@ -129,6 +129,7 @@ int main(int argc, char** argv) {
   addSimulateCommand(app, run);
   addClientCommands(app, run);
   addModelCheckCommand(app, run);
+  addLiveCheckCommand(app, run);
   addModelCommand(app, run);
   addFleetCommand(app, run);
   if (const auto message = unknownCommandMessage(app, argc, argv)) {
