@@ -279,8 +279,12 @@ void LiveCheck::finishBaseline() {
         if (same == b.lines.end()) {
           b.lines.push_back({e.centre_hz, e.width_hz, e.rms_dps_95.hi});
         } else {
+          // One line found at two frequencies (a line that wanders): it covers both.
           same->rms_dps = std::max(same->rms_dps, e.rms_dps_95.hi);
-          same->width_hz = std::max(same->width_hz, e.width_hz);
+          const double lo = std::min(same->centre_hz - 0.5 * same->width_hz, e.centre_hz - 0.5 * e.width_hz);
+          const double hi = std::max(same->centre_hz + 0.5 * same->width_hz, e.centre_hz + 0.5 * e.width_hz);
+          same->centre_hz = 0.5 * (lo + hi);
+          same->width_hz = hi - lo;
         }
       }
     std::vector<std::vector<double>>().swap(b.intervals);
