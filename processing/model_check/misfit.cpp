@@ -8,6 +8,7 @@
 
 #include "processing/base/detrend.hpp"
 #include "processing/base/distributions.hpp"
+#include "processing/model_check/live_check.hpp"
 #include "processing/model_check/pipeline.hpp"
 #include "processing/paper/ar_model.hpp"
 
@@ -145,27 +146,6 @@ HeldOutWhiteness heldOutWhiteness(std::span<const double> fit, std::span<const d
 
 namespace {
 
-// Hann-windowed Welch power (50 % overlap) of x with its mean removed, bins 0..seg/2.
-std::vector<double> welchPower(std::span<const double> x, std::size_t seg) {
-  std::vector<double> power(seg / 2 + 1, 0.0);
-  if (x.size() < seg) return power;
-  double mean = 0.0;
-  for (double v : x) mean += v;
-  mean /= static_cast<double>(x.size());
-  std::vector<double> w(seg), in(seg);
-  for (std::size_t i = 0; i < seg; ++i)
-    w[i] = 0.5 - 0.5 * std::cos(2.0 * std::numbers::pi * static_cast<double>(i) / static_cast<double>(seg));
-  std::vector<std::complex<double>> spec;
-  Eigen::FFT<double> fft;
-  fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);
-  for (std::size_t s = 0; s + seg <= x.size(); s += seg / 2) {
-    for (std::size_t i = 0; i < seg; ++i) in[i] = w[i] * (x[s + i] - mean);
-    fft.fwd(spec, in);
-    for (std::size_t k = 0; k <= seg / 2; ++k) power[k] += std::norm(spec[k]);
-  }
-  return power;
-}
-
 // Sample autocorrelation of x at lags 1..lags.
 std::vector<double> autocorrelation(const std::vector<double>& x, std::size_t lags) {
   std::vector<double> r(lags, 0.0);
@@ -199,7 +179,8 @@ HalvesChange halvesChange(std::span<const double> x, double rate_hz) {
   std::size_t seg = 64;
   while (seg * 2 <= h / 16 && seg < 1024) seg *= 2;
   if (h < 16 * seg) return out;
-  const std::vector<double> pa = welchPower(a, seg), pb = welchPower(b, seg);
+  std::size_t segments = 0;
+  const std::vector<double> pa = welchPowerSum(a, seg, &segments), pb = welchPowerSum(b, seg, &segments);
   double best = -1.0;
   for (std::size_t k = 1; k < seg / 2; ++k) {  // DC and Nyquist left out (half the degrees of freedom)
     if (!(pa[k] > 0.0 && pb[k] > 0.0)) continue;
