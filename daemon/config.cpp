@@ -31,8 +31,8 @@ namespace {
 using Section = formats::TomlSection;
 using formats::shortest;
 
-const std::vector<std::string_view> kSections = {"device", "gpio", "bias", "filter", "allan", "socket",
-                                                 "record", "log",  "mock", "limits", "mqtt",  "state"};
+const std::vector<std::string_view> kSections = {"device", "gpio", "bias",   "filter", "allan", "socket", "record",
+                                                 "log",    "mock", "limits", "mqtt",   "state", "check"};
 const std::vector<std::string_view> kBiasSourceNames = {"estimate", "model", "config"};
 const std::vector<std::string_view> kMockSourceNames = {"simulator", "replay"};
 
@@ -387,6 +387,30 @@ void readState(const Section& s, StateConfig& st) {
   }
 }
 
+void readCheck(const Section& s, CheckConfig& c, double rate_hz) {
+  if (auto v = s.boolean("enabled")) c.enabled = *v;
+  if (auto v = s.number("interval_s")) {
+    if (!(*v >= 60.0 && *v <= 86400.0)) s.failValue("interval_s", "must be between 60 and 86400 s");
+    // The analysis rate: the device's, averaged down to at most kLiveCheckMaxRateHz.
+    const double analysed = rate_hz / std::ceil(rate_hz / kLiveCheckMaxRateHz - 1e-9);
+    if (*v * analysed < 512.0)
+      s.failValue("interval_s", "must hold at least 512 samples at " + shortest(analysed) + " Hz");
+    c.interval_s = *v;
+  }
+  if (auto v = s.number("baseline_s")) {
+    if (!(*v >= c.interval_s && *v <= 604800.0))
+      s.failValue("baseline_s",
+                  "must be at least check.interval_s (" + shortest(c.interval_s) + " s) and at most 604800 s");
+    c.baseline_s = *v;
+  } else if (c.baseline_s < c.interval_s) {
+    c.baseline_s = c.interval_s;  // the default baseline, when the interval is longer
+  }
+  if (auto v = s.number("false_alarms_per_week")) {
+    if (!(*v > 0.0 && *v <= 100.0)) s.failValue("false_alarms_per_week", "must be > 0 and at most 100");
+    c.false_alarms_per_week = *v;
+  }
+}
+
 void readLimits(const Section& s, LimitsConfig& l) {
   if (auto v = s.number("memory_mb")) {
     if (!(*v >= 16.0 && *v <= 1e9)) s.failValue("memory_mb", "must be 16..1e9 MB (10^6 bytes)");
@@ -676,6 +700,8 @@ GyrodConfig readConfig(const formats::TomlDocument& doc, ReferenceChecks checks)
                "ca_file", "cert_file", "key_file", "home_assistant", "home_assistant_prefix"});
   readMqtt(mqtt, config.mqtt);
   readState(section("state", {"directory", "save_interval_s"}), config.state);
+  readCheck(section("check", {"enabled", "interval_s", "baseline_s", "false_alarms_per_week"}), config.check,
+            config.device.rate_hz);
   if (checks == ReferenceChecks::On) {
     checkReferences(filter, socket, mock, config);
     checkMqttFiles(mqtt, config.mqtt);

@@ -201,6 +201,20 @@ struct StateConfig {
   bool operator==(const StateConfig&) const = default;
 };
 
+// The live check averages the device's samples down to at most this rate (lines up to half of
+// it), which bounds its memory at any device rate.
+inline constexpr double kLiveCheckMaxRateHz = 200.0;
+
+// The live check on the board's still data (docs/live-check.md, daemon/live_checker.hpp); gyrod
+// runs it when it has the still detector of filter.model.
+struct CheckConfig {
+  bool enabled = true;
+  double interval_s = 300.0;   // still data per examination
+  double baseline_s = 1800.0;  // the first still data: the board's baseline
+  double false_alarms_per_week = 0.25;
+  bool operator==(const CheckConfig&) const = default;
+};
+
 struct GyrodConfig {
   DeviceConfig device;
   GpioConfig gpio;
@@ -214,6 +228,7 @@ struct GyrodConfig {
   LimitsConfig limits;
   MqttConfig mqtt;
   StateConfig state;
+  CheckConfig check;
   bool operator==(const GyrodConfig&) const = default;
 };
 

@@ -35,6 +35,7 @@
 #include "formats/recording_header.hpp"
 #include "formats/toml_document.hpp"
 #include "processing/simulation/sensor_model.hpp"
+#include "protocol/effect_line.hpp"
 
 namespace gyrod::daemon {
 namespace {
@@ -194,6 +195,34 @@ std::string Gyrod::startCalibrationKeeper() {
   return formats::calibrationStateToToml(restored->state);
 }
 
+// [check] enabled: the live check on the still samples, when filter.model gives the still
+// detector (without it a moving board would be compared with its still baseline).
+void Gyrod::startLiveCheck() {
+  if (!config_.check.enabled) return;
+  if (pipeline_.rateModel() != RateModel::SensorModel) {
+    spdlog::info("live check: off (it runs on still samples, and the still detector needs filter.model)");
+    return;
+  }
+  live_ = std::make_unique<LiveChecker>(loop_, config_.device.rate_hz, config_.check.interval_s,
+                                        config_.check.baseline_s, config_.check.false_alarms_per_week,
+                                        [this](const processing::LiveEffect& e) { queueEffect(e); });
+  spdlog::info(
+      "live check: every {} s of still data at {} Hz against a baseline of the first {} s "
+      "(docs/live-check.md)",
+      formats::shortest(config_.check.interval_s), formats::shortest(live_->analysisRateHz()),
+      formats::shortest(config_.check.baseline_s));
+}
+
+void Gyrod::queueEffect(const processing::LiveEffect& e) {
+  std::string line = protocol::effectJson(e).dump() + "\n";
+  {
+    const std::lock_guard lock(effects_mutex_);
+    effect_lines_.push_back(std::move(line));
+  }
+  clients_to_wake_ = true;
+  wakeDeliveryThread();
+}
+
 // The rate stream's parameters from filter.model, exactly as `gyroctl filter --model` builds
 // them (rateEstimatorParameters of readSensorModelToml), at the device's rate, with
 // filter.rate_low_pass_hz over the model's low-pass when set.
@@ -287,6 +316,7 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
   held_.reserve(static_cast<std::size_t>(std::ceil(0.5 * config.device.rate_hz)) + 16);  // as the pipeline's
   if (!rate_model_.warning.empty()) spdlog::warn("{}", rate_model_.warning);
   const std::string started_from = startCalibrationKeeper();
+  startLiveCheck();
   start_real_ns_ = monotonicNowNs();
   last_pump_real_ns_ = start_real_ns_;
   max_virtual_step_ns_ = maxVirtualStepNs(device_.driver_config);
@@ -577,6 +607,7 @@ void Gyrod::publish(const driver::GyroSample& s, const ProcessedSample& out) {
   if (calibration_)
     if (const processing::RateEstimator* estimator = pipeline_.rateEstimator())
       calibration_->onSample(out.t_s, *estimator);
+  if (live_) live_->onSample(out.t_s, out.raw, out.still.value_or(false));
   ++samples_published_;
   last_temp_c_ = r.temp_c;
   last_t_s_ = r.t_s;
@@ -593,6 +624,7 @@ void Gyrod::onGap(const driver::SampleGap& gap) {
 
 void Gyrod::publishGap(const driver::SampleGap& gap) {
   ++gaps_;
+  if (live_) live_->breakRun();
   missing_samples_ += gap.count;
   const std::string_view reason = driver::gapCauseName(gap.cause);  // a [a-z0-9_] token (docs/protocol.md)
   queueForClients(gapLine(gap.first_seq, gap.count, reason));
@@ -641,6 +673,12 @@ void Gyrod::publishQueuedLines() {
     else
       server_->publishGap({line.gap_first_seq, line.gap_count, std::string_view(line.gap_reason.data())});
   }
+  std::vector<std::string> effects;
+  {
+    const std::lock_guard lock(effects_mutex_);
+    effects.swap(effect_lines_);
+  }
+  for (const std::string& e : effects) server_->publishEffect(e);
 }
 
 void Gyrod::deliveryThreadMain(int sample_policy, int sample_priority) {
@@ -938,6 +976,7 @@ StatusReport Gyrod::statusReport() {
   if (calibration_ && pipeline_.rateModel() == RateModel::SensorModel)
     r.calibration_state = protocol::CalibrationStateStatus{calibration_->path(), calibration_->restored(),
                                                            calibration_->writes(), calibration_->lastError()};
+  if (live_) r.live_check = live_->status();
   return r;
 }
 

@@ -33,6 +33,7 @@
 #include "daemon/config.hpp"
 #include "daemon/device_backend.hpp"
 #include "daemon/event_loop.hpp"
+#include "daemon/live_checker.hpp"
 #include "daemon/memory_budget.hpp"
 #include "daemon/mqtt_publisher.hpp"
 #include "daemon/noise_refit_worker.hpp"
@@ -91,6 +92,9 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   static PipelineSettings pipelineSettings(const GyrodConfig& config, const LoadedRateModel& rate_model);
   std::string rateModelDescription() const;
   std::string startCalibrationKeeper();
+  void startLiveCheck();
+  // The live check's change as an EFFECT line for the delivery thread (sample thread).
+  void queueEffect(const processing::LiveEffect& e);
   void logStillPeriodVerdict();
   void serviceDriver();
   void rearmDriverTimer();
@@ -129,6 +133,11 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   std::unique_ptr<driver::Mpu6050Driver> driver_;
   SamplePipeline pipeline_;
   std::unique_ptr<CalibrationKeeper> calibration_;  // with a state directory
+  std::unique_ptr<LiveChecker> live_;               // [check] enabled, with filter.model's still detector
+  // EFFECT lines from the sample thread to the delivery thread (a few an hour at most): the
+  // sample thread appends, the delivery thread takes them all; each holds it for a move.
+  PriorityInheritanceMutex effects_mutex_;
+  std::vector<std::string> effect_lines_;
   NoiseRefitWorker noise_refit_;
   AllanReplyCache allan_reply_;
   std::unique_ptr<UnixSocketServer> server_;

@@ -142,6 +142,18 @@ MemoryNeed memoryNeeded(const GyrodConfig& c) {
                             std::to_string(sizeof(LineForClients)) + " B",
                         "device.rate_hz", formats::shortest(c.device.rate_hz),
                         handover * static_cast<double>(sizeof(LineForClients))});
+  if (c.check.enabled && !c.filter.model.empty()) {
+    // At its analysis rate (the device's averaged down to kLiveCheckMaxRateHz): the baseline's
+    // intervals kept until it is complete, the interval filling, the one examined, the one before
+    // and the two together (8 B a sample, 3 axes), and the periodogram's work (≈ 64 B a sample of
+    // the two-interval window).
+    const double analysed = rate / std::ceil(rate / kLiveCheckMaxRateHz - 1e-9);
+    const double interval = std::round(c.check.interval_s * analysed);
+    const double baseline = std::ceil(c.check.baseline_s / c.check.interval_s - 1e-9) * interval;
+    need.items.push_back({"live check: 3 axes x " + count(baseline + 5.0 * interval) + " samples x 8 B and its work",
+                          "check.baseline_s", formats::shortest(c.check.baseline_s),
+                          24.0 * (baseline + 5.0 * interval) + 128.0 * interval});
+  }
   if (c.mqtt.enabled() && c.mqtt.qos == 1 && c.mqtt.buffer_messages > 0) {
     const auto kept = static_cast<double>(c.mqtt.buffer_messages);
     // 1.5 times: the array it grew from is still there while its lines are copied.

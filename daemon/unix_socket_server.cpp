@@ -566,6 +566,8 @@ void UnixSocketServer::publishGap(const GapEvent& gap) {
   publishLine(line.data(), n, false);
 }
 
+void UnixSocketServer::publishEffect(std::string_view line) { publishLine(line.data(), line.size(), false); }
+
 void UnixSocketServer::publishLine(const char* data, std::size_t size, bool decimated) {
   bool flagged = false;
   {

@@ -144,6 +144,9 @@ class UnixSocketServer {
   // A GAP line to every watching client, whatever its decimation. Throws
   // std::invalid_argument for a malformed gap (see formatGapLine). As publishRate.
   void publishGap(const GapEvent& gap);
+  // An EFFECT line (with its newline) to every watching client, whatever its decimation. As
+  // publishRate.
+  void publishEffect(std::string_view line);
 
   // The loop's thread only.
   ServerStatus serverStatus() const;

@@ -205,7 +205,8 @@ constexpr std::string_view kStatusFields[] = {"class",
                                               "mqtt_buffered",
                                               "mqtt_dropped",
                                               "mqtt_last_error",
-                                              "calibration_state"};
+                                              "calibration_state",
+                                              "live_check"};
 
 StatusReply statusOf(const json& j) {
   constexpr std::string_view cls = "STATUS";
@@ -250,6 +251,18 @@ StatusReply statusOf(const json& j) {
     c.restored = optionalFlag(*state, cls, "restored").value_or(false);
     c.writes = count(*state, cls, "writes");
     c.last_error = optionalText(*state, cls, "last_error").value_or("");
+  }
+  if (const json* live = field(j, cls, "live_check", &json::is_object, "an object")) {
+    LiveCheckStatus& l = d.live_check.emplace();
+    l.intervals = count(*live, cls, "intervals");
+    l.baseline_ready = optionalFlag(*live, cls, "baseline_ready").value_or(false);
+    l.named = count(*live, cls, "named");
+    l.skipped = count(*live, cls, "skipped");
+    if (const json* current = field(*live, cls, "current", &json::is_array, "an array"))
+      for (const json& e : *current) {
+        if (!e.is_object()) malformed(cls, "live_check.current must hold objects");
+        l.current.push_back(e.dump());
+      }
   }
   if (const json* counters = field(j, cls, "counters", &json::is_object, "an object")) {
     for (auto it = counters->begin(); it != counters->end(); ++it) {

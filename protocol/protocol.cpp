@@ -297,6 +297,15 @@ std::string statusLine(const StatusReport& d, const ServerStatus& s) {
     if (!d.calibration_state->last_error.empty()) state["last_error"] = d.calibration_state->last_error;
     j["calibration_state"] = std::move(state);
   }
+  if (d.live_check) {
+    json current = json::array();
+    for (const std::string& e : d.live_check->current) current.push_back(json::parse(e, nullptr, false));
+    j["live_check"] = {{"intervals", d.live_check->intervals},
+                       {"baseline_ready", d.live_check->baseline_ready},
+                       {"named", d.live_check->named},
+                       {"skipped", d.live_check->skipped},
+                       {"current", std::move(current)}};
+  }
   if (!d.device_counters.empty()) {
     json counters = json::object();
     for (const NamedCount& c : d.device_counters) counters[c.name] = c.value;

@@ -23,7 +23,7 @@
 namespace gyrod::protocol {
 
 inline constexpr int kProtocolMajor = 1;  // incompatible changes
-inline constexpr int kProtocolMinor = 6;  // compatible additions (new classes, new fields)
+inline constexpr int kProtocolMinor = 7;  // compatible additions (new classes, new fields)
 
 // A client line longer than this (not counting the '\n' and an optional '\r') is refused
 // with an ERROR and the client is disconnected.
@@ -174,6 +174,16 @@ struct CalibrationStateStatus {
   bool operator==(const CalibrationStateStatus&) const = default;
 };
 
+// The live check (docs/live-check.md), while gyrod runs it.
+struct LiveCheckStatus {
+  std::uint64_t intervals = 0;       // of still data examined, the baseline's included
+  bool baseline_ready = false;       // the baseline is complete: later intervals are compared with it
+  std::uint64_t named = 0;           // effects named since start
+  std::uint64_t skipped = 0;         // intervals left out because the last examination still ran
+  std::vector<std::string> current;  // each effect now named, as its EFFECT line's JSON object
+  bool operator==(const LiveCheckStatus&) const = default;
+};
+
 // The verdict on the start-up still period (STATUS "still_check", docs/protocol.md).
 enum class StillCheck {
   Pending,        // the still period is being collected
@@ -206,6 +216,7 @@ struct StatusReport {
   std::optional<RecorderStatus> recorder;         // the recorder's counts, while recording
   std::optional<MqttStatus> mqtt;                 // the MQTT publisher, when configured
   std::optional<CalibrationStateStatus> calibration_state;  // with a state directory and a sensor model
+  std::optional<LiveCheckStatus> live_check;                // while gyrod runs the live check
 };
 
 // What the server knows about its clients; added to every STATUS line.

@@ -109,10 +109,11 @@ double f2UpperQuantile(double p, double d2) { return 0.5 * d2 * (std::pow(p, -2.
 // block, so the fit gains on every block it spans, where the blocks' power alone would not).
 // The 95 % interval holds the onsets whose cost is within 3.84 of the best in units of a
 // block's noise (`sigma2` is the white variance the baseline's level stands for there); a
-// line there from the window's first block may have begun earlier (lo moves back by
-// `earlier_s`). Returns the amplitude after the onset, its 95 % half-width, for the rms.
+// line there from the window's first block may have begun as early as `earliest_t` (the start of
+// the interval examined before the window: a weak line can hide in one interval). Returns the
+// amplitude after the onset, its 95 % half-width, for the rms.
 std::pair<double, double> estimateLineOnset(std::span<const double> x, double centre_hz, double sigma2, double t0,
-                                            double rate_hz, double earlier_s, LiveEffect& e) {
+                                            double rate_hz, double earliest_t, LiveEffect& e) {
   const auto block = static_cast<std::size_t>(std::max(1.0, std::round(10.0 * rate_hz)));
   const std::size_t m = x.size() / block;
   if (m < 2 || !(sigma2 > 0.0)) return {0.0, 0.0};
@@ -145,7 +146,7 @@ std::pair<double, double> estimateLineOnset(std::span<const double> x, double ce
     }
   const auto at = [&](std::size_t c) { return t0 + static_cast<double>(c * block) / rate_hz; };
   e.onset_t = at(best);
-  e.onset_95 = {at(c_lo) - (c_lo == 0 ? earlier_s : 0.0), at(c_hi) + static_cast<double>(block) / rate_hz};
+  e.onset_95 = {c_lo == 0 ? std::min(at(0), earliest_t) : at(c_lo), at(c_hi) + static_cast<double>(block) / rate_hz};
   std::complex<double> mean = 0.0;
   for (std::size_t j = best; j < m; ++j) mean += z[j];
   const double after = static_cast<double>(m - best);
@@ -272,7 +273,8 @@ void LiveCheck::finishBaseline() {
     // The lines the board already has, found in each baseline interval as a new one would be,
     // at a looser alpha (missing one here costs a false alarm later).
     for (std::size_t i = 0; i < b.intervals.size(); ++i)
-      for (const LiveEffect& e : findLines(a, b.intervals[i], static_cast<double>(i) * length_s, kBaselineLineAlpha)) {
+      for (const LiveEffect& e :
+           findLines(a, b.intervals[i], static_cast<double>(i) * length_s, 0.0, kBaselineLineAlpha)) {
         auto same = std::find_if(b.lines.begin(), b.lines.end(), [&e](const BaselineLine& l) {
           return std::fabs(l.centre_hz - e.centre_hz) <= 0.5 * (l.width_hz + e.width_hz) + kSameLineHz;
         });
@@ -298,7 +300,7 @@ const LiveCheck::BaselineLine* LiveCheck::baselineLine(std::size_t axis, const L
 }
 
 std::vector<LiveEffect> LiveCheck::findLines(std::size_t axis, std::span<const double> window, double t0,
-                                             double alpha) const {
+                                             double earliest_t, double alpha) const {
   std::vector<LiveEffect> found;
   const std::size_t n = window.size();
   double w2 = 0.0;
@@ -352,8 +354,7 @@ std::vector<LiveEffect> LiveCheck::findLines(std::size_t axis, std::span<const d
     e.centre_hz_95 = {e.centre_hz - half_f, e.centre_hz + half_f};
     e.evidence = "periodogram over the last " + formatSeconds(nn / settings_.rate_hz) + " at " + formatHz(e.centre_hz) +
                  " stands " + formatRatio(peak) + " x the baseline's level (threshold " + formatRatio(threshold) + ")";
-    const auto [amp, amp_half] =
-        estimateLineOnset(window, e.centre_hz, sigma2, t0, settings_.rate_hz, settings_.interval_s, e);
+    const auto [amp, amp_half] = estimateLineOnset(window, e.centre_hz, sigma2, t0, settings_.rate_hz, earliest_t, e);
     if (hi - lo + 1 <= kSinusoidRunBins) {
       // Narrow as a steady sinusoid's main lobe: its amplitude from the demodulated blocks
       // after the onset (the window's spectrum holds it only for the part it spans).
@@ -406,7 +407,7 @@ std::optional<LiveEffect> LiveCheck::findOutlierBurst(std::size_t axis, const Ax
 bool LiveCheck::lineShowsIn(const LiveEffect& e, std::span<const double> x) const {
   if (e.baseline_rms_dps > 0.0) {
     // A grown baseline line: still over kLiveLineGrowth times its old rms.
-    for (const LiveEffect& now : findLines(e.axis, x, 0.0, kGoneAlpha))
+    for (const LiveEffect& now : findLines(e.axis, x, 0.0, 0.0, kGoneAlpha))
       if (std::fabs(now.centre_hz - e.centre_hz) <= 0.5 * (now.width_hz + e.width_hz) + kSameLineHz &&
           now.rms_dps_95.hi > kLiveLineGrowth * e.baseline_rms_dps)
         return true;
@@ -450,6 +451,8 @@ std::vector<LiveEffect> LiveCheck::examine(const std::array<std::vector<double>,
   const double length_s = static_cast<double>(interval_samples_) / settings_.rate_hz;
   const bool contiguous = have_previous_ && std::fabs(previous_t0_ + length_s - t0) < 0.5 / settings_.rate_hz;
   const auto keep = [&] {
+    before_previous_t0_ = previous_t0_;
+    have_before_previous_ = have_previous_;
     for (std::size_t a = 0; a < axes.size(); ++a) {
       previous_[a] = in[a].cleaned;
       previous_first_outlier_t_[a] = std::numeric_limits<double>::quiet_NaN();
@@ -509,7 +512,8 @@ std::vector<LiveEffect> LiveCheck::examine(const std::array<std::vector<double>,
     // Two windows, each at half the family's alpha: the last two intervals (a line that began
     // in the one before shows over both) and the last one.
     if (contiguous) {
-      found = findLines(a, both[a], previous_t0_, alpha_ / 2);
+      found = findLines(a, both[a], previous_t0_, have_before_previous_ ? before_previous_t0_ : previous_t0_ - length_s,
+                        alpha_ / 2);
       std::erase_if(found, [&](const LiveEffect& e) {
         return std::any_of(recently_gone_.begin(), recently_gone_.end(), [&](const LiveEffect& g) {
           return g.axis == a && g.kind == e.kind &&
@@ -517,7 +521,9 @@ std::vector<LiveEffect> LiveCheck::examine(const std::array<std::vector<double>,
         });
       });
     }
-    for (LiveEffect& e : findLines(a, in[a].cleaned, t0, contiguous ? alpha_ / 2 : alpha_)) found.push_back(e);
+    for (LiveEffect& e : findLines(a, in[a].cleaned, t0, have_previous_ ? previous_t0_ : t0 - length_s,
+                                   contiguous ? alpha_ / 2 : alpha_))
+      found.push_back(e);
     if (auto burst = findOutlierBurst(a, in[a], t0, contiguous)) found.push_back(*burst);
     for (LiveEffect& e : found) {
       e.t = t_end;

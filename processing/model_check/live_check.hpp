@@ -28,6 +28,11 @@
 namespace gyrod::processing {
 
 inline constexpr double kLiveOutlierZ = 8.0;
+// The caller's rule for motion: a still detector's verdicts flicker at rest (on gyrod's mock,
+// 2 % of the samples called moving, in stretches up to 0.5 s), so only a stretch of moving
+// verdicts this long breaks the run of still data (the interval it falls in is left out);
+// shorter ones stay in.
+inline constexpr double kLiveMotionBreakS = 1.0;
 inline constexpr double kLiveLineGrowth = 2.0;
 
 struct LiveCheckSettings {
@@ -110,8 +115,10 @@ class LiveCheck {
   // At the end of the baseline: its background, and the lines in its own intervals.
   void finishBaseline();
   const BaselineLine* baselineLine(std::size_t axis, const LiveEffect& e) const;
-  // Lines in the periodogram of `window` (data time t0 at its first sample) at family alpha.
-  std::vector<LiveEffect> findLines(std::size_t axis, std::span<const double> window, double t0, double alpha) const;
+  // Lines in the periodogram of `window` (data time t0 at its first sample) at family alpha;
+  // `earliest_t`: the start of the interval examined before the window (the earliest onset).
+  std::vector<LiveEffect> findLines(std::size_t axis, std::span<const double> window, double t0, double earliest_t,
+                                    double alpha) const;
   // `contiguous`: the interval before ended at t0 (its outliers may be the burst's start).
   std::optional<LiveEffect> findOutlierBurst(std::size_t axis, const AxisInterval& in, double t0,
                                              bool contiguous) const;
@@ -129,8 +136,8 @@ class LiveCheck {
   std::array<AxisBaseline, 3> baseline_;
   // The interval before (cleaned), for the two-interval window; its start, NaN when none.
   std::array<std::vector<double>, 3> previous_;
-  double previous_t0_ = 0.0;
-  bool have_previous_ = false;
+  double previous_t0_ = 0.0, before_previous_t0_ = 0.0;  // and the start of the one before it
+  bool have_previous_ = false, have_before_previous_ = false;
   std::array<double, 3> previous_first_outlier_t_{};  // NaN: the interval before had none
   std::vector<LiveEffect> current_;
   // Effects said gone at the last two examinations: the two-interval window still holds the

@@ -330,10 +330,10 @@ TEST(ConfigErrors, UnknownKeyNamesFileLineKeyAndTheValidKeys) {
 TEST(ConfigErrors, UnknownSectionAndTopLevelKey) {
   EXPECT_EQ(errorOf("[log]\nlevel = \"info\"\n\n[devise]\nbackend = \"mock\"\n"),
             "x.toml:4: unknown section [devise] (valid sections: device, gpio, bias, filter, allan, socket, record, "
-            "log, mock, limits, mqtt, state); did you mean 'device'?");
+            "log, mock, limits, mqtt, state, check); did you mean 'device'?");
   EXPECT_EQ(errorOf("rate_hz = 50\n"),
             "x.toml:1: unknown key 'rate_hz' at top level (keys belong in a section: device, gpio, bias, filter, "
-            "allan, socket, record, log, mock, limits, mqtt, state)");
+            "allan, socket, record, log, mock, limits, mqtt, state, check)");
   EXPECT_EQ(errorOf("device = 5\n"), "x.toml:1: key 'device': must be a section [device] (got integer 5)");
 }
 
@@ -716,4 +716,29 @@ TEST(ConfigValues, TheStateDirectoryAndItsSaveInterval) {
             "x.toml:2: key 'state.save_interval_s': must be between 1 and 86400 s (got 0.5)");
   EXPECT_EQ(errorOf("[state]\ndirectory = 3\n"), "x.toml:2: key 'state.directory': must be a string (got integer 3)");
   EXPECT_EQ(errorOf("[state]\ndir = \"/tmp\"\n").rfind("x.toml:2: unknown key 'dir' in [state]", 0), 0u);
+}
+
+TEST(ConfigValues, TheLiveCheck) {
+  const GyrodConfig defaults = parseConfig("", "x.toml");
+  EXPECT_TRUE(defaults.check.enabled);
+  EXPECT_EQ(defaults.check.interval_s, 300.0);
+  EXPECT_EQ(defaults.check.baseline_s, 1800.0);
+  EXPECT_EQ(defaults.check.false_alarms_per_week, 0.25);
+  const GyrodConfig c = parseConfig(
+      "[check]\nenabled = false\ninterval_s = 120\nbaseline_s = 600\nfalse_alarms_per_week = 1\n", "x.toml");
+  EXPECT_FALSE(c.check.enabled);
+  EXPECT_EQ(c.check.interval_s, 120.0);
+  EXPECT_EQ(c.check.baseline_s, 600.0);
+  EXPECT_EQ(c.check.false_alarms_per_week, 1.0);
+  // A long interval with the default baseline: the baseline becomes one interval.
+  EXPECT_EQ(parseConfig("[check]\ninterval_s = 3600\n", "x.toml").check.baseline_s, 3600.0);
+  EXPECT_EQ(errorOf("[check]\ninterval_s = 10\n"),
+            "x.toml:2: key 'check.interval_s': must be between 60 and 86400 s (got 10)");
+  EXPECT_EQ(errorOf("[device]\nrate_hz = 4\n[check]\ninterval_s = 60\n"),
+            "x.toml:4: key 'check.interval_s': must hold at least 512 samples at 4 Hz (got 60)");
+  EXPECT_EQ(
+      errorOf("[check]\ninterval_s = 600\nbaseline_s = 300\n"),
+      "x.toml:3: key 'check.baseline_s': must be at least check.interval_s (600 s) and at most 604800 s (got 300)");
+  EXPECT_EQ(errorOf("[check]\nfalse_alarms_per_week = 0\n"),
+            "x.toml:2: key 'check.false_alarms_per_week': must be > 0 and at most 100 (got 0)");
 }

@@ -172,7 +172,10 @@ TEST(GyrodCalibrationState, ARestartedGyrodStartsFromTheBiasItHadLearned) {
     LineClient watcher((d.path() / "gyrod.sock").string());
     ASSERT_TRUE(watcher.connected()) << readWholeFile(d.path() / "run1.txt");
     ASSERT_TRUE(watcher.readLine());  // VERSION
-    ASSERT_TRUE(watcher.send("{\"cmd\":\"watch\"}\n"));
+    // Every 10th sample: 2000 lines a second at 400x, which the watcher takes with room to spare
+    // even when it is slowed (ASan + UBSan: a watcher of every sample fell 450 lines behind and
+    // was dropped).
+    ASSERT_TRUE(watcher.send("{\"cmd\":\"watch\",\"decimate\":10}\n"));
     double t0 = std::nan("");
     while (true) {
       const auto line = watcher.readLine(30s);
@@ -190,7 +193,7 @@ TEST(GyrodCalibrationState, ARestartedGyrodStartsFromTheBiasItHadLearned) {
     gyrod.signal(SIGTERM);
     ASSERT_EQ(gyrod.waitExit(5000ms), std::optional<int>(0)) << readWholeFile(d.path() / "run1.txt");
   }
-  ASSERT_GT(last_minute, 500u);
+  ASSERT_GT(last_minute, 250u);  // of the 300 a minute brings
   const std::string log1 = readWholeFile(d.path() / "run1.txt");
   EXPECT_EQ(linesContaining(log1, "calibration state: none yet at"), 1u) << log1;
   EXPECT_EQ(linesContaining(log1, "calibration state: written to"), 1u) << log1;

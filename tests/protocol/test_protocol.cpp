@@ -163,7 +163,7 @@ TEST(ProtocolGap, FormatsAndRejectsMalformedGaps) {
 TEST(ProtocolReplies, VersionAndWatch) {
   const std::string v = versionLine("1.2.3");
   ASSERT_EQ(v.back(), '\n');
-  EXPECT_EQ(json::parse(v), json::parse(R"({"class":"VERSION","release":"1.2.3","proto_major":1,"proto_minor":6})"));
+  EXPECT_EQ(json::parse(v), json::parse(R"({"class":"VERSION","release":"1.2.3","proto_major":1,"proto_minor":7})"));
   EXPECT_EQ(json::parse(watchLine(false, 5)), json::parse(R"({"class":"WATCH","enable":false,"decimate":5})"));
 }
 

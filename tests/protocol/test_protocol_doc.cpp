@@ -101,6 +101,7 @@ nlohmann::json fullStatus() {
   d.recorder = protocol::RecorderStatus{1, 2, 3, 4, "write to file.csv: No space left on device"};
   d.mqtt = protocol::MqttStatus{false, 5, 6, "Connection refused"};
   d.calibration_state = protocol::CalibrationStateStatus{"/var/lib/gyrod/calibration.toml", true, 3, "disk full"};
+  d.live_check = protocol::LiveCheckStatus{7, true, 1, 0, {R"({"class":"EFFECT","state":"new"})"}};
   protocol::ServerStatus s;
   s.client_list.push_back({1, 2, 3, true, 1, 1, 1, 1, true});
   return nlohmann::json::parse(protocol::statusLine(d, s));

@@ -9,6 +9,7 @@
 #include <ctime>
 #include <filesystem>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -112,6 +113,29 @@ void printGap(const protocol::GapNotice& g) {
               static_cast<unsigned long long>(g.first_missing_seq), g.reason.c_str());
 }
 
+// The live check's EFFECT object as a person reads it: "line on y at 12.5 Hz, onset 3600 s".
+std::string effectSummary(const nlohmann::json& e) {
+  const auto number = [](const nlohmann::json& v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.4g", v.is_number() ? v.get<double>() : std::nan(""));
+    return std::string(buf);
+  };
+  std::string s = e.value("effect", std::string("?")) + " on " + e.value("axis", std::string("?"));
+  const nlohmann::json params = e.value("params", nlohmann::json::object());
+  if (params.contains("centre_hz")) s += " at " + number(params["centre_hz"]) + " Hz";
+  if (params.contains("count")) s += ", " + number(params["count"]) + " outliers";
+  if (e.contains("onset_t")) s += ", onset t " + number(e["onset_t"]) + " s";
+  return s;
+}
+
+// An EFFECT line in the text layout: "--- effect new: line on y at 12.5 Hz, onset t 3600 s: ...".
+void printEffect(const std::string& line) {
+  const nlohmann::json e = nlohmann::json::parse(line, nullptr, false);
+  if (!e.is_object()) return;
+  std::printf("--- effect %s: %s: %s\n", e.value("state", std::string("?")).c_str(), effectSummary(e).c_str(),
+              e.value("evidence", std::string()).c_str());
+}
+
 int runWatch(const WatchOptions& opt) {
   if (opt.count && *opt.count == 0) throw std::invalid_argument("--count must be >= 1");
   DaemonConnection conn = DaemonConnection::open(opt.common.socket, kReplyTimeout);
@@ -136,6 +160,8 @@ int runWatch(const WatchOptions& opt) {
       printRate(*rate, *with_rate);
     } else if (const auto* gap = std::get_if<protocol::GapNotice>(&message)) {
       printGap(*gap);
+    } else if (const auto* other = std::get_if<protocol::OtherClass>(&message); other && other->name == "EFFECT") {
+      printEffect(line);
     }
     std::fflush(stdout);
   }
@@ -439,6 +465,14 @@ void printStatus(const protocol::StatusReply& status) {
     printField("calibration_state", c->file + (c->restored ? " (the rate stream started from it)" : "") + ", " +
                                         count(c->writes) + " writes" +
                                         (c->last_error.empty() ? "" : "; last error: " + c->last_error));
+  if (const auto& l = d.live_check) {
+    std::string now;
+    for (const std::string& e : l->current)
+      now += (now.empty() ? "" : "; ") + effectSummary(nlohmann::json::parse(e, nullptr, false));
+    printField("live_check", count(l->intervals) + " intervals, baseline " + (l->baseline_ready ? "ready" : "not yet") +
+                                 ", " + count(l->named) + " named, " + count(l->skipped) +
+                                 " skipped; now: " + (now.empty() ? "nothing" : now));
+  }
   printField("clients", count(s.clients));
   printField("clients_total", count(s.clients_total));
   printField("clients_dropped", count(s.clients_dropped));

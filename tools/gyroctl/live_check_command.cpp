@@ -2,8 +2,9 @@
 // over a recording, interval by interval of still data as a running board's would come: the
 // first --baseline seconds are the board's baseline, every later interval is compared with it,
 // and each effect is printed when first named and when gone. A run of still samples breaks at
-// a GAP or DROPPED line and at a moving sample (gyrod's `still` column, when the recording has
-// one); what does not fill an interval is left out.
+// a GAP or DROPPED line and at kLiveMotionBreakS of moving samples in a row (gyrod's `still`
+// column, when the recording has one); what does not fill an interval is left out.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -16,6 +17,7 @@
 
 #include "formats/recording_csv.hpp"
 #include "processing/model_check/live_check.hpp"
+#include "protocol/effect_line.hpp"
 #include "tools/gyroctl/commands.hpp"
 #include "tools/gyroctl/input.hpp"
 #include "tools/gyroctl/series_checks.hpp"
@@ -55,29 +57,6 @@ std::string effectText(const processing::LiveEffect& e) {
          g4(e.expected) + " expected), largest z " + g4(e.largest_z);
   }
   return s + ", onset " + g4(e.onset_t) + " s " + range(e.onset_95) + "; " + e.evidence;
-}
-
-nlohmann::json pair(const processing::LiveInterval95& i) { return nlohmann::json::array({i.lo, i.hi}); }
-
-// One change as a JSON line, full precision.
-nlohmann::json effectJson(const processing::LiveEffect& e) {
-  nlohmann::json params = nlohmann::json::object();
-  if (e.kind == processing::LiveEffectKind::Line) {
-    params = {{"centre_hz", e.centre_hz}, {"centre_hz_95", pair(e.centre_hz_95)}, {"width_hz", e.width_hz},
-              {"rms_dps", e.rms_dps},     {"rms_dps_95", pair(e.rms_dps_95)},     {"power_ratio", e.power_ratio}};
-    if (e.baseline_rms_dps > 0.0) params["baseline_rms_dps"] = e.baseline_rms_dps;
-  } else {
-    params = {{"count", e.count}, {"expected", e.expected}, {"largest_z", e.largest_z}};
-  }
-  return {{"class", "EFFECT"},
-          {"state", e.gone ? "gone" : "new"},
-          {"effect", processing::liveEffectName(e.kind)},
-          {"axis", std::string(1, axisName(e.axis))},
-          {"t", e.t},
-          {"onset_t", e.onset_t},
-          {"onset_t_95", pair(e.onset_95)},
-          {"params", params},
-          {"evidence", e.evidence}};
 }
 
 const std::vector<double>& gyroColumn(const recording::Recording& rec, std::size_t axis) {
@@ -120,6 +99,9 @@ int runLiveCheck(const LiveCheckOptions& opt) {
   double run_start_t = 0.0;
   std::size_t run_samples = 0;  // since the run began: the nominal clock of its intervals
   std::size_t changes_printed = 0;
+  std::size_t moving_in_a_row = 0;
+  const auto motion_break =
+      std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(processing::kLiveMotionBreakS * in.rate_hz)));
   const auto sampleTime = [&](std::size_t i) { return rec.t.empty() ? static_cast<double>(i) / in.rate_hz : rec.t[i]; };
   const auto breakRun = [&] {
     left_out += interval[0].size();
@@ -133,10 +115,12 @@ int runLiveCheck(const LiveCheckOptions& opt) {
       ++lost_index;
     }
     if (lost_before) breakRun();
-    const bool moving = !rec.still.empty() && !(rec.still[i] == 1.0);
+    // A stretch of moving verdicts of kLiveMotionBreakS breaks the run; shorter ones stay in
+    // (a still detector flickers at rest).
+    moving_in_a_row = (!rec.still.empty() && !(rec.still[i] == 1.0)) ? moving_in_a_row + 1 : 0;
     const bool finite = std::isfinite((*gyro[0])[i]) && std::isfinite((*gyro[1])[i]) && std::isfinite((*gyro[2])[i]);
-    if (moving || !finite) {
-      breakRun();
+    if (moving_in_a_row >= motion_break || !finite) {
+      if (moving_in_a_row == motion_break || !finite) breakRun();
       ++left_out;
       continue;
     }
@@ -146,7 +130,7 @@ int runLiveCheck(const LiveCheckOptions& opt) {
     if (interval[0].size() < n) continue;
     const double t0 = run_start_t + static_cast<double>(run_samples - n) / in.rate_hz;
     for (const processing::LiveEffect& e : check.examine(interval, t0)) {
-      std::printf("%s\n", opt.json ? effectJson(e).dump().c_str() : effectText(e).c_str());
+      std::printf("%s\n", opt.json ? protocol::effectJson(e).dump().c_str() : effectText(e).c_str());
       ++changes_printed;
     }
     ++examined;
@@ -157,7 +141,7 @@ int runLiveCheck(const LiveCheckOptions& opt) {
       std::min(examined, static_cast<std::size_t>(std::ceil(opt.baseline_s / opt.interval_s - 1e-9)));
   if (opt.json) {
     nlohmann::json current = nlohmann::json::array();
-    for (const processing::LiveEffect& e : check.current()) current.push_back(effectJson(e));
+    for (const processing::LiveEffect& e : check.current()) current.push_back(protocol::effectJson(e));
     std::printf("%s\n", nlohmann::json{{"class", "SUMMARY"},
                                        {"intervals", examined},
                                        {"baseline_intervals", baseline},
