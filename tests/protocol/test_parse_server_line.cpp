@@ -158,6 +158,8 @@ TEST(ParseServerLine, StatusRoundTripsEveryField) {
   d.recording = "/var/lib/gyrod/gyro.csv";
   d.mqtt = MqttStatus{true, 12, 3, "TLS handshake failed: certificate verify failed"};
   d.calibration_state = CalibrationStateStatus{"/var/lib/gyrod/calibration.toml", true, 7, ""};
+  // The current effects travel as their EFFECT objects (compact JSON, keys sorted).
+  d.live_check = LiveCheckStatus{12, true, 2, 1, {R"({"axis":"y","class":"EFFECT","effect":"line","state":"new"})"}};
   ServerStatus s;
   s.clients = 2;
   s.clients_total = 5;
@@ -176,6 +178,7 @@ TEST(ParseServerLine, StatusRoundTripsEveryField) {
   EXPECT_EQ(back.daemon.rate_hz, d.rate_hz);
   EXPECT_EQ(back.daemon.mqtt, d.mqtt);
   EXPECT_EQ(back.daemon.calibration_state, d.calibration_state);
+  EXPECT_EQ(back.daemon.live_check, d.live_check);
   EXPECT_EQ(back.server.client_list.size(), 2u);
   EXPECT_EQ(back.server.client_list[0].pid, 4242);
   EXPECT_FALSE(back.server.client_list[1].pid.has_value());
