@@ -9,6 +9,7 @@
 #include <cmath>
 #include <csignal>
 #include <filesystem>
+#include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -78,6 +79,10 @@ TEST(GyrodLiveCheck, AVibrationThatStartsReachesWatchersStatusAndTheJournal) {
   // still detector's flicker leaves an interval out now and then), its onset's interval holding
   // the start.
   const double named_at = effect["t"].get<double>() - mock_start;
+  std::cout << "12.5 Hz from " << kLiveOnsetS << " s of data: named at " << named_at << " s, onset "
+            << effect["onset_t"].get<double>() - mock_start << " s ("
+            << effect["onset_t_95"][0].get<double>() - mock_start << "-"
+            << effect["onset_t_95"][1].get<double>() - mock_start << ")\n";
   EXPECT_GT(named_at, kLiveOnsetS) << effect;
   EXPECT_LE(named_at, kLiveOnsetS + 300.0 + 1.0) << effect;
   EXPECT_LE(effect["onset_t_95"][0].get<double>() - mock_start, kLiveOnsetS + 1.0) << effect;
