@@ -52,6 +52,14 @@ SimulationModel cleanBoard() {
   return m;
 }
 
+LiveCheckSettings settings(double rate_hz, double interval_s, double baseline_s) {
+  LiveCheckSettings s;
+  s.rate_hz = rate_hz;
+  s.interval_s = interval_s;
+  s.baseline_s = baseline_s;
+  return s;
+}
+
 // The line mode (see above); returns the exit status.
 int lineDelays(std::size_t boards, std::uint64_t seed, double interval, double baseline) {
   const SimulationModel model = cleanBoard();
@@ -62,11 +70,7 @@ int lineDelays(std::size_t boards, std::uint64_t seed, double interval, double b
   double worst_centre = 0.0;
   std::vector<double> delays;
   for (std::size_t b = 0; b < boards; ++b) {
-    LiveCheckSettings s;
-    s.rate_hz = model.rate_hz;
-    s.interval_s = interval;
-    s.baseline_s = baseline;
-    LiveCheck check(s);
+    LiveCheck check(settings(model.rate_hz, interval, baseline));
     NoiseSimulator sim(model, kDuration, seed + b);
     const std::size_t axis = (seed + b) % 3, n = check.samplesPerInterval();
     std::array<std::vector<double>, 3> axes;
@@ -131,11 +135,7 @@ int main(int argc, char** argv) {
   std::size_t named = 0, board_weeks = 0;
   double check_cpu = 0.0, data_s = 0.0;
   for (double done = 0.0; done + 1e-9 < weeks; done += 1.0, ++board_weeks) {
-    LiveCheckSettings s;
-    s.rate_hz = model.rate_hz;
-    s.interval_s = interval;
-    s.baseline_s = baseline;
-    LiveCheck check(s);
+    LiveCheck check(settings(model.rate_hz, interval, baseline));
     NoiseSimulator sim(model, kWeek, seed + board_weeks);
     const std::size_t n = check.samplesPerInterval();
     const auto intervals = static_cast<std::size_t>(kWeek / interval);
