@@ -8,7 +8,8 @@
 // Any sample-loop turn longer than that loses samples, which a watching client sees as a GAP
 // line. Asserts none, contiguous sequence numbers, a loop turn far inside the FIFO, and the
 // watcher's edge → line latency. A loss is gyrod's unless one CPU of the machine itself stood
-// still for half a FIFO or more in the two FIFOs' time before it, in one stop or in many:
+// still for half a FIFO or more in the two FIFOs' time before it, in one stop or in many, or
+// a stop of half a FIFO ended in the 0.5 s before it:
 // probes above gyrod's priority time each CPU (machine_stall_probe.hpp), and on a virtual
 // machine with both CPUs busy the host stops a CPU for 5-15 ms now and then, or, on a crowded
 // host, for 2-7 ms a hundred times a second (docs/driver.md "Under a flood of requests").
@@ -73,8 +74,10 @@ std::string floodConfig(const std::filesystem::path& dir, const FloodSetup& setu
 // gyrod's log lines for a FIFO overflow ("2026-11-28 20:13:06.403 warning FIFO overflow on ...")
 // that the machine does not explain. The overflow happened in the two FIFOs' time before the
 // line; it is the machine's when one CPU stood still for half a FIFO or more of that time, in
-// one stop or in many short ones (MachineStallProbe::stolenMsBefore), gyrod's otherwise. The
-// stamp is local wall-clock time to the millisecond, as gyrod's log writes it.
+// one stop or in many short ones (MachineStallProbe::stolenMsBefore), or when a stop of half a
+// FIFO or more ended in the 0.5 s before the line (a long stop leaves the threads behind: the
+// delivery thread's backlog, a client thread stopped while it held the state lock); gyrod's
+// otherwise. The stamp is local wall-clock time to the millisecond, as gyrod's log writes it.
 std::string overflowsTheMachineDoesNotExplain(const std::string& log_text, const MachineStallProbe& machine,
                                               double fifo_ms) {
   static const std::regex kOverflow(R"(^(\d{4})-(\d{2})-(\d{2}) (\d{2}):(\d{2}):(\d{2})\.(\d{3}) \S+ FIFO overflow)");
@@ -94,8 +97,9 @@ std::string overflowsTheMachineDoesNotExplain(const std::string& log_text, const
     const double logged_s = static_cast<double>(std::mktime(&tm)) + std::stoi(m[7]) * 1e-3;
     const double at_s = machine.monotonicFromRealtime(logged_s) + 0.002;  // the stamp's truncation, and rounding
     const double stolen_ms = machine.stolenMsBefore(at_s, 2 * fifo_ms * 1e-3);
-    if (stolen_ms < fifo_ms / 2)
-      unexplained += line + " (one CPU stood still " + std::to_string(stolen_ms) + " ms before it)\n";
+    if (stolen_ms < fifo_ms / 2 && !machine.stalledBefore(at_s, 0.5, fifo_ms / 2))
+      unexplained += line + " (one CPU stood still " + std::to_string(stolen_ms) + " ms before it, no stop of " +
+                     std::to_string(fifo_ms / 2) + " ms in the 0.5 s before)\n";
   }
   return unexplained;
 }
