@@ -42,7 +42,8 @@ bool sameEffect(const processing::LiveEffect& a, const processing::LiveEffect& b
 
 LiveChecker::LiveChecker(EventLoop& loop, double device_rate_hz, double interval_s, double baseline_s,
                          double false_alarms_per_week, OnChange on_change)
-    : on_change_(std::move(on_change)),
+    : motion_(device_rate_hz),
+      on_change_(std::move(on_change)),
       job_(
           loop, [this](std::vector<processing::LiveEffect>&& changes) { applyChanges(std::move(changes)); },
           [this](const std::string& why) {
@@ -52,8 +53,6 @@ LiveChecker::LiveChecker(EventLoop& loop, double device_rate_hz, double interval
   decimation_ = static_cast<std::size_t>(std::ceil(device_rate_hz / kLiveCheckMaxRateHz - 1e-9));
   decimation_ = std::max<std::size_t>(1, decimation_);
   analysis_rate_hz_ = device_rate_hz / static_cast<double>(decimation_);
-  motion_break_ =
-      std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(processing::kLiveMotionBreakS * device_rate_hz)));
   processing::LiveCheckSettings s;
   s.rate_hz = analysis_rate_hz_;
   s.interval_s = interval_s;
@@ -74,9 +73,9 @@ void LiveChecker::breakRun() {
 }
 
 void LiveChecker::onSample(double t_s, const std::array<double, 3>& rate_dps, bool still) {
-  moving_ = still ? 0 : moving_ + 1;
-  if (moving_ >= motion_break_) {
-    if (moving_ == motion_break_) breakRun();
+  const auto verdict = motion_.next(still);
+  if (verdict != processing::LiveMotionRule::Verdict::Keep) {
+    if (verdict == processing::LiveMotionRule::Verdict::Break) breakRun();
     return;
   }
   if (summed_ == 0) block_start_t_ = t_s;

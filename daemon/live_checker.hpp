@@ -60,8 +60,8 @@ class LiveChecker {
   std::size_t summed_ = 0;
   double block_start_t_ = 0.0;
   double run_start_t_ = 0.0;
-  std::uint64_t run_samples_ = 0;              // analysis samples since the run began
-  std::size_t moving_ = 0, motion_break_ = 1;  // moving verdicts in a row; kLiveMotionBreakS of them
+  std::uint64_t run_samples_ = 0;  // analysis samples since the run began
+  processing::LiveMotionRule motion_;
   OnChange on_change_;
   OffLoopJob<std::vector<processing::LiveEffect>> job_;
   std::uint64_t intervals_ = 0, named_ = 0, skipped_ = 0;

@@ -160,6 +160,15 @@ std::pair<double, double> estimateLineOnset(std::span<const double> x, double ce
 
 }  // namespace
 
+LiveMotionRule::LiveMotionRule(double rate_hz)
+    : limit_(std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(kLiveMotionBreakS * rate_hz)))) {}
+
+LiveMotionRule::Verdict LiveMotionRule::next(bool still) {
+  moving_ = still ? 0 : moving_ + 1;
+  if (moving_ < limit_) return Verdict::Keep;
+  return moving_ == limit_ ? Verdict::Break : Verdict::Skip;
+}
+
 const char* liveEffectName(LiveEffectKind kind) {
   switch (kind) {
     case LiveEffectKind::Line: return "line";

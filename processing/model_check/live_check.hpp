@@ -33,6 +33,19 @@ inline constexpr double kLiveOutlierZ = 8.0;
 // verdicts this long breaks the run of still data (the interval it falls in is left out);
 // shorter ones stay in.
 inline constexpr double kLiveMotionBreakS = 1.0;
+
+// That rule, per sample at `rate_hz`: Keep a still sample or one of a short moving stretch,
+// Break at the sample that makes the stretch kLiveMotionBreakS long (the run of still data
+// ends), Skip the moving samples after it.
+class LiveMotionRule {
+ public:
+  enum class Verdict { Keep, Break, Skip };
+  explicit LiveMotionRule(double rate_hz);
+  Verdict next(bool still);
+
+ private:
+  std::size_t moving_ = 0, limit_ = 1;
+};
 inline constexpr double kLiveLineGrowth = 2.0;
 
 struct LiveCheckSettings {

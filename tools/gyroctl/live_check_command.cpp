@@ -99,9 +99,7 @@ int runLiveCheck(const LiveCheckOptions& opt) {
   double run_start_t = 0.0;
   std::size_t run_samples = 0;  // since the run began: the nominal clock of its intervals
   std::size_t changes_printed = 0;
-  std::size_t moving_in_a_row = 0;
-  const auto motion_break =
-      std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(processing::kLiveMotionBreakS * in.rate_hz)));
+  processing::LiveMotionRule motion(in.rate_hz);
   const auto sampleTime = [&](std::size_t i) { return rec.t.empty() ? static_cast<double>(i) / in.rate_hz : rec.t[i]; };
   const auto breakRun = [&] {
     left_out += interval[0].size();
@@ -117,10 +115,10 @@ int runLiveCheck(const LiveCheckOptions& opt) {
     if (lost_before) breakRun();
     // A stretch of moving verdicts of kLiveMotionBreakS breaks the run; shorter ones stay in
     // (a still detector flickers at rest).
-    moving_in_a_row = (!rec.still.empty() && !(rec.still[i] == 1.0)) ? moving_in_a_row + 1 : 0;
+    const auto verdict = motion.next(rec.still.empty() || rec.still[i] == 1.0);
     const bool finite = std::isfinite((*gyro[0])[i]) && std::isfinite((*gyro[1])[i]) && std::isfinite((*gyro[2])[i]);
-    if (moving_in_a_row >= motion_break || !finite) {
-      if (moving_in_a_row == motion_break || !finite) breakRun();
+    if (verdict != processing::LiveMotionRule::Verdict::Keep || !finite) {
+      if (verdict == processing::LiveMotionRule::Verdict::Break || !finite) breakRun();
       ++left_out;
       continue;
     }
