@@ -219,6 +219,7 @@ void Gyrod::queueEffect(const processing::LiveEffect& e) {
     const std::lock_guard lock(effects_mutex_);
     effect_lines_.push_back(std::move(line));
   }
+  effects_queued_.fetch_add(1, std::memory_order_release);
   clients_to_wake_ = true;
   wakeDeliveryThread();
 }
@@ -673,11 +674,13 @@ void Gyrod::publishQueuedLines() {
     else
       server_->publishGap({line.gap_first_seq, line.gap_count, std::string_view(line.gap_reason.data())});
   }
+  if (effects_queued_.load(std::memory_order_acquire) == 0) return;  // no lock on the per-sample path
   std::vector<std::string> effects;
   {
     const std::lock_guard lock(effects_mutex_);
     effects.swap(effect_lines_);
   }
+  effects_queued_.fetch_sub(effects.size(), std::memory_order_relaxed);
   for (const std::string& e : effects) server_->publishEffect(e);
 }
 

@@ -138,6 +138,7 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   // sample thread appends, the delivery thread takes them all; each holds it for a move.
   PriorityInheritanceMutex effects_mutex_;
   std::vector<std::string> effect_lines_;
+  std::atomic<std::size_t> effects_queued_{0};  // the delivery thread takes the mutex only when > 0
   NoiseRefitWorker noise_refit_;
   AllanReplyCache allan_reply_;
   std::unique_ptr<UnixSocketServer> server_;
