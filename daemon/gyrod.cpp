@@ -198,9 +198,13 @@ std::string Gyrod::startCalibrationKeeper() {
 // [check] enabled: the live check on the still samples, when filter.model gives the still
 // detector (without it a moving board would be compared with its still baseline).
 void Gyrod::startLiveCheck() {
-  if (!config_.check.enabled) return;
+  if (!config_.check.enabled) {
+    live_check_off_ = "[check] enabled = false";
+    return;
+  }
   if (pipeline_.rateModel() != RateModel::SensorModel) {
-    spdlog::info("live check: off (it runs on still samples, and the still detector needs filter.model)");
+    live_check_off_ = "it runs on still samples, and the still detector needs filter.model";
+    spdlog::info("live check: off ({})", live_check_off_);
     return;
   }
   live_ = std::make_unique<LiveChecker>(loop_, config_.device.rate_hz, config_.check.interval_s,
@@ -981,6 +985,16 @@ StatusReport Gyrod::statusReport() {
                                                            calibration_->writes(), calibration_->lastError()};
   if (live_) r.live_check = live_->status();
   return r;
+}
+
+// The live check's part of STATUS, copied under the same lock.
+protocol::EffectsReport Gyrod::effectsReport() {
+  std::optional<protocol::LiveCheckStatus> live_check;
+  {
+    const std::lock_guard state(state_mutex_);
+    if (live_) live_check = live_->status();
+  }
+  return protocol::effectsReportOf(live_check, live_check_off_);
 }
 
 }  // namespace gyrod::daemon

@@ -86,6 +86,7 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   AllanReport allanReport() override;
   std::string allanReplyLine() override;
   StatusReport statusReport() override;
+  protocol::EffectsReport effectsReport() override;
 
  private:
   static LoadedRateModel loadRateModel(const GyrodConfig& config);
@@ -134,6 +135,7 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   SamplePipeline pipeline_;
   std::unique_ptr<CalibrationKeeper> calibration_;  // with a state directory
   std::unique_ptr<LiveChecker> live_;               // [check] enabled, with filter.model's still detector
+  std::string live_check_off_;                      // without live_: why (set before the threads start)
   // EFFECT lines from the sample thread to the delivery thread (a few an hour at most): the
   // sample thread appends, the delivery thread takes them all; each holds it for a move.
   PriorityInheritanceMutex effects_mutex_;

@@ -343,6 +343,15 @@ void UnixSocketServer::handleLine(Client& c, std::string_view line) {
         reply = errorLine(ErrorCode::Internal, std::string("the daemon could not produce ALLAN: ") + e.what());
       }
       queueReply(c, std::move(reply));
+    } else if (std::holds_alternative<EffectsRequest>(request)) {
+      std::string reply;
+      try {
+        reply = effectsLine(content_.effectsReport());
+      } catch (const std::exception& e) {
+        spdlog::error("EFFECTS reply for client {} failed: {}", c.id, e.what());
+        reply = errorLine(ErrorCode::Internal, std::string("the daemon could not produce EFFECTS: ") + e.what());
+      }
+      queueReply(c, std::move(reply));
     } else {
       std::string reply;
       try {

@@ -98,7 +98,7 @@ ListeningSocket openListeningSocket(const SocketOptions& options);
 // O_NONBLOCK and FD_CLOEXEC on `fd`; throws std::system_error.
 void setNonBlockingCloseOnExec(int fd);
 
-// What the daemon answers to "allan" and "status". Not on the per-sample path: may
+// What the daemon answers to "allan", "status" and "effects". Not on the per-sample path: may
 // allocate. An exception thrown here becomes an ERROR "internal" line for that client.
 class ServerContent {
  public:
@@ -108,6 +108,11 @@ class ServerContent {
   // serves a line cached at each noise refit instead (daemon/allan_reply_cache.hpp).
   virtual std::string allanReplyLine() { return protocol::allanLine(allanReport()); }
   virtual StatusReport statusReport() = 0;
+  // The reply to "effects": by default what statusReport() says of the live check; gyrod reads
+  // only the live check's part, under the lock STATUS takes, and says why it is off.
+  virtual protocol::EffectsReport effectsReport() {
+    return protocol::effectsReportOf(statusReport().live_check, "the daemon does not run the live check");
+  }
 };
 
 struct ServerOptions {

@@ -290,6 +290,21 @@ StatusReply statusOf(const json& j) {
   return r;
 }
 
+EffectsReport effectsOf(const json& j) {
+  constexpr std::string_view cls = "EFFECTS";
+  EffectsReport r;
+  r.live_check = required(field(j, cls, "live_check", &json::is_string, "a string"), cls, "live_check") == "on";
+  r.reason = optionalText(j, cls, "reason").value_or("");
+  r.baseline_ready = optionalFlag(j, cls, "baseline_ready").value_or(false);
+  if (j.contains("intervals")) r.intervals = count(j, cls, "intervals");
+  if (const json* effects = field(j, cls, "effects", &json::is_array, "an array"))
+    for (const json& e : *effects) {
+      if (!e.is_object()) malformed(cls, "effects must hold objects");
+      r.effects.push_back(e.dump());
+    }
+  return r;
+}
+
 }  // namespace
 
 ServerMessage parseServerLine(std::string_view line) {
@@ -311,6 +326,7 @@ ServerMessage parseServerLine(std::string_view line) {
   if (cls == "ERROR") return ErrorReply{optionalText(j, cls, "code").value_or(""), optionalText(j, cls, "message")};
   if (cls == "ALLAN") return allanOf(j);
   if (cls == "STATUS") return statusOf(j);
+  if (cls == "EFFECTS") return effectsOf(j);
   return OtherClass{cls};
 }
 

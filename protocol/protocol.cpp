@@ -333,10 +333,40 @@ std::string statusLine(const StatusReport& d, const ServerStatus& s) {
   return json(j).dump(-1, ' ', false, json::error_handler_t::replace) + '\n';
 }
 
+EffectsReport effectsReportOf(const std::optional<LiveCheckStatus>& live_check, std::string off_reason) {
+  EffectsReport r;
+  if (!live_check) {
+    r.reason = std::move(off_reason);
+    return r;
+  }
+  r.live_check = true;
+  r.baseline_ready = live_check->baseline_ready;
+  r.intervals = live_check->intervals;
+  r.effects = live_check->current;
+  return r;
+}
+
+std::string effectsLine(const EffectsReport& r) {
+  json j = {{"class", "EFFECTS"}, {"live_check", r.live_check ? "on" : "off"}};
+  if (!r.reason.empty()) j["reason"] = r.reason;
+  if (r.live_check) {
+    j["baseline_ready"] = r.baseline_ready;
+    j["intervals"] = r.intervals;
+  }
+  json effects = json::array();
+  for (const std::string& e : r.effects) {
+    json object = json::parse(e, nullptr, false);
+    if (object.is_object()) effects.push_back(std::move(object));  // never a line that is not JSON
+  }
+  j["effects"] = std::move(effects);
+  return j.dump(-1, ' ', false, json::error_handler_t::replace) + '\n';
+}
+
 std::string requestLine(const Request& request) {
   if (const auto* w = std::get_if<WatchRequest>(&request))
     return json({{"cmd", "watch"}, {"enable", w->enable}, {"decimate", w->decimate}}).dump();
   if (std::holds_alternative<AllanRequest>(request)) return R"({"cmd":"allan"})";
+  if (std::holds_alternative<EffectsRequest>(request)) return R"({"cmd":"effects"})";
   return R"({"cmd":"status"})";
 }
 
@@ -432,7 +462,12 @@ Request parseRequest(std::string_view line) {
     rejectOtherFields({});
     return StatusRequest{};
   }
-  throw ProtocolError(ErrorCode::UnknownCommand, "unknown cmd " + quotedText(cmd) + " (known: watch, allan, status)");
+  if (cmd == "effects") {
+    rejectOtherFields({});
+    return EffectsRequest{};
+  }
+  throw ProtocolError(ErrorCode::UnknownCommand,
+                      "unknown cmd " + quotedText(cmd) + " (known: watch, allan, status, effects)");
 }
 
 }  // namespace gyrod::protocol

@@ -23,7 +23,7 @@
 namespace gyrod::protocol {
 
 inline constexpr int kProtocolMajor = 1;  // incompatible changes
-inline constexpr int kProtocolMinor = 7;  // compatible additions (new classes, new fields)
+inline constexpr int kProtocolMinor = 8;  // compatible additions (new classes, new fields)
 
 // A client line longer than this (not counting the '\n' and an optional '\r') is refused
 // with an ERROR and the client is disconnected.
@@ -184,6 +184,21 @@ struct LiveCheckStatus {
   bool operator==(const LiveCheckStatus&) const = default;
 };
 
+// The reply to "effects" (EFFECTS): the effects the live check names now. While gyrod does not
+// run the check, `live_check` is false and `reason` says why; the list is then empty.
+struct EffectsReport {
+  bool live_check = false;           // gyrod runs the live check
+  std::string reason;                // why it does not; empty (omitted) while it does
+  bool baseline_ready = false;       // with live_check: later intervals are compared with the baseline
+  std::uint64_t intervals = 0;       // with live_check: intervals of still data examined
+  std::vector<std::string> effects;  // each effect now named, as its EFFECT line's JSON object
+  bool operator==(const EffectsReport&) const = default;
+};
+// The reply from what STATUS says of the live check (none: not running, for `off_reason`).
+EffectsReport effectsReportOf(const std::optional<LiveCheckStatus>& live_check, std::string off_reason);
+// {"class":"EFFECTS","live_check":"on"|"off",["reason"],["baseline_ready","intervals"],"effects":[...]}
+std::string effectsLine(const EffectsReport& report);
+
 // The verdict on the start-up still period (STATUS "still_check", docs/protocol.md).
 enum class StillCheck {
   Pending,        // the still period is being collected
@@ -286,8 +301,8 @@ struct StatusReply {
 struct OtherClass {
   std::string name;
 };
-using ServerMessage =
-    std::variant<VersionReply, WatchReply, RateSample, GapNotice, AllanReport, StatusReply, ErrorReply, OtherClass>;
+using ServerMessage = std::variant<VersionReply, WatchReply, RateSample, GapNotice, AllanReport, StatusReply,
+                                   EffectsReport, ErrorReply, OtherClass>;
 
 // Parses one server line (without its '\n'). Throws MalformedLine.
 ServerMessage parseServerLine(std::string_view line);
@@ -300,7 +315,8 @@ struct WatchRequest {
 };
 struct AllanRequest {};
 struct StatusRequest {};
-using Request = std::variant<WatchRequest, AllanRequest, StatusRequest>;
+struct EffectsRequest {};
+using Request = std::variant<WatchRequest, AllanRequest, StatusRequest, EffectsRequest>;
 
 // A client line that is not a valid request: what the ERROR line will say.
 class ProtocolError : public std::invalid_argument {

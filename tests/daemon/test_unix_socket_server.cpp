@@ -37,7 +37,7 @@ TEST_F(ServerTest, VersionOnConnect) {
   TestClient c(socketPath());
   const json v = c.readObject(loop_);
   EXPECT_EQ(v, json::parse(std::string(R"({"class":"VERSION","release":")") + GYROD_RELEASE +
-                           R"(","proto_major":1,"proto_minor":7})"));
+                           R"(","proto_major":1,"proto_minor":8})"));
   EXPECT_EQ(server_->clientCount(), 1u);
 }
 
@@ -148,15 +148,19 @@ TEST_F(ServerTest, ContentFailureBecomesAnErrorAndTheClientStays) {
   startServer();
   auto c = connect();
   content_.fail = true;
-  c->send("{\"cmd\":\"allan\"}\n{\"cmd\":\"status\"}\n");
+  c->send("{\"cmd\":\"allan\"}\n{\"cmd\":\"status\"}\n{\"cmd\":\"effects\"}\n");
   const json e1 = c->readObject(loop_);
   const json e2 = c->readObject(loop_);
+  const json e3 = c->readObject(loop_);
   EXPECT_EQ(e1["code"], "internal");
   EXPECT_NE(e1["message"].get<std::string>().find("statistics not available"), std::string::npos);
   EXPECT_EQ(e2["code"], "internal");
+  EXPECT_EQ(e3["code"], "internal");
+  EXPECT_NE(e3["message"].get<std::string>().find("could not produce EFFECTS"), std::string::npos);
   content_.fail = false;
-  c->send("{\"cmd\":\"status\"}\n");
+  c->send("{\"cmd\":\"status\"}\n{\"cmd\":\"effects\"}\n");
   EXPECT_EQ(c->readObject(loop_)["class"], "STATUS");
+  EXPECT_EQ(c->readObject(loop_)["class"], "EFFECTS");
 }
 
 TEST_F(ServerTest, BadRequestsGetNamedErrorsAndTheClientStays) {

@@ -210,10 +210,13 @@ TEST(ParseServerLine, UnknownClassesAreNamedNotRefused) {
 }
 
 TEST(ParseServerLine, LinesThatBreakTheProtocolAreRefused) {
-  for (const char* bad : {"", "not json", "[1,2]", R"({"seq":1})", R"({"class":3})", R"({"class":"RATE"})",
-                          R"({"class":"RATE","seq":-1})", R"({"class":"RATE","seq":1,"raw":[1,2]})",
-                          R"({"class":"RATE","seq":1,"t":"soon"})", R"({"class":"GAP","seq":1,"count":2})",
-                          R"({"class":"ALLAN","samples":3,"tau":[1,2],"adev":{"x":{"raw":[1]}}})"}) {
+  for (const char* bad :
+       {"", "not json", "[1,2]", R"({"seq":1})", R"({"class":3})", R"({"class":"RATE"})",
+        R"({"class":"RATE","seq":-1})", R"({"class":"RATE","seq":1,"raw":[1,2]})",
+        R"({"class":"RATE","seq":1,"t":"soon"})", R"({"class":"GAP","seq":1,"count":2})",
+        R"({"class":"ALLAN","samples":3,"tau":[1,2],"adev":{"x":{"raw":[1]}}})", R"({"class":"EFFECTS","effects":[]})",
+        R"({"class":"EFFECTS","live_check":true})", R"({"class":"EFFECTS","live_check":"on","effects":[3]})",
+        R"({"class":"EFFECTS","live_check":"on","intervals":-1})"}) {
     EXPECT_THROW(parseServerLine(bad), MalformedLine) << bad;
   }
 }
@@ -225,6 +228,24 @@ TEST(RequestLine, ParsesBackToTheSameRequest) {
   EXPECT_EQ(std::get<WatchRequest>(watch).decimate, 25u);
   EXPECT_TRUE(std::holds_alternative<AllanRequest>(parseRequest(requestLine(AllanRequest{}))));
   EXPECT_TRUE(std::holds_alternative<StatusRequest>(parseRequest(requestLine(StatusRequest{}))));
+  EXPECT_TRUE(std::holds_alternative<EffectsRequest>(parseRequest(requestLine(EffectsRequest{}))));
+}
+
+TEST(ParseServerLine, EffectsRoundTripsOnAndOff) {
+  EffectsReport on;
+  on.live_check = true;
+  on.baseline_ready = true;
+  on.intervals = 14;
+  on.effects = {R"({"class":"EFFECT","state":"new","effect":"line","axis":"y","params":{"centre_hz":12.5}})",
+                R"({"class":"EFFECT","state":"new","effect":"some_later_kind","axis":"x","params":{}})"};
+  EXPECT_EQ(parsed<EffectsReport>(effectsLine(on)), on);
+  EffectsReport off;
+  off.reason = "it runs on still samples, and the still detector needs filter.model";
+  EXPECT_EQ(parsed<EffectsReport>(effectsLine(off)), off);
+  // Fields of a later minor version are ignored.
+  EXPECT_EQ(
+      parsed<EffectsReport>(R"({"class":"EFFECTS","live_check":"on","intervals":2,"effects":[],"next":1})").intervals,
+      2u);
 }
 
 TEST(ParseServerLine, RateBiasAndStillRoundTripBitForBit) {

@@ -163,7 +163,7 @@ TEST(ProtocolGap, FormatsAndRejectsMalformedGaps) {
 TEST(ProtocolReplies, VersionAndWatch) {
   const std::string v = versionLine("1.2.3");
   ASSERT_EQ(v.back(), '\n');
-  EXPECT_EQ(json::parse(v), json::parse(R"({"class":"VERSION","release":"1.2.3","proto_major":1,"proto_minor":7})"));
+  EXPECT_EQ(json::parse(v), json::parse(R"({"class":"VERSION","release":"1.2.3","proto_major":1,"proto_minor":8})"));
   EXPECT_EQ(json::parse(watchLine(false, 5)), json::parse(R"({"class":"WATCH","enable":false,"decimate":5})"));
 }
 
@@ -239,6 +239,27 @@ TEST(ProtocolReplies, StatusOmitsUnknownFieldsAndListsClients) {
   EXPECT_EQ(j, expected);
 }
 
+// EFFECTS: the live check's current effects as their EFFECT objects, or "off" and why.
+TEST(ProtocolReplies, EffectsListsTheCurrentEffectsOrSaysTheCheckIsOff) {
+  LiveCheckStatus live{9, true, 3, 1, {R"({"class":"EFFECT","state":"new","effect":"line","axis":"y","t":4200.0})"}};
+  const std::string on = effectsLine(effectsReportOf(live, "unused while it runs"));
+  ASSERT_EQ(on.back(), '\n');
+  EXPECT_EQ(json::parse(on), json::parse(R"({"class":"EFFECTS","live_check":"on","baseline_ready":true,"intervals":9,
+    "effects":[{"class":"EFFECT","state":"new","effect":"line","axis":"y","t":4200.0}]})"));
+  EXPECT_EQ(on.find(R"({"class":"EFFECTS","live_check":"on")"), 0u) << on;  // class first, as in every line
+  live.current.clear();
+  live.baseline_ready = false;
+  EXPECT_EQ(json::parse(effectsLine(effectsReportOf(live, ""))),
+            json::parse(R"({"class":"EFFECTS","live_check":"on","baseline_ready":false,"intervals":9,"effects":[]})"));
+  EXPECT_EQ(json::parse(effectsLine(effectsReportOf(std::nullopt, "[check] enabled = false"))),
+            json::parse(R"({"class":"EFFECTS","live_check":"off","reason":"[check] enabled = false","effects":[]})"));
+  // A list entry that is not a JSON object is left out: the line stays valid JSON.
+  EffectsReport odd;
+  odd.live_check = true;
+  odd.effects = {"not json", R"({"class":"EFFECT"})"};
+  EXPECT_EQ(json::parse(effectsLine(odd))["effects"], json::parse(R"([{"class":"EFFECT"}])"));
+}
+
 TEST(ProtocolRequests, ValidRequests) {
   const Request w = parseRequest(R"({"cmd":"watch","enable":true})");
   ASSERT_TRUE(std::holds_alternative<WatchRequest>(w));
@@ -250,6 +271,7 @@ TEST(ProtocolRequests, ValidRequests) {
   EXPECT_TRUE(std::get<WatchRequest>(parseRequest(R"({"cmd":"watch"})")).enable);  // documented default
   EXPECT_TRUE(std::holds_alternative<AllanRequest>(parseRequest(R"({"cmd":"allan"})")));
   EXPECT_TRUE(std::holds_alternative<StatusRequest>(parseRequest(R"({"cmd":"status"})")));
+  EXPECT_TRUE(std::holds_alternative<EffectsRequest>(parseRequest(R"({"cmd":"effects"})")));
 }
 
 TEST(ProtocolRequests, EachProblemIsNamed) {
@@ -267,6 +289,7 @@ TEST(ProtocolRequests, EachProblemIsNamed) {
       {R"({"cmd":7})", ErrorCode::BadType, "\"cmd\" must be a string, got number"},
       {R"({"cmd":"reboot"})", ErrorCode::UnknownCommand, "unknown cmd \"reboot\""},
       {R"({"cmd":"status","verbose":true})", ErrorCode::UnknownField, "\"status\" takes no field \"verbose\""},
+      {R"({"cmd":"effects","axis":"y"})", ErrorCode::UnknownField, "\"effects\" takes no field \"axis\""},
       {R"({"cmd":"watch","enabel":true})", ErrorCode::UnknownField, "no field \"enabel\""},
       {R"({"cmd":"watch","enable":"yes"})", ErrorCode::BadType, "\"enable\" must be true or false, got string"},
       {R"({"cmd":"watch","enable":1})", ErrorCode::BadType, "\"enable\" must be true or false, got number"},
@@ -318,7 +341,7 @@ TEST(ProtocolRequests, ControlBytesRefuseTheWholeLine) {
     ADD_FAILURE() << "an escaped NUL in cmd was accepted";
   } catch (const ProtocolError& e) {
     EXPECT_EQ(e.code(), ErrorCode::UnknownCommand);
-    EXPECT_EQ(std::string(e.what()), R"(unknown cmd "bogus\u0000x" (known: watch, allan, status))");
+    EXPECT_EQ(std::string(e.what()), R"(unknown cmd "bogus\u0000x" (known: watch, allan, status, effects))");
   }
 }
 

@@ -1,6 +1,7 @@
 // docs/protocol.md lists names the code defines: the STATUS fields, the device states, the
-// gap reasons, the driver counters, the still checks, and the ALLAN and Allan-table fields. Each list is read from the page and compared with
-// what the code sends, so neither can change without the other.
+// gap reasons, the driver counters, the still checks, the ALLAN and Allan-table fields, the
+// EFFECTS fields, the requests and the MQTT topics. Each list is read from the page and compared
+// with what the code sends or takes, so neither can change without the other.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -235,4 +236,45 @@ TEST(ProtocolDoc, MqttTopicsAreTheOnesPublished) {
       std::string(protocol::kMqttGapTopic),    std::string(protocol::kMqttSummaryTopic),
       std::string(protocol::kMqttAllanTopic),  std::string(protocol::kMqttModelTopic)};
   EXPECT_EQ(documented, published);
+}
+
+TEST(ProtocolDoc, EffectsFieldsAreTheOnesSent) {
+  protocol::LiveCheckStatus live{3, true, 1, 0, {R"({"class":"EFFECT","state":"new"})"}};
+  std::set<std::string> sent;
+  for (const auto& line : {protocol::effectsLine(protocol::effectsReportOf(live, "")),
+                           protocol::effectsLine(protocol::effectsReportOf(std::nullopt, "why"))}) {
+    const nlohmann::json reply = nlohmann::json::parse(line);
+    for (const auto& [key, value] : reply.items()) sent.insert(key);
+  }
+  EXPECT_EQ(firstColumnNames(section(readDoc(), "### EFFECTS")), sent);
+}
+
+// The request table names every command the parser takes (its unknown_cmd message lists them)
+// and the ERROR table's unknown_cmd row names them too.
+TEST(ProtocolDoc, RequestsAreTheOnesTheServerTakes) {
+  std::string known;
+  try {
+    protocol::parseRequest(R"({"cmd":"zz_no_such_command"})");
+  } catch (const protocol::ProtocolError& e) {
+    known = e.what();
+  }
+  const std::size_t open = known.find("(known: ");
+  ASSERT_NE(open, std::string::npos) << known;
+  std::set<std::string> taken;
+  std::istringstream list(known.substr(open + 8, known.rfind(')') - open - 8));
+  for (std::string name; std::getline(list, name, ',');) taken.insert(name.substr(name.find_first_not_of(' ')));
+  std::set<std::string> documented;
+  const std::string requests = section(readDoc(), "## Client → server");
+  std::istringstream lines(requests);
+  for (std::string line; std::getline(lines, line);) {
+    const std::string marker = R"(| `{"cmd":")";
+    if (line.rfind(marker, 0) != 0) continue;
+    documented.insert(line.substr(marker.size(), line.find('"', marker.size()) - marker.size()));
+  }
+  EXPECT_EQ(documented, taken);
+  std::string unknown_cmd_row;
+  std::istringstream errors(section(readDoc(), "### ERROR"));
+  for (std::string line; std::getline(errors, line);)
+    if (line.rfind("| `unknown_cmd`", 0) == 0) unknown_cmd_row = line;
+  for (const auto& name : taken) EXPECT_NE(unknown_cmd_row.find("`" + name + "`"), std::string::npos) << name;
 }
