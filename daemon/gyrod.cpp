@@ -219,6 +219,7 @@ void Gyrod::startLiveCheck() {
 
 void Gyrod::queueEffect(const processing::LiveEffect& e) {
   std::string line = protocol::effectJson(e).dump() + "\n";
+  if (mqtt_) mqtt_->pushEffect(std::string_view(line).substr(0, line.size() - 1));  // a message: no newline
   {
     const std::lock_guard lock(effects_mutex_);
     effect_lines_.push_back(std::move(line));

@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <mutex>
 #include <stdexcept>
 
@@ -78,6 +79,7 @@ MqttPublisher::MqttPublisher(MqttSettings settings, MqttDerivedSources sources)
       status_topic_(settings_.prefix + "/" + std::string(protocol::kMqttStatusTopic)),
       rate_topic_(settings_.prefix + "/" + std::string(protocol::kMqttRateTopic)),
       gap_topic_(settings_.prefix + "/" + std::string(protocol::kMqttGapTopic)),
+      effect_topic_(settings_.prefix + "/" + std::string(protocol::kMqttEffectTopic)),
       ring_(settings_.queue_lines),
       buffer_(settings_.qos == 1 ? settings_.buffer_messages : 0),
       jitter_(std::random_device{}()),
@@ -109,6 +111,8 @@ MqttPublisher::MqttPublisher(MqttSettings settings, MqttDerivedSources sources)
 MqttPublisher::~MqttPublisher() {
   stop();
   mosquitto_destroy(mosq_);
+  std::string* line = nullptr;
+  while (effect_ring_.tryPop(line)) delete line;  // lines the thread did not take: the ring owns them
 }
 
 void MqttPublisher::stop() {
@@ -134,6 +138,18 @@ void MqttPublisher::setUpTls() {
 
 void MqttPublisher::push(const LineForClients& line) noexcept {
   if (!ring_.tryPush(line)) dropped_.fetch_add(1, std::memory_order_relaxed);
+}
+
+void MqttPublisher::pushEffect(std::string_view line) noexcept {
+  try {
+    auto copy = std::make_unique<std::string>(line);
+    if (effect_ring_.tryPush(copy.get()))
+      (void)copy.release();  // the publisher's thread owns it now
+    else
+      effects_refused_.fetch_add(1, std::memory_order_relaxed);
+  } catch (const std::bad_alloc&) {
+    effects_refused_.fetch_add(1, std::memory_order_relaxed);
+  }
 }
 
 void MqttPublisher::wake() noexcept {
@@ -298,6 +314,42 @@ bool MqttPublisher::publishLine(const LineForClients& line) {
   return true;
 }
 
+// The EFFECT lines from the sample thread, kept until the broker has them. Kept whatever qos
+// says: they are few, and each is news a fleet's dashboard would otherwise miss.
+void MqttPublisher::takeEffects() {
+  std::string* line = nullptr;
+  while (effect_ring_.tryPop(line)) {
+    const std::unique_ptr<std::string> owned(line);
+    if (effects_kept_.size() == kMaxKeptEffects) {
+      effects_kept_.pop_front();
+      spdlog::warn("MQTT: {} EFFECT lines wait for the broker; the oldest is dropped", kMaxKeptEffects);
+    }
+    effects_kept_.push_back(std::move(*owned));
+  }
+  const std::uint64_t refused = effects_refused_.load(std::memory_order_relaxed);
+  if (refused != effects_refused_logged_) {
+    spdlog::warn("MQTT: {} EFFECT line(s) could not be handed to the publisher and are not published",
+                 refused - effects_refused_logged_);
+    effects_refused_logged_ = refused;
+  }
+}
+
+// QoS 1: every change reaches a subscriber at least once. Not retained: a topic keeps only its
+// last message, which would show a later subscriber one change of one effect (a "gone", say)
+// as if it were the board's state; what is named now is STATUS's live_check and the socket's
+// "effects" reply.
+void MqttPublisher::sendEffects() {
+  while (connected_ && !effects_kept_.empty()) {
+    const std::string& e = effects_kept_.front();
+    if (mosquitto_publish(mosq_, nullptr, effect_topic_.c_str(), static_cast<int>(e.size()), e.data(), 1, false) !=
+        MOSQ_ERR_SUCCESS)
+      break;  // kept: the connection is being lost
+    published_.fetch_add(1, std::memory_order_relaxed);
+    if (settings_.qos == 1) ++unacknowledged_;
+    effects_kept_.pop_front();
+  }
+}
+
 // The buffer, oldest first, as far as the broker keeps up with its acknowledgements.
 void MqttPublisher::sendBuffered() {
   while (connected_ && !buffer_.empty() && unacknowledged_ < kMaxUnacknowledged) {
@@ -389,7 +441,9 @@ void MqttPublisher::threadMain() {
       next_status = now + kStatusEvery;
     }
     while (ring_.tryPop(line)) takeLine(line);
+    takeEffects();
     sendBuffered();
+    sendEffects();
     if (connected) publishDerived(!was_connected);
     was_connected = connected;
     if (connected_ || connecting_) {

@@ -12,15 +12,21 @@
 // the broker keeps its side of them. With qos 0 nothing waits for a broker that is not there.
 // Whatever is dropped (the ring full, the buffer full, qos 0 while disconnected) is counted.
 // Topics under the prefix: status (retained; "online" when connected, "offline" as the last
-// will and at a clean stop), rate (every rate_every-th RATE line), gap (every GAP line), and
-// those of daemon/mqtt_derived_topics.hpp (summary, allan, model, Home Assistant discovery).
+// will and at a clean stop), rate (every rate_every-th RATE line), gap (every GAP line), effect
+// (every EFFECT line of the live check, QoS 1 whatever qos says, kept while the broker is away),
+// and those of daemon/mqtt_derived_topics.hpp (summary, allan, model, Home Assistant discovery).
+// EFFECT lines come a few an hour and vary in length: each is a string of its own whose
+// ownership passes to the publisher through a small lock-free ring of pointers, so the sample
+// thread's share stays a copy and a push.
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <mutex>
 #include <random>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -81,12 +87,21 @@ class MqttPublisher {
 
   // Sample thread only: never waits.
   void push(const LineForClients& line) noexcept;
+  // Sample thread only: an EFFECT line (one JSON object, without its newline) for
+  // <prefix>/effect. Copies it and never waits; wake() hands it on at once. Dropped (and logged
+  // by the publisher) when kEffectQueueLines are waiting for the publisher's thread.
+  void pushEffect(std::string_view line) noexcept;
   // Sample thread, once per loop turn that pushed lines (one write to an eventfd): the
   // publisher takes them at once rather than at its next keep-alive wake-up.
   void wake() noexcept;
 
   MqttStats stats() const;
   const std::string& statusTopic() const { return status_topic_; }
+
+  // EFFECT lines between the sample thread and the publisher's, and kept for the broker while it
+  // is away (the oldest dropped beyond it): the live check names a few an hour.
+  static constexpr std::size_t kEffectQueueLines = 64;
+  static constexpr std::size_t kMaxKeptEffects = 256;
 
  private:
   void threadMain();
@@ -95,6 +110,8 @@ class MqttPublisher {
   void takeLine(const LineForClients& line);
   bool publishLine(const LineForClients& line);
   void sendBuffered();
+  void takeEffects();
+  void sendEffects();
   void attemptConnection(std::chrono::steady_clock::time_point now);
   void runLoop();
   bool checkConnecting();
@@ -110,8 +127,14 @@ class MqttPublisher {
   static void onLog(mosquitto* mosq, void* self, int level, const char* text);
 
   MqttSettings settings_;
-  std::string status_topic_, rate_topic_, gap_topic_;
+  std::string status_topic_, rate_topic_, gap_topic_, effect_topic_;
   SpscRing<LineForClients> ring_;
+  // Each pointer owns its line: the sample thread releases it into the ring, the publisher's
+  // thread takes it back (the destructor frees what is left).
+  SpscRing<std::string*> effect_ring_{kEffectQueueLines};
+  std::atomic<std::uint64_t> effects_refused_{0};  // the effect ring was full (sample thread)
+  std::uint64_t effects_refused_logged_ = 0;       // publisher thread
+  std::deque<std::string> effects_kept_;           // publisher thread: not yet handed to libmosquitto
   std::atomic<bool> stop_{false};
   std::atomic<bool> connected_{false};
   bool connecting_ = false;  // publisher thread (and libmosquitto's callbacks, on it)

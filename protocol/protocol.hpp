@@ -73,6 +73,7 @@ inline constexpr std::string_view kMqttGapTopic = "gap";
 inline constexpr std::string_view kMqttSummaryTopic = "summary";  // 1 Hz: mean rate, temperature, still
 inline constexpr std::string_view kMqttAllanTopic = "allan";      // retained: the ALLAN reply
 inline constexpr std::string_view kMqttModelTopic = "model";      // retained: the calibration in use
+inline constexpr std::string_view kMqttEffectTopic = "effect";    // each EFFECT line, QoS 1, not retained
 
 // Longest possible RATE line: 23 doubles of ≤ 24 characters in shortest round-trip form
 // (552), "time" (≤ 24: fixed with 6 decimals below 1e15, else shortest), a 20-digit seq,

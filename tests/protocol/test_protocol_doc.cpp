@@ -234,7 +234,8 @@ TEST(ProtocolDoc, MqttTopicsAreTheOnesPublished) {
   const std::set<std::string> published = {
       std::string(protocol::kMqttStatusTopic), std::string(protocol::kMqttRateTopic),
       std::string(protocol::kMqttGapTopic),    std::string(protocol::kMqttSummaryTopic),
-      std::string(protocol::kMqttAllanTopic),  std::string(protocol::kMqttModelTopic)};
+      std::string(protocol::kMqttAllanTopic),  std::string(protocol::kMqttModelTopic),
+      std::string(protocol::kMqttEffectTopic)};
   EXPECT_EQ(documented, published);
 }
 
