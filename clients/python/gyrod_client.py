@@ -7,7 +7,8 @@
             if isinstance(item, gyrod_client.Rate):
                 print(item.seq, item.t, item.rate)
 
-`watch()` yields `Rate` and `Gap` objects; `status()` and `allan()` return the reply as a dict.
+`watch()` yields `Rate` and `Gap` objects; `status()`, `allan()` and `effects()` return the reply
+as a dict.
 Fields this module does not name are kept in `.fields` and classes it does not know are
 skipped, as the protocol asks of clients (a minor version may add them); a field gyrod left
 out (it never sends null) is None here.
@@ -168,6 +169,13 @@ class Client:
     def allan(self) -> dict:
         self._send({"cmd": "allan"})
         return self._reply("ALLAN")
+
+    def effects(self) -> dict:
+        """The EFFECTS reply: "live_check" ("on" or "off", with "reason") and "effects", each effect
+        the live check names now as its EFFECT object (protocol 1.8; an older gyrod answers with
+        an ERROR, raised as ProtocolError)."""
+        self._send({"cmd": "effects"})
+        return self._reply("EFFECTS")
 
     def watch(self, decimate: int = 1) -> Iterator[Union[Rate, Gap]]:
         """Turns watching on and yields every RATE and GAP line, until the connection ends."""

@@ -1,4 +1,4 @@
-// gyroctl watch / allan / status as a user runs them: a real gyroctl process against a
+// gyroctl watch / allan / status / effects as a user runs them: a real gyroctl process against a
 // server in this test process (the loop is pumped while gyroctl runs).
 #include <fcntl.h>
 #include <grp.h>
@@ -271,6 +271,74 @@ TEST_F(GyroctlTest, StatusShowsTheDeviceReasonAndEveryDriverCounter) {
   EXPECT_EQ(s["device_retrying"], false);
   EXPECT_EQ(s["counters"], json::parse(R"({"transfers_failed":12,"recoveries":3,"data_ready_missed":7})"));
   EXPECT_EQ(s["mqtt_buffered"], 250);
+}
+
+// The effects the live check names now, in a table whatever the effect (a kind this gyroctl does
+// not know shows its parameters all the same); --json passes the EFFECTS line through.
+TEST_F(GyroctlTest, EffectsTableAndJson) {
+  content_.status.device_state = "streaming";
+  content_.status.live_check = protocol::LiveCheckStatus{
+      14,
+      true,
+      2,
+      0,
+      {R"({"class":"EFFECT","state":"new","effect":"line","axis":"y","t":4200.0,"onset_t":3600.0,)"
+       R"("onset_t_95":[3300.0,3620.0],"params":{"centre_hz":12.4996,"centre_hz_95":[12.4988,12.5005],)"
+       R"("width_hz":0.005,"rms_dps":0.0026,"rms_dps_95":[0.0021,0.0031],"power_ratio":23.0},)"
+       R"("evidence":"periodogram over the last 600 s at 12.5 Hz stands 23 x the baseline's level"})",
+       R"({"class":"EFFECT","state":"new","effect":"some_later_kind","axis":"z","t":4500.0,"onset_t":4380.5,)"
+       R"("onset_t_95":[4300.0,4400.0],"params":{"step_dps":0.01},"evidence":"a later detector's words"})"}};
+  startServer();
+  const CommandResult h = run({"effects", "--socket", socketPath()});
+  ASSERT_EQ(h.exit_status, 0) << h.err;
+  const auto lines = splitLines(h.out);
+  ASSERT_EQ(lines.size(), 5u) << h.out;
+  EXPECT_EQ(lines[0], "live check: on, 14 intervals examined, baseline ready");
+  EXPECT_EQ(words(lines[1]).front(), "effect") << h.out;
+  EXPECT_NE(lines[2].find("line"), std::string::npos) << h.out;
+  EXPECT_NE(lines[2].find("  y  "), std::string::npos) << h.out;
+  EXPECT_NE(lines[2].find("3600 (3300..3620)"), std::string::npos) << h.out;
+  EXPECT_NE(lines[2].find("4200.0"), std::string::npos) << h.out;
+  EXPECT_NE(lines[2].find("centre_hz 12.5 (12.5..12.5), width_hz 0.005, rms_dps 0.0026 (0.0021..0.0031)"),
+            std::string::npos)
+      << h.out;
+  EXPECT_NE(lines[2].find("stands 23 x the baseline's level"), std::string::npos) << h.out;
+  EXPECT_NE(lines[3].find("some_later_kind"), std::string::npos) << h.out;
+  EXPECT_NE(lines[3].find("step_dps 0.01"), std::string::npos) << h.out;
+  EXPECT_NE(lines[3].find("a later detector's words"), std::string::npos) << h.out;
+  // The columns line up: each row's axis starts where the header's does.
+  EXPECT_EQ(lines[2].find(" y "), lines[1].find(" axis")) << h.out;
+  EXPECT_EQ(lines[2].find("centre_hz"), lines[1].find("parameters")) << h.out;
+
+  const CommandResult j = run({"effects", "--socket", socketPath(), "--json"});
+  ASSERT_EQ(j.exit_status, 0) << j.err;
+  const json e = json::parse(j.out);
+  EXPECT_EQ(e["class"], "EFFECTS");
+  EXPECT_EQ(e["live_check"], "on");
+  ASSERT_EQ(e["effects"].size(), 2u);
+  EXPECT_EQ(e["effects"][0]["params"]["centre_hz"], 12.4996);
+  EXPECT_EQ(e["effects"][1]["effect"], "some_later_kind");
+
+  content_.status.live_check->current.clear();
+  content_.status.live_check->baseline_ready = false;
+  const CommandResult none = run({"effects", "--socket", socketPath()});
+  ASSERT_EQ(none.exit_status, 0) << none.err;
+  EXPECT_EQ(none.out,
+            "live check: on, 14 intervals examined, baseline not complete yet (nothing is compared with it before)\n"
+            "no effect named now\n");
+}
+
+TEST_F(GyroctlTest, EffectsSaysWhenTheLiveCheckIsOff) {
+  content_.status.device_state = "streaming";
+  startServer();
+  const CommandResult h = run({"effects", "--socket", socketPath()});
+  ASSERT_EQ(h.exit_status, 0) << h.err;
+  EXPECT_EQ(h.out, "live check: off (the daemon does not run the live check)\n");
+  const CommandResult j = run({"effects", "--socket", socketPath(), "--json"});
+  ASSERT_EQ(j.exit_status, 0) << j.err;
+  EXPECT_EQ(json::parse(j.out),
+            json::parse(R"({"class":"EFFECTS","live_check":"off","reason":"the daemon does not run the live check",)"
+                        R"("effects":[]})"));
 }
 
 namespace {

@@ -3,7 +3,8 @@
 // when gyrod is killed; a broker that comes only after gyrod has started; a broker restarted
 // under a persistent session (qos 1: no message lost or reordered); TLS with a throw-away CA
 // and password authentication, and the failures STATUS reports (wrong CA, wrong password, no
-// broker).
+// broker); the live check's EFFECT line on the effect topic, and the same effect listed by the
+// socket's "effects" and `gyroctl effects`.
 #include <gtest/gtest.h>
 #include <mosquitto.h>
 #include <netinet/in.h>
@@ -15,8 +16,11 @@
 
 #include <chrono>
 #include <cstdlib>
+#include <filesystem>
+#include <iostream>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -468,4 +472,106 @@ TEST(GyrodMqtt, PublishesTheSummaryTheRetainedAllanAndModelAndHomeAssistantDisco
     EXPECT_EQ(m.topic.rfind("homeassistant/sensor/board_1/", 0), 0u) << m.topic;
   }
   EXPECT_EQ(json::parse(home.messages().front().payload)["device"]["identifiers"], json::array({"board_1"}));
+}
+
+namespace {
+
+// The live check's set-up of test_gyrod_live_check.cpp: the accelerated mock at rest with a
+// sensor model (the still detector), a 12.5 Hz vibration of 0.02 deg/s on y from 300 s of data.
+constexpr double kMqttEffectOnsetS = 300.0;
+
+std::string mqttEffectSensorModel() {
+  std::ostringstream m;
+  m << "rate_hz = 50\n[temperature]\nstart_c = 30\nfinal_c = 30\ntime_constant_s = 900.0\nnoise_std_c = 0.02\n";
+  for (const char* axis : {"x", "y", "z"}) {
+    m << "[" << axis << "]\nquantization_urad = 0.1663\narw_deg_per_sqrt_h = 0.95164\n"
+      << "bias_instability_deg_per_h = 0.60565\nrrw_deg_per_h_sqrt_h = 0.07759\nbias_dps = 0.5\n"
+      << "[" << axis << ".calibration]\nbias_std_dps = 0.02\ntemperature_coefficient_dps_per_c = 0.0\n"
+      << "temperature_coefficient_std_dps_per_c = 0.05\ntemperature_reference_c = 25.0\n";
+  }
+  return m.str();
+}
+
+// qos 0 and one RATE message in 1000: the broker is not flooded at 100 x real time, and the
+// effect topic is QoS 1 all the same.
+std::string mqttEffectConfig(const ScratchDir& d, const std::filesystem::path& model, int port) {
+  std::ostringstream c;
+  c << "[device]\nbackend = \"mock\"\nrate_hz = 50\n"
+    << "[filter]\nmodel = \"" << model.string() << "\"\n"
+    << "[socket]\npath = \"" << (d.path() / "gyrod.sock").string() << "\"\n"
+    << "[check]\ninterval_s = 60\nbaseline_s = 120\n"
+    << "[mock]\nspeed = 100\nseed = 4\nmotion = \"sine:axis=y,freq=12.5,amp=0.02,start=" << kMqttEffectOnsetS << "\"\n"
+    << "[mqtt]\nurl = \"mqtt://127.0.0.1:" << port << "\"\nprefix = \"test/board-1\"\nqos = 0\nrate_every = 1000\n";
+  return c.str();
+}
+
+// The reply of one request on a connection of its own, skipping other classes.
+json replyOf(const std::filesystem::path& socket, const std::string& request, const std::string& cls) {
+  LineClient c(socket.string());
+  if (!c.readLine()) return {};  // VERSION
+  c.send(request + "\n");
+  for (int i = 0; i < 10; ++i) {
+    const auto line = c.readLine(10s);
+    if (!line) break;
+    json j = json::parse(*line);
+    if (j.value("class", "") == cls) return j;
+  }
+  return {};
+}
+
+}  // namespace
+
+// An effect the live check names goes to <prefix>/effect (not retained), and while it lasts the
+// socket's "effects" and `gyroctl effects` list it: the same object on all three.
+TEST(GyrodMqtt, PublishesEachEffectAndTheSocketListsIt) {
+  const int port = freeLoopbackPort();
+  Broker broker(port);
+  ScratchDir d;
+  const auto model = d.write("model.toml", mqttEffectSensorModel());
+  const auto cfg = d.write("gyrod.toml", mqttEffectConfig(d, model, port));
+  Subscriber sub(port, "test/board-1/effect");
+  ASSERT_TRUE(sub.connected()) << "no broker on port " << port << " (/usr/sbin/mosquitto: Debian's mosquitto)";
+  GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt");
+  const auto socket = d.path() / "gyrod.sock";
+  // Before the baseline is complete the check runs and names nothing.
+  const json early = replyOf(socket, R"({"cmd":"effects"})", "EFFECTS");
+  ASSERT_EQ(early.value("class", ""), "EFFECTS") << readWholeFile(d.path() / "log.txt");
+  EXPECT_EQ(early["live_check"], "on") << early;
+  EXPECT_FALSE(early.contains("reason")) << early;
+
+  ASSERT_TRUE(sub.waitFor([](const auto& m) { return !m.empty(); }, 90s)) << readWholeFile(d.path() / "log.txt");
+  const Message message = sub.messages().front();
+  EXPECT_FALSE(message.retained);
+  const json published = json::parse(message.payload);  // one JSON object, no newline
+  EXPECT_EQ(published["class"], "EFFECT") << message.payload;
+  EXPECT_EQ(published["state"], "new") << message.payload;
+  EXPECT_EQ(published["effect"], "line") << message.payload;
+  EXPECT_EQ(published["axis"], "y") << message.payload;
+
+  const json listed = replyOf(socket, R"({"cmd":"effects"})", "EFFECTS");
+  EXPECT_EQ(listed["live_check"], "on") << listed;
+  EXPECT_TRUE(listed["baseline_ready"].get<bool>()) << listed;
+  EXPECT_GE(listed["intervals"].get<int>(), 3) << listed;
+  ASSERT_GE(listed["effects"].size(), 1u) << listed;
+  EXPECT_EQ(listed["effects"][0], published) << listed;
+  // STATUS's live_check lists the same.
+  EXPECT_EQ(statusOf(socket)["live_check"]["current"], listed["effects"]);
+
+  const CommandResult text = runGyroctl("effects --socket " + socket.string(), d.path());
+  EXPECT_EQ(text.exit_status, 0) << text.err;
+  std::cout << text.out;
+  EXPECT_NE(text.out.find("live check: on, "), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("baseline ready"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("centre_hz 12.5"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find(published["evidence"].get<std::string>()), std::string::npos) << text.out;
+  const CommandResult raw = runGyroctl("effects --json --socket " + socket.string(), d.path());
+  EXPECT_EQ(raw.exit_status, 0) << raw.err;
+  EXPECT_EQ(json::parse(raw.out)["effects"][0], published) << raw.out;
+
+  gyrod.signal(SIGTERM);
+  EXPECT_EQ(gyrod.waitExit(10s), std::optional<int>(0));
+  // A subscriber that comes later is given no old change: the topic retains nothing.
+  Subscriber late(port, "test/board-1/effect");
+  ASSERT_TRUE(late.connected());
+  EXPECT_FALSE(late.waitFor([](const auto& m) { return !m.empty(); }, 1s));
 }

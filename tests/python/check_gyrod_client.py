@@ -99,6 +99,10 @@ def check_against_gyrod(path):
         # ALLAN while RATE lines keep coming: allan() skips them to its reply.
         allan = gyro.allan()
         check(allan["class"] == "ALLAN" and allan["samples"] > 0, "allan() returns the ALLAN dict")
+        # Without filter.model gyrod does not run the live check, and says so.
+        effects = gyro.effects()
+        check(effects["class"] == "EFFECTS" and effects["live_check"] == "off" and effects["effects"] == []
+              and "filter.model" in effects["reason"], "effects() returns the EFFECTS dict: %r" % effects)
 
     out = io.StringIO()
     with redirect_stdout(out):

@@ -75,7 +75,7 @@ TEST(GyroctlConventions, AWordFarFromEveryCommandGetsNoSuggestionButTheList) {
   EXPECT_EQ(
       r.err,
       "gyroctl: unknown command 'frobnicate' (commands: analyze, filter, attitude, import, simulate, watch, allan, "
-      "status, model-check, live-check, model, fleet)\n");
+      "status, effects, model-check, live-check, model, fleet)\n");
 }
 
 TEST(GyroctlConventions, AKnownCommandStillParsesItsOwnOptions) {

@@ -1,4 +1,4 @@
-// gyroctl watch / allan / status: the client side of the gyrod socket (docs/protocol.md).
+// gyroctl watch / allan / status / effects: the client side of the gyrod socket (docs/protocol.md).
 #include <unistd.h>
 
 #include <algorithm>
@@ -513,6 +513,90 @@ int runStatus(const CommonOptions& opt) {
   return kExitOk;
 }
 
+// ---- effects -------------------------------------------------------------------------------
+
+std::string effectNumber(const nlohmann::ordered_json& v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v.is_number() ? v.get<double>() : std::nan(""));
+  return buf;
+}
+
+// A value with its 95 % interval when the line gives one ([lo, hi]).
+std::string withInterval(const nlohmann::ordered_json& value, const nlohmann::ordered_json* interval95) {
+  std::string s = value.is_number() ? effectNumber(value) : value.dump();
+  if (interval95 != nullptr && interval95->is_array() && interval95->size() == 2)
+    s += " (" + effectNumber((*interval95)[0]) + ".." + effectNumber((*interval95)[1]) + ")";
+  return s;
+}
+
+// Every parameter the line carries, whatever the effect: "name value (lo..hi)", a parameter's
+// 95 % interval (its name + "_95") beside it rather than on its own.
+std::string paramsText(const nlohmann::ordered_json& params) {
+  std::string s;
+  if (!params.is_object()) return s;
+  for (auto it = params.begin(); it != params.end(); ++it) {
+    if (it.key().ends_with("_95") && params.contains(it.key().substr(0, it.key().size() - 3))) continue;
+    const auto interval = params.find(it.key() + "_95");
+    s += (s.empty() ? "" : ", ") + it.key() + " " + withInterval(*it, interval == params.end() ? nullptr : &*interval);
+  }
+  return s;
+}
+
+std::string timeText(const nlohmann::ordered_json& t) {
+  if (!t.is_number()) return "-";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f", t.get<double>());
+  return buf;
+}
+
+// One row per effect named now: what, where, when it began and when it was named (RATE's t),
+// its parameters and the evidence, in columns as wide as their longest entry.
+void printEffects(const protocol::EffectsReport& r) {
+  if (!r.live_check) {
+    const std::string why = r.reason.empty() ? "" : " (" + r.reason + ")";
+    std::printf("live check: off%s\n", why.c_str());
+    return;
+  }
+  std::printf("live check: on, %llu intervals examined, baseline %s\n", static_cast<unsigned long long>(r.intervals),
+              r.baseline_ready ? "ready" : "not complete yet (nothing is compared with it before)");
+  if (r.effects.empty()) {
+    std::printf("no effect named now\n");
+    return;
+  }
+  using Row = std::array<std::string, 6>;
+  std::vector<Row> rows = {{"effect", "axis", "onset t [s] (95 %)", "t [s]", "parameters", "evidence"}};
+  for (const std::string& line : r.effects) {
+    const nlohmann::ordered_json e = nlohmann::ordered_json::parse(line, nullptr, false);
+    if (!e.is_object()) continue;
+    const auto interval = e.find("onset_t_95");
+    rows.push_back({e.value("effect", std::string("?")), e.value("axis", std::string("?")),
+                    e.contains("onset_t") ? withInterval(e["onset_t"], interval == e.end() ? nullptr : &*interval)
+                                          : std::string("-"),
+                    timeText(e.value("t", nlohmann::ordered_json())),
+                    paramsText(e.value("params", nlohmann::ordered_json::object())),
+                    e.value("evidence", std::string())});
+  }
+  std::array<int, 5> width{};
+  for (const Row& row : rows)
+    for (std::size_t c = 0; c < width.size(); ++c) width[c] = std::max(width[c], static_cast<int>(row[c].size()));
+  for (const Row& row : rows)
+    std::printf("%-*s  %-*s  %-*s  %-*s  %-*s  %s\n", width[0], row[0].c_str(), width[1], row[1].c_str(), width[2],
+                row[2].c_str(), width[3], row[3].c_str(), width[4], row[4].c_str(), row[5].c_str());
+  std::printf("t: when the live check named it, onset t: when it began; both on the clock of RATE's t\n");
+}
+
+int runEffects(const CommonOptions& opt) {
+  DaemonConnection conn = DaemonConnection::open(opt.socket, kReplyTimeout);
+  conn.sendLine(protocol::requestLine(protocol::EffectsRequest{}));
+  std::string raw;
+  const auto effects = conn.readReply<protocol::EffectsReport>(kReplyTimeout, &raw);
+  if (opt.json)
+    std::printf("%s\n", raw.c_str());
+  else
+    printEffects(effects);
+  return kExitOk;
+}
+
 }  // namespace
 
 void addClientCommands(CLI::App& app, CommandRunner& run) {
@@ -544,6 +628,14 @@ void addClientCommands(CLI::App& app, CommandRunner& run) {
     addCommonOptions(sub, *opt);
     sub->add_flag("--json", opt->json, "print gyrod's STATUS line unchanged");
     sub->callback([&run, opt] { run = [opt] { return runStatus(*opt); }; });
+  }
+  {
+    auto opt = std::make_shared<CommonOptions>();
+    auto* sub = app.add_subcommand(
+        "effects", "Show what gyrod's live check names now: each effect, its axis, onset, parameters and evidence");
+    addCommonOptions(sub, *opt);
+    sub->add_flag("--json", opt->json, "print gyrod's EFFECTS line unchanged");
+    sub->callback([&run, opt] { run = [opt] { return runEffects(*opt); }; });
   }
 }
 

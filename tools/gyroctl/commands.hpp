@@ -21,7 +21,7 @@ void addFilterCommand(CLI::App& app, CommandRunner& run);
 void addAttitudeCommand(CLI::App& app, CommandRunner& run);
 void addImportCommand(CLI::App& app, CommandRunner& run);
 void addSimulateCommand(CLI::App& app, CommandRunner& run);
-// watch, allan, status: talk to a running gyrod over its socket.
+// watch, allan, status, effects: talk to a running gyrod over its socket.
 void addClientCommands(CLI::App& app, CommandRunner& run);
 void addModelCheckCommand(CLI::App& app, CommandRunner& run);
 // model: a sensor model's calibration, with what a board learned on top of it.
