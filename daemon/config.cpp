@@ -514,7 +514,7 @@ void readMock(const Section& s, MockConfig& m) {
   if (!s.node("faults")->is_table()) s.failType(*s.node("faults"), "faults", "must be a table");
   const Section f(s.file(), *s.node("faults")->as_table(), s.qualified("faults"),
                   {"transfer_error_fraction", "error_burst", "vanish", "silent_reset_at_s", "fifo_overflow_at_s",
-                   "who_am_i", "stuck_data_ready_at_s", "stuck_data_ready_duration_s"});
+                   "who_am_i", "stuck_data_ready_at_s", "stuck_data_ready_duration_s", "glitch_burst"});
   auto& faults = m.faults;
   const auto nonNegative = [](double t) { return t >= 0.0; };
   const std::string time_requirement = "must be a time ≥ 0 s, or an array of them";
@@ -535,6 +535,32 @@ void readMock(const Section& s, MockConfig& m) {
       burst.count = static_cast<std::uint32_t>(*v);
     }
     faults.error_bursts.push_back(burst);
+  }
+  for (const auto& g : f.tables("glitch_burst", {"at_s", "duration_s", "count", "axis", "bit"})) {
+    MockGlitchBurst burst;
+    if (auto v = g.number("at_s")) {
+      if (!(*v >= 0.0)) g.failValue("at_s", "must be ≥ 0 s");
+      burst.at_s = *v;
+    } else {
+      f.failValue("glitch_burst", "each burst needs at_s");
+    }
+    if (auto v = g.number("duration_s")) {
+      if (!(*v >= 0.0)) g.failValue("duration_s", "must be ≥ 0 s");
+      burst.duration_s = *v;
+    }
+    if (auto v = g.integer("count")) {
+      if (*v < 1 || *v > 1000000) g.failValue("count", "must be 1..1000000 samples");
+      burst.count = static_cast<std::uint32_t>(*v);
+    }
+    if (auto v = g.string("axis")) {
+      if (*v != "x" && *v != "y" && *v != "z") g.failValue("axis", "must be \"x\", \"y\" or \"z\"");
+      burst.axis = (*v)[0] - 'x';
+    }
+    if (auto v = g.integer("bit")) {
+      if (*v < 0 || *v > 15) g.failValue("bit", "must be a bit of the 16-bit word, 0..15");
+      burst.bit = static_cast<int>(*v);
+    }
+    faults.glitch_bursts.push_back(burst);
   }
   for (const auto& t : f.tables("vanish", {"at_s", "duration_s", "power_lost"})) {
     MockVanish v;

@@ -151,6 +151,16 @@ struct MockErrorBurst {
   std::uint32_t count = 1;  // consecutive failing transfers
   bool operator==(const MockErrorBurst&) const = default;
 };
+// `count` samples spread over [at_s, at_s + duration_s) with bit `bit` of one axis's gyro word
+// flipped (outliers the chip reports as data).
+struct MockGlitchBurst {
+  double at_s = 0.0;
+  double duration_s = 0.0;
+  std::uint32_t count = 1;
+  int axis = 0;  // 0..2: "x", "y", "z"
+  int bit = 8;   // 256 LSB: 1.95 °/s at ±250 °/s
+  bool operator==(const MockGlitchBurst&) const = default;
+};
 struct MockVanish {
   double at_s = 0.0;
   double duration_s = 0.0;
@@ -166,6 +176,7 @@ struct MockFaults {
   std::optional<int> who_am_i;             // WHO_AM_I answer instead of 0x68 (clones)
   std::vector<double> stuck_data_ready_at_s;
   std::optional<double> stuck_data_ready_duration_s;  // empty = stuck until the end
+  std::vector<MockGlitchBurst> glitch_bursts;
   bool operator==(const MockFaults&) const = default;
 };
 

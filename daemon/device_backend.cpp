@@ -99,6 +99,8 @@ driver::FaultPlan faultPlanFor(const MockFaults& f) {
   for (double t : f.silent_reset_at_s) plan.brownouts_ns.push_back(secondsToNs(t));
   for (double t : f.fifo_overflow_at_s) plan.forced_fifo_overflows_ns.push_back(secondsToNs(t));
   if (f.who_am_i) plan.who_am_i = static_cast<std::uint8_t>(*f.who_am_i);
+  for (const auto& g : f.glitch_bursts)
+    plan.glitch_bursts.push_back({secondsToNs(g.at_s), secondsToNs(g.duration_s), g.count, g.axis, g.bit});
   for (double t : f.stuck_data_ready_at_s) {
     // "Until the end" when no duration is given: a century of sensor time.
     const double duration = f.stuck_data_ready_duration_s.value_or(100.0 * 365 * 86400);

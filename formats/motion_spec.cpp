@@ -289,11 +289,14 @@ std::vector<double> finiteNumbers(std::string_view text, std::string_view what) 
 
 processing::WarmUp parseWarmUpSpec(std::string_view text) {
   const std::vector<double> v = finiteNumbers(text, "warm-up");
-  if (v.size() != 2)
-    throw std::invalid_argument("warm-up: expected DELTA_C,TAU_S (e.g. 15,300), got " + formats::quotedValue(text));
+  if (v.size() != 2 && v.size() != 3)
+    throw std::invalid_argument("warm-up: expected DELTA_C,TAU_S[,START_S] (e.g. 15,300 or 8,300,3600), got " +
+                                formats::quotedValue(text));
   if (!(v[1] > 0.0))
     throw std::invalid_argument("warm-up: the time constant TAU_S must be > 0 s, got " + formats::quotedValue(text));
-  return {v[0], v[1]};
+  if (v.size() == 3 && !(v[2] >= 0.0))
+    throw std::invalid_argument("warm-up: the start START_S must be >= 0 s, got " + formats::quotedValue(text));
+  return {v[0], v[1], v.size() == 3 ? v[2] : 0.0};
 }
 
 std::array<double, processing::kSimulatedAxes> parseAxisValues(std::string_view text, std::string_view what) {

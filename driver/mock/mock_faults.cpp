@@ -1,5 +1,7 @@
 // Faults: a new plan, and what each scheduled fault does to the chip. The plan's checks,
 // its timeline and the transfer errors are mock::FaultSchedule's (fault_schedule.cpp).
+#include <algorithm>
+#include <stdexcept>
 #include <utility>
 
 #include "driver/mock/mock_mpu6050.hpp"
@@ -12,6 +14,19 @@ void MockMpu6050::setFaultPlan(const FaultPlan& plan) {
 
   // A new plan ends whatever the old one had started.
   faults_.replace(plan, std::move(events));
+  glitches_.clear();
+  next_glitch_ = 0;
+  for (const GlitchBurst& g : plan.glitch_bursts) {
+    if (g.axis < 0 || g.axis > 2 || g.bit < 0 || g.bit > 15 || g.count == 0 || g.duration_ns < 0 || g.start_ns < 0)
+      throw std::invalid_argument("FaultPlan.glitch_bursts: axis 0..2, bit 0..15, count >= 1, times >= 0");
+    for (std::uint32_t k = 0; k < g.count; ++k)
+      glitches_.push_back(
+          {g.start_ns + static_cast<std::int64_t>(static_cast<double>(g.duration_ns) * static_cast<double>(k) /
+                                                  static_cast<double>(g.count)),
+           g.axis, g.bit});
+  }
+  std::sort(glitches_.begin(), glitches_.end(), [](const Glitch& a, const Glitch& b) { return a.at_ns < b.at_ns; });
+  while (next_glitch_ < glitches_.size() && glitches_[next_glitch_].at_ns < now_ns_ - epoch_ns_) ++next_glitch_;
   if (!powered_) {
     powered_ = true;
     resetChip();

@@ -45,6 +45,17 @@ struct StuckDataReadyLine {
   bool level_high = false;
 };
 
+// Corrupted samples: `count` of them, spread evenly over [start, start + duration) in sensor
+// time, have bit `bit` of one axis's gyro word flipped as the chip writes it (output registers
+// and FIFO alike): an outlier the chip reports as data, as EMI or a marginal supply makes one.
+struct GlitchBurst {
+  std::int64_t start_ns = 0;
+  std::int64_t duration_ns = 0;
+  std::uint32_t count = 1;
+  int axis = 0;  // 0..2: x, y, z
+  int bit = 8;   // 0..15 (8: 256 LSB, 1.95 °/s at ±250 °/s)
+};
+
 struct FaultPlan {
   RandomTransferErrors random_errors;
   std::vector<TransferErrorBurst> error_bursts;
@@ -58,6 +69,7 @@ struct FaultPlan {
   // WHO_AM_I answers this instead of 0x68 (clones: 0x70, 0x72, 0x98, ...).
   std::optional<std::uint8_t> who_am_i;
   std::vector<StuckDataReadyLine> stuck_data_ready;
+  std::vector<GlitchBurst> glitch_bursts;
   // When false (default) an injected EIO/burst/random error happens before the chip sees
   // the transfer. When true the chip has done it and only the report fails: a FIFO burst
   // lost its bytes, INT_STATUS was cleared, a write landed. NACKs never take effect.
@@ -85,6 +97,7 @@ struct MockCounters {
   std::uint64_t source_rate_mismatch_ticks = 0;  // ticks taken at a rate the source did not expect
   std::uint64_t samples_produced = 0;            // sample-rate ticks; also the next sequence number
   std::uint64_t fifo_frames_written = 0;         // samples appended to the FIFO
+  std::uint64_t glitched_samples = 0;            // samples with a bit flipped (GlitchBurst)
   std::uint64_t fifo_bytes_written = 0;
   std::uint64_t fifo_bytes_overwritten = 0;  // oldest bytes lost to overflow
   std::uint64_t fifo_overflow_events = 0;    // appends that overwrote something

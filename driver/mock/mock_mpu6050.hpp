@@ -181,6 +181,13 @@ class MockMpu6050 final : public I2cBus, private mock::ChipTimeline {
 
   mock::Fifo fifo_;
   mock::FaultSchedule faults_;
+  // The plan's glitches in sensor time, sorted, and the next one due.
+  struct Glitch {
+    std::int64_t at_ns = 0;
+    int axis = 0, bit = 0;
+  };
+  std::vector<Glitch> glitches_;
+  std::size_t next_glitch_ = 0;
   std::int64_t next_event_ns_ = mock::kNever;  // reset done, pulse end or the next fault
 
   MockCounters counters_;

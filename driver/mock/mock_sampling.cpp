@@ -53,6 +53,13 @@ void MockMpu6050::sampleTick(std::int64_t t_ns) {
     s.accel[i] = processing::quantizeToInt16(true_accel_g_[i] + config_.accel_bias_g[i] + accelNoise(),
                                              mpu6050::kAccelLsbPerG[afs_sel]);
   }
+  // A glitch due: one bit of one word flipped as the chip writes it (one per sample; several due
+  // at once take the samples that follow).
+  if (next_glitch_ < glitches_.size() && glitches_[next_glitch_].at_ns <= t_ns - epoch_ns_) {
+    const Glitch& g = glitches_[next_glitch_++];
+    s.gyro[g.axis] = static_cast<std::int16_t>(static_cast<std::uint16_t>(s.gyro[g.axis]) ^ (1U << g.bit));
+    ++counters_.glitched_samples;
+  }
   // TEMP_OUT = (T − 36.53) · 340, the inverse of RM Registers 65–66.
   s.temperature =
       processing::quantizeToInt16(temperature_c_ - mpu6050::kTemperatureOffsetDegC, mpu6050::kTemperatureLsbPerDegC);

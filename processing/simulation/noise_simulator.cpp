@@ -180,15 +180,25 @@ void validateSimulationModel(const SimulationModel& model) {
 TemperatureModel withWarmUp(TemperatureModel temperature, const WarmUp& warm_up) {
   requireFinite(warm_up.delta_c, "warm-up temperature rise delta_c");
   requirePositive(warm_up.time_constant_s, "warm-up time constant");
+  requireNonNegative(warm_up.start_s, "warm-up start");
   temperature.final_c = temperature.start_c + warm_up.delta_c;
   temperature.time_constant_s = warm_up.time_constant_s;
+  temperature.delay_s = warm_up.start_s;
   return temperature;
+}
+
+double temperatureCurveC(const TemperatureModel& temp, double t_s) {
+  // Without a warm-up the curve is final + (+0)·e^{…} = final + 0.0 bit for bit: the exponential
+  // is skipped (it was 8 % of a model check's time, which simulates that case).
+  const double warmup = temp.start_c - temp.final_c;
+  if (warmup == 0.0) return temp.final_c + 0.0;
+  if (t_s < temp.delay_s) return temp.start_c;
+  return temp.final_c + warmup * portable::exp(-(t_s - temp.delay_s) / temp.time_constant_s);
 }
 
 double temperatureCouplingDps(const AxisExtraEffects& extra, const TemperatureModel& temp, double t_s) {
   if (extra.temperature_coefficient_dps_per_c == 0.0) return 0.0;
-  const double true_temp = temp.final_c + (temp.start_c - temp.final_c) * portable::exp(-t_s / temp.time_constant_s);
-  return extra.temperature_coefficient_dps_per_c * (true_temp - extra.temperature_reference_c);
+  return extra.temperature_coefficient_dps_per_c * (temperatureCurveC(temp, t_s) - extra.temperature_reference_c);
 }
 
 std::vector<GaussMarkovComponent> flickerGaussMarkovBank(double flat_allan_variance, double tau0_s, double duration_s) {
@@ -516,11 +526,7 @@ SimulatedSample NoiseSimulator::nextAnalog() {
     if (motion_) attitude_.step(out.true_rate_dps, 1.0 / internal_rate_hz_);
   }
   const TemperatureModel& temp = model_.temperature;
-  // Without a warm-up the curve is final + (+0)·e^{…} = final + 0.0 bit for bit: skip the
-  // exponential (it was 8 % of a model check's time, which simulates that case).
-  const double warmup = temp.start_c - temp.final_c;
-  out.temperature_c =
-      warmup == 0.0 ? temp.final_c + 0.0 : temp.final_c + warmup * portable::exp(-t / temp.time_constant_s);
+  out.temperature_c = temperatureCurveC(temp, t);
   if (temp.noise_std_c > 0.0) out.temperature_c += temp.noise_std_c * temperature_noise_.next();
   ++analog_index_;
   return out;

@@ -79,12 +79,15 @@ struct AxisNoiseModel {
   AxisExtraEffects extra;  // none by default
 };
 
-// T(t) = final + (start − final)·e^{−t/time_constant} + white noise of std noise_std.
+// T(t) = final + (start − final)·e^{−(t − delay)/time_constant} + white noise of std noise_std,
+// T = start before `delay_s` (a warm-up that begins later: a motor switched on, a cold board
+// brought in).
 struct TemperatureModel {
   double start_c = 25.0;
   double final_c = 25.0;
   double time_constant_s = 600.0;
   double noise_std_c = 0.0;
+  double delay_s = 0.0;
 };
 
 // A warm-up (docs/simulator.md "Warm-up"): the die temperature rises by delta_c from the
@@ -93,11 +96,14 @@ struct TemperatureModel {
 struct WarmUp {
   double delta_c = 0.0;
   double time_constant_s = 0.0;
+  double start_s = 0.0;  // when it begins (the temperature steady at start_c before)
 };
 // `temperature` warming up from its start_c: final_c = start_c + delta_c, the time constant
-// replaced (the noise kept). Throws std::invalid_argument naming the value (delta finite,
+// and the delay replaced (the noise kept). Throws std::invalid_argument naming the value (delta finite,
 // time constant finite and > 0).
 TemperatureModel withWarmUp(TemperatureModel temperature, const WarmUp& warm_up);
+// The noise-free temperature curve at t.
+double temperatureCurveC(const TemperatureModel& temperature, double t_s);
 // The temperature coupling k·(T(t) − T_ref) of one axis at t, on the noise-free curve (0 when
 // k is 0): what next() adds at the output rate, and what the mock adds to the analog rate.
 double temperatureCouplingDps(const AxisExtraEffects& extra, const TemperatureModel& temperature, double t_s);

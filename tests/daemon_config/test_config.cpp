@@ -196,6 +196,7 @@ fifo_overflow_at_s = [40, 41.5]
 who_am_i = 0x72
 stuck_data_ready_at_s = [50]
 stuck_data_ready_duration_s = 5
+glitch_burst = [{ at_s = 3600, duration_s = 60, count = 30, axis = "z", bit = 9 }, { at_s = 10 }]
 )",
                              "full.toml");
   EXPECT_EQ(c.device.backend, DeviceBackend::Mock);
@@ -242,6 +243,7 @@ stuck_data_ready_duration_s = 5
   EXPECT_EQ(f.who_am_i, 0x72);
   EXPECT_EQ(f.stuck_data_ready_at_s, (std::vector<double>{50.0}));
   EXPECT_EQ(f.stuck_data_ready_duration_s, 5.0);
+  EXPECT_EQ(f.glitch_bursts, (std::vector<MockGlitchBurst>{{3600.0, 60.0, 30, 2, 9}, {10.0, 0.0, 1, 0, 8}}));
 }
 
 TEST(ConfigValues, BusNumbersAndPaths) {
@@ -341,7 +343,9 @@ TEST(ConfigErrors, UnknownKeysInNestedAndInlineTables) {
   EXPECT_EQ(errorOf("[mock.faults]\nvanishh = 3\n"),
             "x.toml:2: unknown key 'vanishh' in [mock.faults] (valid keys: transfer_error_fraction, error_burst, "
             "vanish, silent_reset_at_s, fifo_overflow_at_s, who_am_i, stuck_data_ready_at_s, "
-            "stuck_data_ready_duration_s); did you mean 'vanish'?");
+            "stuck_data_ready_duration_s, glitch_burst); did you mean 'vanish'?");
+  EXPECT_EQ(errorOf("[mock.faults]\nglitch_burst = [{ at_s = 1, axis = \"w\" }]\n"),
+            "x.toml:2: key 'mock.faults.glitch_burst.axis': must be \"x\", \"y\" or \"z\" (got \"w\")");
   EXPECT_EQ(
       errorOf("[mock.faults]\nerror_burst = [\n  { at_s = 1, count = 2 },\n  { at_s = 3, cnt = 4 },\n]\n"),
       "x.toml:4: unknown key 'cnt' in [mock.faults.error_burst] (valid keys: at_s, count); did you mean 'count'?");

@@ -70,8 +70,9 @@ TEST(ConfigMockWarmUp, WarmUpAndCouplingAreReadAndChecked) {
             (std::vector<double>{0.01, 0.01, 0.01}));
   EXPECT_TRUE(GyrodConfig{}.mock.warm_up.empty());
   EXPECT_TRUE(GyrodConfig{}.mock.temperature_coefficient_dps_per_c.empty());
-  EXPECT_EQ(motionErrorOf("[mock]\nwarm_up = \"15\"\n"),
-            "x.toml:2: key 'mock.warm_up': warm-up: expected DELTA_C,TAU_S (e.g. 15,300), got '15' (got \"15\")");
+  EXPECT_EQ(
+      motionErrorOf("[mock]\nwarm_up = \"15\"\n"),
+      "x.toml:2: key 'mock.warm_up': warm-up: expected DELTA_C,TAU_S[,START_S] (e.g. 15,300 or 8,300,3600), got '15' (got \"15\")");
   EXPECT_EQ(
       motionErrorOf("[mock]\n\nwarm_up = \"15,-1\"\n"),
       "x.toml:3: key 'mock.warm_up': warm-up: the time constant TAU_S must be > 0 s, got '15,-1' (got \"15,-1\")");

@@ -134,6 +134,38 @@ TEST(MockMpu6050Faults, BrownOutSilentlyRestoresResetValuesAndEmptiesTheFifo) {
   EXPECT_EQ(rig.mock.counters().transfers, rig.mock.counters().transfers_ok);
 }
 
+// Five samples spread over 0.2–0.3 s have bit 8 of z flipped: 393 LSB (3 °/s) reads 137; the
+// other samples and axes are untouched.
+TEST(MockMpu6050Faults, AGlitchBurstFlipsOneBitOfOneAxisInTheSamplesItSpreadsOver) {
+  ConstantSource source({1, 2, 3});
+  Rig rig(source);
+  FaultPlan plan;
+  plan.glitch_bursts.push_back({200 * kNsPerMillisecond, 100 * kNsPerMillisecond, 5, 2, 8});
+  rig.mock.setFaultPlan(plan);
+  std::vector<SampleRecord> samples;
+  rig.mock.setSampleObserver([&samples](const SampleRecord& s) { samples.push_back(s); });
+  rig.wake(3, 9);  // 100 Hz
+  rig.advance(kNsPerSecond);
+  ASSERT_GE(samples.size(), 90u);
+  std::size_t glitched = 0;
+  for (const SampleRecord& s : samples) {
+    EXPECT_EQ(s.gyro[0], 131);
+    EXPECT_EQ(s.gyro[1], 262);
+    if (s.gyro[2] == (393 ^ 256)) {
+      ++glitched;
+      const double t = static_cast<double>(s.time_ns - rig.mock.epochNs()) * 1e-9;
+      EXPECT_GE(t, 0.2);
+      EXPECT_LT(t, 0.3 + 0.011);
+    } else {
+      EXPECT_EQ(s.gyro[2], 393);
+    }
+  }
+  EXPECT_EQ(glitched, 5u);
+  EXPECT_EQ(rig.mock.counters().glitched_samples, 5u);
+  plan.glitch_bursts[0].bit = 16;
+  EXPECT_THROW(rig.mock.setFaultPlan(plan), std::invalid_argument);
+}
+
 TEST(MockMpu6050Faults, ForcedOverflowFillsTheFifoPastItsEnd) {
   ConstantSource source({1, 2, 3});
   Rig rig(source);

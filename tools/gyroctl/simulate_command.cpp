@@ -195,8 +195,9 @@ void addSimulateCommand(CLI::App& app, CommandRunner& run) {
   sub->add_option("--dlpf", opt->dlpf, "DLPF_CFG 0..6 (default: the model file's, else no DLPF)");
   sub->add_option("--fs-sel", opt->fs_sel, "FS_SEL 0..3: quantise and saturate (default: the model file's, else not)");
   sub->add_option("--warm-up", opt->warm_up,
-                  "DELTA_C,TAU_S: the die temperature rises by DELTA_C from the model's start with time constant "
-                  "TAU_S; the bias follows through the temperature coupling (docs/simulator.md)");
+                  "DELTA_C,TAU_S[,START_S]: the die temperature rises by DELTA_C from the model's start with time "
+                  "constant TAU_S (from START_S on); the bias follows through the temperature coupling "
+                  "(docs/simulator.md)");
   sub->add_option("--temperature-coefficient", opt->temperature_coefficient,
                   "K or KX,KY,KZ [deg/s per C]: the bias's temperature coupling (reference: the model's, 25 C)");
   sub->add_option("--motion", opt->motion,
