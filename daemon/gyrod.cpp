@@ -207,8 +207,14 @@ void Gyrod::startLiveCheck() {
     spdlog::info("live check: off ({})", live_check_off_);
     return;
   }
+  // The coupling the model gives each axis: the check names a bias that follows temperature
+  // otherwise.
+  std::array<double, 3> coupling{};
+  if (rate_model_.params)
+    for (std::size_t a = 0; a < coupling.size(); ++a)
+      coupling[a] = rate_model_.params->axes[a].temperature_coefficient_dps_per_c;
   live_ = std::make_unique<LiveChecker>(loop_, config_.device.rate_hz, config_.check.interval_s,
-                                        config_.check.baseline_s, config_.check.false_alarms_per_week,
+                                        config_.check.baseline_s, config_.check.false_alarms_per_week, coupling,
                                         [this](const processing::LiveEffect& e) { queueEffect(e); });
   spdlog::info(
       "live check: every {} s of still data at {} Hz against a baseline of the first {} s "
@@ -613,7 +619,7 @@ void Gyrod::publish(const driver::GyroSample& s, const ProcessedSample& out) {
   if (calibration_)
     if (const processing::RateEstimator* estimator = pipeline_.rateEstimator())
       calibration_->onSample(out.t_s, *estimator);
-  if (live_) live_->onSample(out.t_s, out.raw, out.still.value_or(false));
+  if (live_) live_->onSample(out.t_s, out.raw, s.temp_c, out.still.value_or(false));
   ++samples_published_;
   last_temp_c_ = r.temp_c;
   last_t_s_ = r.t_s;

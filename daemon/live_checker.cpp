@@ -29,8 +29,13 @@ std::string journalLine(const processing::LiveEffect& e) {
   if (e.kind == processing::LiveEffectKind::Line)
     s += ", rms " + g4(e.rms_dps) + " deg/s" +
          (e.baseline_rms_dps > 0.0 ? " (the baseline had " + g4(e.baseline_rms_dps) + ")" : "");
-  else
+  else if (e.kind == processing::LiveEffectKind::OutlierBurst)
     s += ": " + std::to_string(e.count) + " outliers where " + g4(e.expected) + " were expected";
+  else if (e.kind == processing::LiveEffectKind::BiasStep)
+    s += ": " + g4(e.size_dps) + " deg/s (" + g4(e.size_dps_95.lo) + " to " + g4(e.size_dps_95.hi) + ")";
+  else
+    s += ": " + g4(e.coefficient_dps_per_c) + " deg/s per C (" + g4(e.coefficient_dps_per_c_95.lo) + " to " +
+         g4(e.coefficient_dps_per_c_95.hi) + ") where the model has " + g4(e.baseline_coefficient_dps_per_c);
   return s + ", onset " + g4(e.onset_t) + " s (" + g4(e.onset_95.lo) + "-" + g4(e.onset_95.hi) + "); " + e.evidence;
 }
 
@@ -41,7 +46,8 @@ bool sameEffect(const processing::LiveEffect& a, const processing::LiveEffect& b
 }  // namespace
 
 LiveChecker::LiveChecker(EventLoop& loop, double device_rate_hz, double interval_s, double baseline_s,
-                         double false_alarms_per_week, OnChange on_change)
+                         double false_alarms_per_week, const std::array<double, 3>& temperature_coefficient_dps_per_c,
+                         OnChange on_change)
     : motion_(device_rate_hz),
       on_change_(std::move(on_change)),
       job_(
@@ -58,9 +64,10 @@ LiveChecker::LiveChecker(EventLoop& loop, double device_rate_hz, double interval
   s.interval_s = interval_s;
   s.baseline_s = baseline_s;
   s.false_alarms_per_week = false_alarms_per_week;
+  s.temperature_coefficient_dps_per_c = temperature_coefficient_dps_per_c;
   check_ = std::make_shared<processing::LiveCheck>(s);
   interval_samples_ = check_->samplesPerInterval();
-  examined_ = std::make_shared<std::array<std::vector<double>, 3>>();
+  examined_ = std::make_shared<IntervalData>();
   for (auto& x : filling_) x.reserve(interval_samples_);
   for (auto& x : *examined_) x.reserve(interval_samples_);
 }
@@ -72,7 +79,7 @@ void LiveChecker::breakRun() {
   run_samples_ = 0;
 }
 
-void LiveChecker::onSample(double t_s, const std::array<double, 3>& rate_dps, bool still) {
+void LiveChecker::onSample(double t_s, const std::array<double, 3>& rate_dps, double temperature_c, bool still) {
   const auto verdict = motion_.next(still);
   if (verdict != processing::LiveMotionRule::Verdict::Keep) {
     if (verdict == processing::LiveMotionRule::Verdict::Break) breakRun();
@@ -80,9 +87,10 @@ void LiveChecker::onSample(double t_s, const std::array<double, 3>& rate_dps, bo
   }
   if (summed_ == 0) block_start_t_ = t_s;
   for (std::size_t a = 0; a < 3; ++a) sum_[a] += rate_dps[a];
+  sum_[3] += temperature_c;
   if (++summed_ < decimation_) return;
   if (run_samples_ == 0) run_start_t_ = block_start_t_;
-  for (std::size_t a = 0; a < 3; ++a) filling_[a].push_back(sum_[a] / static_cast<double>(decimation_));
+  for (std::size_t a = 0; a < 4; ++a) filling_[a].push_back(sum_[a] / static_cast<double>(decimation_));
   sum_ = {};
   summed_ = 0;
   ++run_samples_;
@@ -99,7 +107,11 @@ void LiveChecker::examine() {
   std::swap(filling_, *examined_);  // no allocation: the buffers trade places
   ++intervals_;
   try {
-    job_.start([check = check_, data = examined_, t0] { return check->examine(*data, t0); });
+    job_.start([check = check_, data = examined_, t0] {
+      const IntervalData& d = *data;
+      return check->examine(
+          {std::span<const double>(d[0]), std::span<const double>(d[1]), std::span<const double>(d[2])}, d[3], t0);
+    });
   } catch (const std::exception& e) {
     spdlog::warn("live check: cannot start an examination ({}); the interval is left out", e.what());
     for (auto& x : *examined_) x.clear();

@@ -29,15 +29,18 @@ class LiveChecker {
   // `device_rate_hz`: the samples' rate; the check runs at it divided by the smallest whole
   // factor that brings it to kLiveCheckMaxRateHz or below. Throws std::invalid_argument (the
   // settings, as processing::LiveCheck does).
+  // `temperature_coefficient_dps_per_c`: the coupling filter.model gives each axis (the check
+  // names one that differs).
   LiveChecker(EventLoop& loop, double device_rate_hz, double interval_s, double baseline_s,
-              double false_alarms_per_week, OnChange on_change);
+              double false_alarms_per_week, const std::array<double, 3>& temperature_coefficient_dps_per_c,
+              OnChange on_change);
   LiveChecker(const LiveChecker&) = delete;
   LiveChecker& operator=(const LiveChecker&) = delete;
 
   // On the loop, per sample: `still` is the still detector's verdict; kLiveMotionBreakS of
   // samples in a row without it break the run (and the samples until it says still again are
   // left out); fewer stay in.
-  void onSample(double t_s, const std::array<double, 3>& rate_dps, bool still);
+  void onSample(double t_s, const std::array<double, 3>& rate_dps, double temperature_c, bool still);
   // A gap: the run of still samples breaks.
   void breakRun();
   // On the loop; the caller holds what guards it from the STATUS readers.
@@ -52,11 +55,14 @@ class LiveChecker {
   std::size_t decimation_ = 1;
   std::size_t interval_samples_ = 0;
   std::shared_ptr<processing::LiveCheck> check_;
-  // Filled on the loop, and the one an examination reads (not touched by the loop while it runs).
-  std::array<std::vector<double>, 3> filling_;
-  std::shared_ptr<std::array<std::vector<double>, 3>> examined_;
-  // The decimation's running sums, and the run's data time at its first output sample.
-  std::array<double, 3> sum_{};
+  // Filled on the loop, and the one an examination reads (not touched by the loop while it runs):
+  // the three axes and the temperature.
+  using IntervalData = std::array<std::vector<double>, 4>;  // x, y, z [°/s], temperature [°C]
+  IntervalData filling_;
+  std::shared_ptr<IntervalData> examined_;
+  // The decimation's running sums (axes, temperature), and the run's data time at its first
+  // output sample.
+  std::array<double, 4> sum_{};
   std::size_t summed_ = 0;
   double block_start_t_ = 0.0;
   double run_start_t_ = 0.0;

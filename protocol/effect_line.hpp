@@ -19,8 +19,15 @@ inline nlohmann::json effectJson(const processing::LiveEffect& e) {
     params = {{"centre_hz", e.centre_hz}, {"centre_hz_95", pair(e.centre_hz_95)}, {"width_hz", e.width_hz},
               {"rms_dps", e.rms_dps},     {"rms_dps_95", pair(e.rms_dps_95)},     {"power_ratio", e.power_ratio}};
     if (e.baseline_rms_dps > 0.0) params["baseline_rms_dps"] = e.baseline_rms_dps;
-  } else {
+  } else if (e.kind == processing::LiveEffectKind::OutlierBurst) {
     params = {{"count", e.count}, {"expected", e.expected}, {"largest_z", e.largest_z}};
+  } else if (e.kind == processing::LiveEffectKind::BiasStep) {
+    params = {{"size_dps", e.size_dps}, {"size_dps_95", pair(e.size_dps_95)}, {"scale_s", e.scale_s}, {"z", e.z}};
+  } else {
+    params = {{"coefficient_dps_per_c", e.coefficient_dps_per_c},
+              {"coefficient_dps_per_c_95", pair(e.coefficient_dps_per_c_95)},
+              {"baseline_coefficient_dps_per_c", e.baseline_coefficient_dps_per_c},
+              {"temperature_change_c", e.temperature_change_c}};
   }
   return {{"class", "EFFECT"},
           {"state", e.gone ? "gone" : "new"},

@@ -2,6 +2,7 @@
 
 #include <boost/math/distributions/chi_squared.hpp>
 #include <boost/math/distributions/normal.hpp>
+#include <boost/math/distributions/students_t.hpp>
 #include <stdexcept>
 
 namespace gyrod::processing {
@@ -27,6 +28,12 @@ double chiSquareCdf(double x, double dof) {
     throw std::invalid_argument("the chi-square probability needs degrees of freedom > 0, got " + std::to_string(dof));
   if (x <= 0.0) return 0.0;
   return boost::math::cdf(boost::math::chi_squared_distribution<double>(dof), x);
+}
+
+double studentTUpperTail(double t, double dof) {
+  if (!(dof > 0.0))
+    throw std::invalid_argument("the t probability needs degrees of freedom > 0, got " + std::to_string(dof));
+  return boost::math::cdf(boost::math::complement(boost::math::students_t_distribution<double>(dof), t));
 }
 
 }  // namespace gyrod::processing

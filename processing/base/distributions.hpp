@@ -11,5 +11,8 @@ double normalCdf(double z);
 double chiSquareQuantile(double p, double dof);
 // P(X ≤ x) for X ~ χ²(dof).
 double chiSquareCdf(double x, double dof);
+// P(T > t) for T ~ Student's t with `dof` degrees of freedom (fractional allowed, > 0): a
+// difference over a standard deviation estimated with that many degrees of freedom.
+double studentTUpperTail(double t, double dof);
 
 }  // namespace gyrod::processing

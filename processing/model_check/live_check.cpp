@@ -19,7 +19,7 @@ namespace gyrod::processing {
 namespace {
 
 constexpr double kSecondsPerWeek = 7.0 * 86400.0;
-constexpr std::size_t kLiveDetectors = 2;  // lines, outlier bursts
+constexpr std::size_t kLiveDetectors = 4;  // lines, outlier bursts, bias steps, temperature couplings
 constexpr std::size_t kOutlierHalfWindow = 10;
 // The lowest bins are left out of the line search: below ~0.5 Hz a board's slow noise
 // (flicker, random walk) moves the power from one interval to the next more than Welch's
@@ -55,6 +55,34 @@ std::string formatRatio(double r) {
   std::snprintf(buf, sizeof buf, "%.3g", r);
   return buf;
 }
+
+std::string formatDps(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g deg/s", v);
+  return buf;
+}
+
+// Means of consecutive blocks of `block` samples (a last, partial block left out).
+std::vector<double> blockMeans(std::span<const double> x, std::size_t block) {
+  std::vector<double> out;
+  if (block == 0) return out;
+  out.reserve(x.size() / block);
+  for (std::size_t s = 0; s + block <= x.size(); s += block) {
+    double sum = 0.0;
+    for (std::size_t i = s; i < s + block; ++i) sum += x[i];
+    out.push_back(sum / static_cast<double>(block));
+  }
+  return out;
+}
+
+double meanOf(const std::vector<double>& y, std::size_t from, std::size_t to) {
+  double sum = 0.0;
+  for (std::size_t j = from; j < to; ++j) sum += y[j];
+  return sum / static_cast<double>(to - from);
+}
+
+// Two-sided P(|T| > |t|) for Student's t with `dof` degrees of freedom.
+double twoSidedT(double t, double dof) { return 2.0 * studentTUpperTail(std::fabs(t), dof); }
 
 // P(N ≥ c) for N ~ Poisson(mu).
 double poissonUpperTail(std::size_t c, double mu) {
@@ -173,6 +201,8 @@ const char* liveEffectName(LiveEffectKind kind) {
   switch (kind) {
     case LiveEffectKind::Line: return "line";
     case LiveEffectKind::OutlierBurst: return "outlier_burst";
+    case LiveEffectKind::BiasStep: return "bias_step";
+    case LiveEffectKind::TemperatureBias: return "temperature_bias";
   }
   return "?";
 }
@@ -231,6 +261,21 @@ LiveCheck::LiveCheck(const LiveCheckSettings& settings) : settings_(settings) {
   while (segment_ * 2 <= interval_samples_ / 16 && segment_ < 1024) segment_ *= 2;
   segment_w2_ = hannSumOfSquares(segment_);
   baseline_needed_ = static_cast<std::size_t>(std::ceil(settings.baseline_s / settings.interval_s - 1e-9));
+  for (double k : settings.temperature_coefficient_dps_per_c)
+    if (!std::isfinite(k)) throw std::invalid_argument("live check: temperature_coefficient_dps_per_c must be finite");
+  block_ = std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(kLiveBlockS * settings.rate_hz)));
+  blocks_ = interval_samples_ / block_;
+  if (blocks_ >= 2) {
+    for (std::size_t s = 1; s <= blocks_ / 2; s *= 2) scales_.push_back(s);
+    if (scales_.back() != blocks_ / 2) scales_.push_back(blocks_ / 2);
+    scales_.push_back(blocks_);
+  }
+  for (AllanPool& p : pool_) {
+    p.sum_half_d2.assign(scales_.size(), 0.0);
+    p.terms.assign(scales_.size(), 0.0);
+    p.dof.assign(scales_.size(), 0.0);
+  }
+  level_since_t_.fill(-std::numeric_limits<double>::infinity());
   const double intervals_per_week = kSecondsPerWeek / settings.interval_s;
   alpha_ =
       settings.false_alarms_per_week / (intervals_per_week * static_cast<double>(kLiveDetectors * baseline_.size()));
@@ -413,6 +458,176 @@ std::optional<LiveEffect> LiveCheck::findOutlierBurst(std::size_t axis, const Ax
   return e;
 }
 
+double LiveCheck::knownCoupling(std::size_t axis) const { return settings_.temperature_coefficient_dps_per_c[axis]; }
+
+// The window's middle boundaries: blocks_/2 .. blocks_/2 + blocks_ − 1 of its 2·blocks_, so
+// that successive windows (one interval apart) judge each boundary once, each with half an
+// interval of data or more on both sides.
+void LiveCheck::addToPool(std::size_t axis, const std::vector<double>& y, std::size_t first) {
+  const std::size_t m = blocks_, lo = m / 2;
+  for (std::size_t i = 0; i < scales_.size(); ++i) {
+    const std::size_t s = scales_[i];
+    double sum = 0.0, count = 0.0;
+    for (std::size_t c = lo; c < lo + m; ++c) {
+      if (c < first + s || c + s > y.size()) continue;
+      const double d = meanOf(y, c, c + s) - meanOf(y, c - s, c);
+      sum += 0.5 * d * d;
+      count += 1.0;
+    }
+    if (count == 0.0) continue;
+    AllanPool& p = pool_[axis];
+    p.sum_half_d2[i] += sum;
+    p.terms[i] += count;
+    // Differences 2s blocks apart are independent; overlapping ones add about half as much
+    // again (the overlapping estimator's gain on white noise), hence 0.75 per s blocks spanned.
+    p.dof[i] += 0.75 * std::min(count, static_cast<double>(m) / static_cast<double>(s));
+  }
+}
+
+std::optional<LiveEffect> LiveCheck::findStep(std::size_t axis, const std::vector<double>& y, std::size_t first,
+                                              double window_t0) const {
+  const std::size_t m = blocks_, lo = m / 2;
+  const AllanPool& p = pool_[axis];
+  const double block_s = static_cast<double>(block_) / settings_.rate_hz;
+  struct Best {
+    double p = 2.0, d = 0.0, z = 0.0, sd = 0.0;
+    std::size_t c = 0, i = 0;
+  } best;
+  std::size_t tests = 0;
+  for (std::size_t i = 0; i + 1 < scales_.size(); ++i) {  // the last scale (a whole interval) is the coupling's
+    const std::size_t s = scales_[i];
+    if (!(p.dof[i] >= 1.0) || !(p.sum_half_d2[i] > 0.0)) continue;
+    const double sd = std::sqrt(2.0 * p.sum_half_d2[i] / p.terms[i]);  // of a difference: √2·σA
+    for (std::size_t c = lo; c < lo + m; ++c) {
+      if (c < first + s || c + s > y.size()) continue;
+      const double d = meanOf(y, c, c + s) - meanOf(y, c - s, c);
+      const double pv = twoSidedT(d / sd, p.dof[i]);
+      ++tests;
+      if (pv < best.p) best = {pv, d, d / sd, sd, c, i};
+    }
+  }
+  if (tests == 0 || !(best.p * static_cast<double>(tests) < alpha_)) return std::nullopt;
+  // Where it is: one step fitted to all the window's blocks since `first` by least squares (the
+  // detection judged the middle boundaries only; a step near the window's end shows there
+  // too, a block or more early). The 95 % interval holds the boundaries whose cost is within
+  // 3.84 of the best in units of a block mean's variance (σA² at one block), widened by a
+  // block on each side.
+  const double block_var = p.sum_half_d2[0] / p.terms[0];
+  const std::size_t n = y.size();
+  std::vector<double> cost(n, std::numeric_limits<double>::infinity());
+  for (std::size_t c = first + 1; c < n; ++c) {
+    const double a = meanOf(y, first, c), b = meanOf(y, c, n);
+    double rss = 0.0;
+    for (std::size_t j = first; j < n; ++j) rss += (y[j] - (j < c ? a : b)) * (y[j] - (j < c ? a : b));
+    cost[c] = rss / block_var;
+  }
+  const auto at_best = std::min_element(cost.begin(), cost.end());
+  const auto c_best = static_cast<std::size_t>(at_best - cost.begin());
+  std::size_t c_lo = c_best, c_hi = c_best;
+  for (std::size_t c = first + 1; c < n; ++c)
+    if (cost[c] - *at_best <= 3.84) {
+      c_lo = std::min(c_lo, c);
+      c_hi = std::max(c_hi, c);
+    }
+  // Its size at the detection's scale, or the largest that fits, from the blocks clear of the
+  // onset's interval on both sides (the block the step fell in holds part of it).
+  const std::size_t before_end = c_lo - 1, after_start = std::min(n, c_hi + 1);
+  std::size_t i = best.i;
+  while (i > 0 && (before_end < first + scales_[i] || after_start + scales_[i] > n)) --i;
+  const std::size_t s = scales_[i];
+  const bool fits = before_end >= first + s && after_start + s <= n;
+  const double sd = fits ? std::sqrt(2.0 * p.sum_half_d2[i] / p.terms[i]) : best.sd;
+  const double size = fits ? meanOf(y, after_start, after_start + s) - meanOf(y, before_end - s, before_end) : best.d;
+  const auto at = [&](std::size_t c) { return window_t0 + static_cast<double>(c) * block_s; };
+  LiveEffect e;
+  e.kind = LiveEffectKind::BiasStep;
+  e.axis = axis;
+  e.onset_t = at(c_best);
+  e.onset_95 = {at(c_lo - 1), at(std::min(n, c_hi + 1))};
+  e.size_dps = size;
+  e.size_dps_95 = {size - 1.96 * sd, size + 1.96 * sd};
+  e.scale_s = static_cast<double>(s) * block_s;
+  e.z = best.z;
+  e.evidence = "the mean of the " + formatSeconds(static_cast<double>(scales_[best.i]) * block_s) +
+               " after a boundary differs from the same before it by " + formatDps(best.d) + ", " +
+               formatRatio(std::fabs(best.z)) + " x the board's own sqrt(2)*Allan deviation there (t p " +
+               formatRatio(best.p) + " over " + std::to_string(tests) + " tests, family threshold " +
+               formatRatio(alpha_) + ")";
+  return e;
+}
+
+std::optional<LiveEffect> LiveCheck::findCoupling(std::size_t axis, const std::vector<double>& y,
+                                                  const std::vector<double>& temp, double window_t0) const {
+  const std::size_t m = blocks_, n = y.size();
+  if (scales_.empty() || temp.size() != n || n != 2 * m) return std::nullopt;
+  const double dt = meanOf(temp, m, n) - meanOf(temp, 0, m);
+  if (!(std::fabs(dt) >= kLiveMinTemperatureChangeC)) return std::nullopt;
+  const AllanPool& p = pool_[axis];
+  const std::size_t last = scales_.size() - 1;
+  if (!(p.dof[last] >= 1.0) || !(p.sum_half_d2[last] > 0.0)) return std::nullopt;
+  const double k0 = knownCoupling(axis);
+  const double sd = std::sqrt(2.0 * p.sum_half_d2[last] / p.terms[last]);
+  const double dy = meanOf(y, m, n) - meanOf(y, 0, m) - k0 * dt;
+  const double pv = twoSidedT(dy / sd, p.dof[last]);
+  if (!(pv < alpha_)) return std::nullopt;
+  // What the temperature's shape explains against what the best single step explains.
+  const double t_mean = meanOf(temp, 0, n);
+  double stt = 0.0, sty = 0.0;
+  std::vector<double> r(n);
+  for (std::size_t j = 0; j < n; ++j) r[j] = y[j] - k0 * temp[j];
+  const double r_mean = meanOf(r, 0, n);
+  for (std::size_t j = 0; j < n; ++j) {
+    stt += (temp[j] - t_mean) * (temp[j] - t_mean);
+    sty += (temp[j] - t_mean) * (r[j] - r_mean);
+  }
+  const double slope = sty / stt;
+  double rss_t = 0.0;
+  for (std::size_t j = 0; j < n; ++j) {
+    const double e = r[j] - r_mean - slope * (temp[j] - t_mean);
+    rss_t += e * e;
+  }
+  double rss_step = std::numeric_limits<double>::infinity();
+  for (std::size_t c = 1; c < n; ++c) {
+    const double a = meanOf(r, 0, c), b = meanOf(r, c, n);
+    double rss = 0.0;
+    for (std::size_t j = 0; j < n; ++j) rss += (r[j] - (j < c ? a : b)) * (r[j] - (j < c ? a : b));
+    rss_step = std::min(rss_step, rss);
+  }
+  if (!(rss_t < rss_step)) return std::nullopt;
+  LiveEffect e;
+  e.kind = LiveEffectKind::TemperatureBias;
+  e.axis = axis;
+  const double block_s = static_cast<double>(block_) / settings_.rate_hz;
+  e.onset_t = window_t0;
+  e.onset_95 = {window_t0, window_t0 + static_cast<double>(n) * block_s};
+  e.coefficient_dps_per_c = k0 + slope;
+  const double half = 1.96 * sd / std::fabs(dt);
+  e.coefficient_dps_per_c_95 = {e.coefficient_dps_per_c - half, e.coefficient_dps_per_c + half};
+  e.baseline_coefficient_dps_per_c = k0;
+  e.temperature_change_c = dt;
+  e.evidence = "the temperature moved " + formatRatio(dt) + " C between the last two intervals and their means by " +
+               formatDps(dy) + " more than the known coupling explains, " + formatRatio(std::fabs(dy / sd)) +
+               " x the board's own sqrt(2)*Allan deviation at one interval (t p " + formatRatio(pv) +
+               "); the temperature's shape fits the blocks better than any one step";
+  return e;
+}
+
+bool LiveCheck::couplingStillShows(const LiveEffect& e, const std::vector<double>& y,
+                                   const std::vector<double>& temp) const {
+  const std::size_t m = blocks_, n = y.size();
+  if (scales_.empty() || temp.size() != n || n != 2 * m) return true;
+  const AllanPool& p = pool_[e.axis];
+  const std::size_t last = scales_.size() - 1;
+  if (!(p.sum_half_d2[last] > 0.0)) return true;
+  const double sd = std::sqrt(2.0 * p.sum_half_d2[last] / p.terms[last]);
+  const double dt = meanOf(temp, m, n) - meanOf(temp, 0, m);
+  const double k0 = knownCoupling(e.axis);
+  // Only a window where the named coupling would stand out (3 × the noise) can show it gone.
+  if (std::fabs((e.coefficient_dps_per_c - k0) * dt) < 3.0 * sd) return true;
+  const double dy = meanOf(y, m, n) - meanOf(y, 0, m) - k0 * dt;
+  return std::fabs(dy) >= 1.96 * sd;
+}
+
 bool LiveCheck::lineShowsIn(const LiveEffect& e, std::span<const double> x) const {
   if (e.baseline_rms_dps > 0.0) {
     // A grown baseline line: still over kLiveLineGrowth times its old rms.
@@ -451,15 +666,81 @@ bool LiveCheck::stillShows(const LiveEffect& e, const AxisInterval& in, const st
   return lineShowsIn(e, in.cleaned) || (both != nullptr && lineShowsIn(e, *both));
 }
 
-std::vector<LiveEffect> LiveCheck::examine(const std::array<std::vector<double>, 3>& axes, double t0) {
+LiveCheck::LevelWindow LiveCheck::levelWindow(const std::array<std::vector<double>, 3>& blocks,
+                                              const std::vector<double>& temp_blocks, bool contiguous) const {
+  LevelWindow w;
+  w.ok = contiguous && !scales_.empty() && previous_blocks_[0].size() == blocks_;
+  if (!w.ok) return w;
+  w.t0 = previous_t0_;
+  for (std::size_t a = 0; a < blocks.size(); ++a) {
+    w.y[a] = previous_blocks_[a];
+    w.y[a].insert(w.y[a].end(), blocks[a].begin(), blocks[a].end());
+  }
+  if (temp_blocks.size() == blocks_ && previous_temperature_blocks_.size() == blocks_) {
+    w.temp = previous_temperature_blocks_;
+    w.temp.insert(w.temp.end(), temp_blocks.begin(), temp_blocks.end());
+  }
+  return w;
+}
+
+std::size_t LiveCheck::firstBlock(std::size_t axis, double window_t0) const {
+  const double since = (level_since_t_[axis] - window_t0) / (static_cast<double>(block_) / settings_.rate_hz);
+  return since <= 0.0 ? 0 : static_cast<std::size_t>(std::ceil(since - 1e-9));
+}
+
+std::vector<double> LiveCheck::corrected(const LevelWindow& w, std::size_t axis, double k) {
+  std::vector<double> y = w.y[axis];
+  if (!w.temp.empty())
+    for (std::size_t j = 0; j < y.size(); ++j) y[j] -= k * (w.temp[j] - w.temp[0]);
+  return y;
+}
+
+const LiveEffect* LiveCheck::currentEffect(LiveEffectKind kind, std::size_t axis) const {
+  for (const LiveEffect& c : current_)
+    if (c.kind == kind && c.axis == axis) return &c;
+  return nullptr;
+}
+
+void LiveCheck::findLevelChanges(std::size_t axis, const LevelWindow& w, std::vector<LiveEffect>& found) {
+  // A coupling first (a warm-up's bias drift is its, not a step's), then steps in what the
+  // coupling in force leaves; a window with neither adds to the board's Allan pool.
+  const std::size_t first = firstBlock(axis, w.t0);
+  bool named = false;
+  double k = knownCoupling(axis);
+  const LiveEffect* named_coupling = currentEffect(LiveEffectKind::TemperatureBias, axis);
+  if (named_coupling != nullptr) k = named_coupling->coefficient_dps_per_c;
+  if (!w.temp.empty() && first == 0 && named_coupling == nullptr)
+    if (auto c = findCoupling(axis, w.y[axis], w.temp, w.t0)) {
+      k = c->coefficient_dps_per_c;
+      found.push_back(*c);
+      named = true;
+    }
+  const std::vector<double> y = corrected(w, axis, k);
+  if (auto step = findStep(axis, y, first, w.t0)) {
+    level_since_t_[axis] = step->onset_95.hi;
+    found.push_back(*step);
+    named = true;
+  }
+  if (!named) addToPool(axis, y, first);
+}
+
+std::vector<LiveEffect> LiveCheck::examine(const std::array<std::span<const double>, 3>& axes,
+                                           std::span<const double> temperature_c, double t0) {
   std::vector<LiveEffect> changes;
   for (const auto& x : axes)
     if (x.size() != interval_samples_) return changes;
+  if (!temperature_c.empty() && temperature_c.size() != interval_samples_) return changes;
   std::array<AxisInterval, 3> in;
   for (std::size_t a = 0; a < axes.size(); ++a) in[a] = prepare(axes[a]);
   const double length_s = static_cast<double>(interval_samples_) / settings_.rate_hz;
   const bool contiguous = have_previous_ && std::fabs(previous_t0_ + length_s - t0) < 0.5 / settings_.rate_hz;
+  std::array<std::vector<double>, 3> blocks;
+  for (std::size_t a = 0; a < axes.size(); ++a) blocks[a] = blockMeans(in[a].cleaned, block_);
+  const std::vector<double> temp_blocks = blockMeans(temperature_c, block_);
+  const LevelWindow window = levelWindow(blocks, temp_blocks, contiguous);
   const auto keep = [&] {
+    for (std::size_t a = 0; a < axes.size(); ++a) previous_blocks_[a] = blocks[a];
+    previous_temperature_blocks_ = temp_blocks;
     before_previous_t0_ = previous_t0_;
     have_before_previous_ = have_previous_;
     for (std::size_t a = 0; a < axes.size(); ++a) {
@@ -485,6 +766,9 @@ std::vector<LiveEffect> LiveCheck::examine(const std::array<std::vector<double>,
       b.samples += static_cast<double>(in[a].scores.size());
       b.intervals.push_back(in[a].cleaned);
     }
+    if (window.ok)
+      for (std::size_t a = 0; a < axes.size(); ++a)
+        addToPool(a, corrected(window, a, knownCoupling(a)), firstBlock(a, window.t0));
     if (++baseline_intervals_ == baseline_needed_) finishBaseline();
     keep();
     return changes;
@@ -498,7 +782,14 @@ std::vector<LiveEffect> LiveCheck::examine(const std::array<std::vector<double>,
       both[a].insert(both[a].end(), in[a].cleaned.begin(), in[a].cleaned.end());
     }
   for (auto it = current_.begin(); it != current_.end();) {
-    if (stillShows(*it, in[it->axis], contiguous ? &both[it->axis] : nullptr)) {
+    bool shows = false;  // a bias step is an event: the level after it is the board's from now on
+    if (it->kind == LiveEffectKind::TemperatureBias) {
+      shows = !window.ok || window.temp.empty() || firstBlock(it->axis, window.t0) != 0 ||
+              couplingStillShows(*it, window.y[it->axis], window.temp);
+    } else if (it->kind != LiveEffectKind::BiasStep) {
+      shows = stillShows(*it, in[it->axis], contiguous ? &both[it->axis] : nullptr);
+    }
+    if (shows) {
       ++it;
       continue;
     }
@@ -511,7 +802,7 @@ std::vector<LiveEffect> LiveCheck::examine(const std::array<std::vector<double>,
   }
   const auto known = [this](const LiveEffect& e) {
     return std::any_of(current_.begin(), current_.end(), [&e](const LiveEffect& c) {
-      if (c.axis != e.axis || c.kind != e.kind) return false;
+      if (c.axis != e.axis || c.kind != e.kind || e.kind == LiveEffectKind::BiasStep) return false;
       return e.kind != LiveEffectKind::Line ||
              std::fabs(c.centre_hz - e.centre_hz) <= 0.5 * (c.width_hz + e.width_hz) + 0.1;
     });
@@ -534,6 +825,7 @@ std::vector<LiveEffect> LiveCheck::examine(const std::array<std::vector<double>,
                                    contiguous ? alpha_ / 2 : alpha_))
       found.push_back(e);
     if (auto burst = findOutlierBurst(a, in[a], t0, contiguous)) found.push_back(*burst);
+    if (window.ok) findLevelChanges(a, window, found);
     for (LiveEffect& e : found) {
       e.t = t_end;
       if (known(e)) continue;

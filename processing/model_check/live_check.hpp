@@ -12,7 +12,15 @@
 //    A run of bins above the family threshold is a line, with its centre, width and rms, and
 //    its onset from the power at its centre in 10 s blocks;
 //  - an outlier burst: samples whose robust z against their neighbours (localOutlierScores)
-//    exceeds kLiveOutlierZ, counted against the baseline's rate (Poisson).
+//    exceeds kLiveOutlierZ, counted against the baseline's rate (Poisson);
+//  - a bias step: in 10 s block means of the last two intervals, the difference of the means
+//    s blocks after and s blocks before each block boundary of the window's middle, over
+//    √2·σA(s), the board's own overlapping Allan deviation at that scale pooled over its still
+//    data so far (Student's t with the pool's degrees of freedom: a young pool asks for more);
+//  - a temperature coupling that is not the board's: when the temperature moved between the
+//    last two intervals, their means' difference less what the known coupling explains, over
+//    √2·σA(one interval), named when the temperature's shape fits the blocks better than any
+//    one step does.
 // Each detector's threshold is set from a false-alarm budget per board-week
 // (LiveCheckSettings::false_alarms_per_week, shared by the detectors and the axes) and the
 // number of intervals in a week. An effect is reported once when first named ("new") and
@@ -54,10 +62,20 @@ struct LiveCheckSettings {
   double baseline_s = 1800.0;  // the first still data, rounded up to whole intervals
   // Expected false EFFECT lines per week of clean data, all detectors and axes together.
   double false_alarms_per_week = 0.25;
+  // The bias's temperature coupling the board is known to have, per axis (a model file's): the
+  // check names a coupling that differs from it.
+  std::array<double, 3> temperature_coefficient_dps_per_c{};
 };
 
-enum class LiveEffectKind { Line, OutlierBurst };
-const char* liveEffectName(LiveEffectKind kind);  // "line", "outlier_burst"
+// The block of the step and coupling detectors, in seconds of data.
+inline constexpr double kLiveBlockS = 10.0;
+// The temperature must move at least this much between two intervals for the coupling to be
+// judged (below it no slope can be told from the noise on a board's usual scale).
+inline constexpr double kLiveMinTemperatureChangeC = 0.2;
+
+enum class LiveEffectKind { Line, OutlierBurst, BiasStep, TemperatureBias };
+// "line", "outlier_burst", "bias_step", "temperature_bias"
+const char* liveEffectName(LiveEffectKind kind);
 
 struct LiveInterval95 {
   double lo = 0.0, hi = 0.0;
@@ -79,6 +97,14 @@ struct LiveEffect {
   double baseline_rms_dps = 0.0;  // a line the baseline had, grown: its rms there (else 0)
   std::size_t count = 0;
   double expected = 0.0, largest_z = 0.0;
+  // Bias step: size_dps (after − before) at the scale that showed it, scale_s (the data on
+  // each side), z (size over √2·σA there).
+  double size_dps = 0.0, scale_s = 0.0, z = 0.0;
+  LiveInterval95 size_dps_95;
+  // Temperature bias: the coupling now (regression of the blocks on temperature) and the one
+  // the board was known to have, and the temperature change that showed it.
+  double coefficient_dps_per_c = 0.0, baseline_coefficient_dps_per_c = 0.0, temperature_change_c = 0.0;
+  LiveInterval95 coefficient_dps_per_c_95;
   std::string evidence;  // one sentence: the statistic against its threshold
 };
 
@@ -91,8 +117,19 @@ class LiveCheck {
 
   // One interval: per axis the still samples (°/s) at the settings' rate, the interval's
   // data time [t0, t0 + n/rate). Intervals of other lengths are refused (returns nothing).
-  // Returns what changed: effects newly named and effects gone.
-  std::vector<LiveEffect> examine(const std::array<std::vector<double>, 3>& axes, double t0);
+  // `temperature_c`: the die temperature at the same samples, or empty (then no coupling is
+  // judged). Returns what changed: effects newly named and effects gone.
+  std::vector<LiveEffect> examine(const std::array<std::span<const double>, 3>& axes,
+                                  std::span<const double> temperature_c, double t0);
+  std::vector<LiveEffect> examine(const std::array<std::vector<double>, 3>& axes, std::span<const double> temperature_c,
+                                  double t0) {
+    return examine(
+        {std::span<const double>(axes[0]), std::span<const double>(axes[1]), std::span<const double>(axes[2])},
+        temperature_c, t0);
+  }
+  std::vector<LiveEffect> examine(const std::array<std::vector<double>, 3>& axes, double t0) {
+    return examine(axes, {}, t0);
+  }
 
   bool baselineReady() const { return baseline_intervals_ >= baseline_needed_; }
   const std::vector<LiveEffect>& current() const { return current_; }
@@ -140,6 +177,41 @@ class LiveCheck {
   bool stillShows(const LiveEffect& e, const AxisInterval& in, const std::vector<double>* both) const;
   bool lineShowsIn(const LiveEffect& e, std::span<const double> x) const;
   double outlierRate(std::size_t axis) const;
+  // The overlapping Allan variance of 10 s block means at each scale, pooled over the board's
+  // contiguous still windows with nothing named in them: Σ d²/2, their number, and the degrees
+  // of freedom they are worth.
+  struct AllanPool {
+    std::vector<double> sum_half_d2, terms, dof;
+  };
+  // Block means of a window `y` (2 intervals, corrected for the known coupling): adds its
+  // differences at the window's middle boundaries to the pool; `first` the earliest block
+  // that may be used (after a step named in the window).
+  void addToPool(std::size_t axis, const std::vector<double>& y, std::size_t first);
+  std::optional<LiveEffect> findStep(std::size_t axis, const std::vector<double>& y, std::size_t first,
+                                     double window_t0) const;
+  std::optional<LiveEffect> findCoupling(std::size_t axis, const std::vector<double>& y,
+                                         const std::vector<double>& temp, double window_t0) const;
+  // The step and coupling detectors' window: 10 s block means of the interval before and this
+  // one, when contiguous (ok), and the temperature's when both intervals carry it; t0 is its start.
+  struct LevelWindow {
+    std::array<std::vector<double>, 3> y;
+    std::vector<double> temp;
+    double t0 = 0.0;
+    bool ok = false;
+  };
+  LevelWindow levelWindow(const std::array<std::vector<double>, 3>& blocks, const std::vector<double>& temp_blocks,
+                          bool contiguous) const;
+  // The first block of a window starting at window_t0 after the last step named on the axis.
+  std::size_t firstBlock(std::size_t axis, double window_t0) const;
+  // The window's blocks of one axis less what a coupling k explains.
+  static std::vector<double> corrected(const LevelWindow& w, std::size_t axis, double k);
+  const LiveEffect* currentEffect(LiveEffectKind kind, std::size_t axis) const;
+  // Couplings and steps on one axis of the window, appended to `found`.
+  void findLevelChanges(std::size_t axis, const LevelWindow& w, std::vector<LiveEffect>& found);
+  // Whether a named coupling still differs from the known one (false when the window shows
+  // the known coupling again; true when the temperature did not move enough to tell).
+  bool couplingStillShows(const LiveEffect& e, const std::vector<double>& y, const std::vector<double>& temp) const;
+  double knownCoupling(std::size_t axis) const;
 
   LiveCheckSettings settings_;
   std::size_t interval_samples_ = 0, segment_ = 0;
@@ -152,6 +224,14 @@ class LiveCheck {
   double previous_t0_ = 0.0, before_previous_t0_ = 0.0;  // and the start of the one before it
   bool have_previous_ = false, have_before_previous_ = false;
   std::array<double, 3> previous_first_outlier_t_{};  // NaN: the interval before had none
+  std::size_t block_ = 0, blocks_ = 0;                // samples per block, blocks per interval
+  std::vector<std::size_t> scales_;                   // the step detector's scales, in blocks (1, 2, 4, …, blocks_)
+  std::array<AllanPool, 3> pool_;
+  // Block means of the interval before (cleaned), and of its temperature (empty: none).
+  std::array<std::vector<double>, 3> previous_blocks_;
+  std::vector<double> previous_temperature_blocks_;
+  // The data time of the last step named per axis: no difference reaches back across it.
+  std::array<double, 3> level_since_t_{};
   std::vector<LiveEffect> current_;
   // Effects said gone at the last two examinations: the two-interval window still holds the
   // interval before their end, and must not name them again from it.

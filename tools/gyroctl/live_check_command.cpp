@@ -11,6 +11,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -52,9 +53,15 @@ std::string effectText(const processing::LiveEffect& e) {
   if (e.kind == processing::LiveEffectKind::Line) {
     s += ": " + g4(e.centre_hz) + " Hz " + range(e.centre_hz_95) + ", " + g4(e.width_hz) + " Hz wide, rms " +
          g4(e.rms_dps) + " deg/s " + range(e.rms_dps_95);
-  } else {
+  } else if (e.kind == processing::LiveEffectKind::OutlierBurst) {
     s += ": " + std::to_string(e.count) + " samples beyond robust z " + g4(processing::kLiveOutlierZ) + " (" +
          g4(e.expected) + " expected), largest z " + g4(e.largest_z);
+  } else if (e.kind == processing::LiveEffectKind::BiasStep) {
+    s += ": " + g4(e.size_dps) + " deg/s " + range(e.size_dps_95) + " over " + g4(e.scale_s) + " s each side";
+  } else {
+    s += ": " + g4(e.coefficient_dps_per_c) + " deg/s per C " + range(e.coefficient_dps_per_c_95) + " where " +
+         g4(e.baseline_coefficient_dps_per_c) + " was known, the temperature moving " + g4(e.temperature_change_c) +
+         " C";
   }
   return s + ", onset " + g4(e.onset_t) + " s " + range(e.onset_95) + "; " + e.evidence;
 }
@@ -95,6 +102,10 @@ int runLiveCheck(const LiveCheckOptions& opt) {
   const std::size_t n = check.samplesPerInterval(), total = rec.size();
   std::array<std::vector<double>, 3> interval;
   for (auto& x : interval) x.reserve(n);
+  // The die temperature beside them, when the recording has it (the coupling is judged on it).
+  const bool have_temp = rec.temp.size() == total;
+  std::vector<double> temperature;
+  temperature.reserve(n);
   std::size_t lost_index = 0, examined = 0, left_out = 0;
   double run_start_t = 0.0;
   std::size_t run_samples = 0;  // since the run began: the nominal clock of its intervals
@@ -104,6 +115,7 @@ int runLiveCheck(const LiveCheckOptions& opt) {
   const auto breakRun = [&] {
     left_out += interval[0].size();
     for (auto& x : interval) x.clear();
+    temperature.clear();
     run_samples = 0;
   };
   for (std::size_t i = 0; i < total; ++i) {
@@ -124,15 +136,21 @@ int runLiveCheck(const LiveCheckOptions& opt) {
     }
     if (run_samples == 0) run_start_t = sampleTime(i);
     for (std::size_t a = 0; a < 3; ++a) interval[a].push_back((*gyro[a])[i]);
+    if (have_temp) temperature.push_back(rec.temp[i]);
     ++run_samples;
     if (interval[0].size() < n) continue;
     const double t0 = run_start_t + static_cast<double>(run_samples - n) / in.rate_hz;
-    for (const processing::LiveEffect& e : check.examine(interval, t0)) {
+    // A temperature missing anywhere in the interval: no coupling judged on it.
+    const bool temp_ok =
+        have_temp && std::all_of(temperature.begin(), temperature.end(), [](double c) { return std::isfinite(c); });
+    for (const processing::LiveEffect& e :
+         check.examine(interval, temp_ok ? std::span<const double>(temperature) : std::span<const double>(), t0)) {
       std::printf("%s\n", opt.json ? protocol::effectJson(e).dump().c_str() : effectText(e).c_str());
       ++changes_printed;
     }
     ++examined;
     for (auto& x : interval) x.clear();
+    temperature.clear();
   }
   left_out += interval[0].size();
   const std::size_t baseline =
