@@ -23,6 +23,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 #include <numbers>
 #include <optional>
 #include <string>
@@ -67,43 +68,72 @@ LiveCheckSettings settings(double rate_hz, double interval_s, double baseline_s)
   return s;
 }
 
-// The line mode (see above); returns the exit status.
-int lineDelays(std::size_t boards, std::uint64_t seed, double interval, double baseline) {
+// One hidden effect per board: `boards` boards of 2 h, the effect `add`ed to axis (seed + b) % 3
+// from `onset(b)` on. Returns per board the first effect named after the onset on that axis of
+// `kind` (empty when none), and counts the others in *others.
+using Hidden = std::function<double(std::size_t b, double t)>;  // what board b's axis gets at t
+std::vector<std::optional<LiveEffect>> hiddenEffectRuns(std::size_t boards, std::uint64_t seed, double interval,
+                                                        double baseline, LiveEffectKind kind,
+                                                        const std::function<double(std::size_t)>& onset,
+                                                        const Hidden& add, std::size_t* others) {
   const SimulationModel model = cleanBoard();
-  constexpr double kDuration = 7200.0, kOnset = 3600.0, kHz = 12.5;
-  // White rate noise of N °/s/√Hz has σ²(τ₀) = N²/τ₀ per sample (IEEE 952): N = ARW/60.
-  const double sigma = 0.3 / 60.0 * std::sqrt(model.rate_hz);
-  std::size_t named = 0;
-  double worst_centre = 0.0;
-  std::vector<double> delays;
+  constexpr double kDuration = 7200.0;
+  std::vector<std::optional<LiveEffect>> first(boards);
   for (std::size_t b = 0; b < boards; ++b) {
     LiveCheck check(settings(model.rate_hz, interval, baseline));
     NoiseSimulator sim(model, kDuration, seed + b);
     const std::size_t axis = (seed + b) % 3, n = check.samplesPerInterval();
     std::array<std::vector<double>, 3> axes;
     for (auto& x : axes) x.resize(n);
-    std::optional<double> found;
     std::size_t i = 0;
     for (std::size_t k = 0; k < static_cast<std::size_t>(kDuration / interval); ++k) {
       for (std::size_t j = 0; j < n; ++j, ++i) {
         const SimulatedSample sample = sim.next();
         const double t = static_cast<double>(i) / model.rate_hz;
         for (std::size_t a = 0; a < 3; ++a) axes[a][j] = sample.rate_dps[a];
-        if (t >= kOnset) axes[axis][j] += 0.1 * sigma * std::sin(2.0 * std::numbers::pi * kHz * t);
+        if (t >= onset(b)) axes[axis][j] += add(b, t);
       }
-      for (const LiveEffect& e : check.examine(axes, static_cast<double>(k) * interval))
-        if (!e.gone && !found && e.kind == LiveEffectKind::Line && e.axis == axis) {
-          found = e.t - kOnset;
-          worst_centre = std::max(worst_centre, std::fabs(e.centre_hz - kHz) / kHz);
+      for (const LiveEffect& e : check.examine(axes, static_cast<double>(k) * interval)) {
+        if (e.gone) continue;
+        if (e.kind == kind && e.axis == axis && !first[b] && e.t > onset(b)) {
+          first[b] = e;
+        } else if (others != nullptr && ++*others <= 10) {
+          std::printf("board %zu (hidden on axis %zu at %.0f s): %s on axis %zu at %.0f s: %s\n", b, axis, onset(b),
+                      liveEffectName(e.kind), e.axis, e.t, e.evidence.c_str());
         }
+      }
     }
-    if (found && *found <= 600.0) ++named;
-    if (found) delays.push_back(*found);
   }
+  return first;
+}
+
+// The named boards' delays after their onsets, "min-max" s, and how many within 600 s.
+std::string delayRange(const std::vector<std::optional<LiveEffect>>& first,
+                       const std::function<double(std::size_t)>& onset, std::size_t* within) {
+  std::vector<double> delays;
+  for (std::size_t b = 0; b < first.size(); ++b)
+    if (first[b]) delays.push_back(first[b]->t - onset(b));
+  *within = static_cast<std::size_t>(std::count_if(delays.begin(), delays.end(), [](double d) { return d <= 600.0; }));
   std::sort(delays.begin(), delays.end());
-  const std::string range = delays.empty() ? "none"
-                                           : std::to_string(static_cast<int>(delays.front())) + "-" +
-                                                 std::to_string(static_cast<int>(delays.back()));
+  return delays.empty()
+             ? "none"
+             : std::to_string(static_cast<int>(delays.front())) + "-" + std::to_string(static_cast<int>(delays.back()));
+}
+
+// The line mode (see above); returns the exit status.
+int lineDelays(std::size_t boards, std::uint64_t seed, double interval, double baseline) {
+  constexpr double kHz = 12.5;
+  // White rate noise of N °/s/√Hz has σ²(τ₀) = N²/τ₀ per sample (IEEE 952): N = ARW/60.
+  const double sigma = 0.3 / 60.0 * std::sqrt(cleanBoard().rate_hz);
+  const auto onset = [](std::size_t) { return 3600.0; };
+  const auto first = hiddenEffectRuns(
+      boards, seed, interval, baseline, LiveEffectKind::Line, onset,
+      [sigma](std::size_t, double t) { return 0.1 * sigma * std::sin(2.0 * std::numbers::pi * kHz * t); }, nullptr);
+  double worst_centre = 0.0;
+  for (const auto& e : first)
+    if (e) worst_centre = std::max(worst_centre, std::fabs(e->centre_hz - kHz) / kHz);
+  std::size_t named = 0;
+  const std::string range = delayRange(first, onset, &named);
   std::printf(
       "%zu boards, a 12.5 Hz line of 0.1 sigma from 3600 s: %zu named within 600 s on the right axis; "
       "delays %s s; the centre's largest error %.3g %%\n",
@@ -113,47 +143,19 @@ int lineDelays(std::size_t boards, std::uint64_t seed, double interval, double b
 
 // The step mode (see above); returns the exit status.
 int stepDelays(std::size_t boards, std::uint64_t seed, double interval, double baseline, double size) {
-  const SimulationModel model = cleanBoard();
-  constexpr double kDuration = 7200.0;
-  std::size_t named = 0, wrong = 0;
-  std::vector<double> delays;
-  for (std::size_t b = 0; b < boards; ++b) {
-    LiveCheck check(settings(model.rate_hz, interval, baseline));
-    NoiseSimulator sim(model, kDuration, seed + b);
-    const std::size_t axis = (seed + b) % 3, n = check.samplesPerInterval();
-    const double onset = 3600.0 + 300.0 * static_cast<double>((seed + b) * 7919 % 1000) / 1000.0;
-    const double signed_size = (b % 2 ? -1.0 : 1.0) * size;
-    std::array<std::vector<double>, 3> axes;
-    for (auto& x : axes) x.resize(n);
-    std::optional<double> found;
-    std::size_t i = 0;
-    for (std::size_t k = 0; k < static_cast<std::size_t>(kDuration / interval); ++k) {
-      for (std::size_t j = 0; j < n; ++j, ++i) {
-        const SimulatedSample sample = sim.next();
-        const double t = static_cast<double>(i) / model.rate_hz;
-        for (std::size_t a = 0; a < 3; ++a) axes[a][j] = sample.rate_dps[a];
-        if (t >= onset) axes[axis][j] += signed_size;
-      }
-      for (const LiveEffect& e : check.examine(axes, static_cast<double>(k) * interval)) {
-        if (e.gone) continue;
-        if (e.kind == LiveEffectKind::BiasStep && e.axis == axis && !found && e.t > onset)
-          found = e.t - onset;
-        else if (++wrong <= 10)
-          std::printf("board %zu (step on axis %zu at %.0f s): %s on axis %zu at %.0f s: %s\n", b, axis, onset,
-                      liveEffectName(e.kind), e.axis, e.t, e.evidence.c_str());
-      }
-    }
-    if (found && *found <= 600.0) ++named;
-    if (found) delays.push_back(*found);
-  }
-  std::sort(delays.begin(), delays.end());
-  const std::string range = delays.empty() ? "none"
-                                           : std::to_string(static_cast<int>(delays.front())) + "-" +
-                                                 std::to_string(static_cast<int>(delays.back()));
+  const auto onset = [seed](std::size_t b) {
+    return 3600.0 + 300.0 * static_cast<double>((seed + b) * 7919 % 1000) / 1000.0;
+  };
+  std::size_t others = 0;
+  const auto first = hiddenEffectRuns(
+      boards, seed, interval, baseline, LiveEffectKind::BiasStep, onset,
+      [size](std::size_t b, double) { return (b % 2 ? -1.0 : 1.0) * size; }, &others);
+  std::size_t named = 0;
+  const std::string range = delayRange(first, onset, &named);
   std::printf(
       "%zu boards, a bias step of %.4g deg/s at 3600-3900 s: %zu named within 600 s on the right axis "
       "(%.0f %%); delays %s s; %zu other effects named\n",
-      boards, size, named, 100.0 * static_cast<double>(named) / static_cast<double>(boards), range.c_str(), wrong);
+      boards, size, named, 100.0 * static_cast<double>(named) / static_cast<double>(boards), range.c_str(), others);
   return 0;
 }
 

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "gyrod_process.hpp"
+#include "live_sensor_model.hpp"
 #include "tools/run_command.hpp"
 
 using namespace gyrod::test;
@@ -24,18 +25,6 @@ using namespace std::chrono_literals;
 namespace {
 
 constexpr double kLiveOnsetS = 300.0;  // after the baseline (two 60 s intervals) and a few more
-
-std::string liveSensorModel() {
-  std::ostringstream m;
-  m << "rate_hz = 50\n[temperature]\nstart_c = 30\nfinal_c = 30\ntime_constant_s = 900.0\nnoise_std_c = 0.02\n";
-  for (const char* axis : {"x", "y", "z"}) {
-    m << "[" << axis << "]\nquantization_urad = 0.1663\narw_deg_per_sqrt_h = 0.95164\n"
-      << "bias_instability_deg_per_h = 0.60565\nrrw_deg_per_h_sqrt_h = 0.07759\nbias_dps = 0.5\n"
-      << "[" << axis << ".calibration]\nbias_std_dps = 0.02\ntemperature_coefficient_dps_per_c = 0.0\n"
-      << "temperature_coefficient_std_dps_per_c = 0.05\ntemperature_reference_c = 25.0\n";
-  }
-  return m.str();
-}
 
 std::string liveConfig(const ScratchDir& d, const std::string& model_line) {
   std::ostringstream c;
@@ -50,7 +39,7 @@ std::string liveConfig(const ScratchDir& d, const std::string& model_line) {
 
 TEST(GyrodLiveCheck, AVibrationThatStartsReachesWatchersStatusAndTheJournal) {
   ScratchDir d;
-  const auto model = d.write("model.toml", liveSensorModel());
+  const auto model = d.write("model.toml", liveCheckSensorModel());
   const auto cfg = d.write("gyrod.toml", liveConfig(d, "[filter]\nmodel = \"" + model.string() + "\"\n"));
   GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt");
   LineClient watcher((d.path() / "gyrod.sock").string());
@@ -160,7 +149,7 @@ struct Replayed {
 // samples are watched whole (the white noise's σ), then every 1000th.
 Replayed replayUntilEffect(const std::string& mock_lines, double until_s) {
   ScratchDir d;
-  const auto model = d.write("model.toml", liveSensorModel());
+  const auto model = d.write("model.toml", liveCheckSensorModel());
   const auto cfg = d.write("gyrod.toml", replayConfig(d, model.string(), mock_lines));
   GyrodProcess gyrod({"--config", cfg.string()}, d.path() / "log.txt");
   Replayed r;
@@ -220,7 +209,7 @@ void expectNamedInTime(const Replayed& r, double onset_s) {
 // raw samples' own σ is lower (the paper's 20 Hz DLPF takes the noise above 20 Hz off) and is
 // printed beside it.
 TEST(GyrodLiveCheckReplay, ALineOfATenthOfTheNoiseIsNamedWithin10Minutes) {
-  const double kAmplitude = 0.1 * 0.95164 / 60.0 * std::sqrt(50.0);  // liveSensorModel's ARW
+  const double kAmplitude = 0.1 * 0.95164 / 60.0 * std::sqrt(50.0);  // liveCheckSensorModel's ARW
   std::ostringstream mock;
   mock << "motion = \"sine:axis=y,freq=12.5,amp=" << kAmplitude << ",start=" << kReplayOnsetS << "\"\n";
   const Replayed r = replayUntilEffect(mock.str(), kReplayOnsetS + 900.0);

@@ -29,6 +29,7 @@
 #include <fcntl.h>
 
 #include "gyrod_process.hpp"
+#include "live_sensor_model.hpp"
 #include "mqtt_broker.hpp"
 #include "tools/run_command.hpp"
 
@@ -480,18 +481,6 @@ namespace {
 // sensor model (the still detector), a 12.5 Hz vibration of 0.02 deg/s on y from 300 s of data.
 constexpr double kMqttEffectOnsetS = 300.0;
 
-std::string mqttEffectSensorModel() {
-  std::ostringstream m;
-  m << "rate_hz = 50\n[temperature]\nstart_c = 30\nfinal_c = 30\ntime_constant_s = 900.0\nnoise_std_c = 0.02\n";
-  for (const char* axis : {"x", "y", "z"}) {
-    m << "[" << axis << "]\nquantization_urad = 0.1663\narw_deg_per_sqrt_h = 0.95164\n"
-      << "bias_instability_deg_per_h = 0.60565\nrrw_deg_per_h_sqrt_h = 0.07759\nbias_dps = 0.5\n"
-      << "[" << axis << ".calibration]\nbias_std_dps = 0.02\ntemperature_coefficient_dps_per_c = 0.0\n"
-      << "temperature_coefficient_std_dps_per_c = 0.05\ntemperature_reference_c = 25.0\n";
-  }
-  return m.str();
-}
-
 // qos 0 and one RATE message in 1000: the broker is not flooded at 100 x real time, and the
 // effect topic is QoS 1 all the same.
 std::string mqttEffectConfig(const ScratchDir& d, const std::filesystem::path& model, int port) {
@@ -527,7 +516,7 @@ TEST(GyrodMqtt, PublishesEachEffectAndTheSocketListsIt) {
   const int port = freeLoopbackPort();
   Broker broker(port);
   ScratchDir d;
-  const auto model = d.write("model.toml", mqttEffectSensorModel());
+  const auto model = d.write("model.toml", liveCheckSensorModel());
   const auto cfg = d.write("gyrod.toml", mqttEffectConfig(d, model, port));
   Subscriber sub(port, "test/board-1/effect");
   ASSERT_TRUE(sub.connected()) << "no broker on port " << port << " (/usr/sbin/mosquitto: Debian's mosquitto)";

@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <span>
 #include <vector>
 
 #include "processing/base/distributions.hpp"
@@ -54,8 +55,10 @@ double whiteSigma(const std::vector<double>& x) {
   return std::sqrt(ss / static_cast<double>(x.size() - 1) / 2.0);
 }
 
-// Runs the stream through the check interval by interval; every change it reports.
-std::vector<LiveEffect> runLive(LiveCheck& check, const std::array<std::vector<double>, 3>& axes) {
+// Runs the stream (and its temperature, when given) through the check interval by interval;
+// every change it reports.
+std::vector<LiveEffect> runLive(LiveCheck& check, const std::array<std::vector<double>, 3>& axes,
+                                const std::vector<double>& temperature = {}) {
   std::vector<LiveEffect> all;
   const std::size_t n = check.samplesPerInterval();
   for (std::size_t start = 0; start + n <= axes[0].size(); start += n) {
@@ -63,7 +66,9 @@ std::vector<LiveEffect> runLive(LiveCheck& check, const std::array<std::vector<d
     for (std::size_t a = 0; a < 3; ++a)
       interval[a].assign(axes[a].begin() + static_cast<std::ptrdiff_t>(start),
                          axes[a].begin() + static_cast<std::ptrdiff_t>(start + n));
-    const auto changes = check.examine(interval, static_cast<double>(start) / kLiveRate);
+    const std::span<const double> temp =
+        temperature.empty() ? std::span<const double>() : std::span<const double>(temperature).subspan(start, n);
+    const auto changes = check.examine(interval, temp, static_cast<double>(start) / kLiveRate);
     all.insert(all.end(), changes.begin(), changes.end());
   }
   return all;
@@ -277,22 +282,6 @@ std::vector<double> liveTemperature(std::uint64_t seed, double from, double rise
   return t;
 }
 
-std::vector<LiveEffect> runLiveWithTemperature(LiveCheck& check, const std::array<std::vector<double>, 3>& axes,
-                                               const std::vector<double>& temperature) {
-  std::vector<LiveEffect> all;
-  const std::size_t n = check.samplesPerInterval();
-  for (std::size_t start = 0; start + n <= axes[0].size(); start += n) {
-    std::array<std::vector<double>, 3> interval;
-    for (std::size_t a = 0; a < 3; ++a)
-      interval[a].assign(axes[a].begin() + static_cast<std::ptrdiff_t>(start),
-                         axes[a].begin() + static_cast<std::ptrdiff_t>(start + n));
-    const auto changes = check.examine(interval, std::span<const double>(temperature).subspan(start, n),
-                                       static_cast<double>(start) / kLiveRate);
-    all.insert(all.end(), changes.begin(), changes.end());
-  }
-  return all;
-}
-
 }  // namespace
 
 // A warm-up of 8 °C at a seeded time after the baseline, the bias of one axis following it at
@@ -311,7 +300,7 @@ TEST(LiveCheck, ATemperatureCouplingThatIsNotTheBoardsIsNamedAndAKnownOneIsNot) 
     const std::string what = "seed " + std::to_string(seed) + ", warm-up from " + std::to_string(from) + " s";
     {
       LiveCheck check(liveSettings());
-      const auto changes = runLiveWithTemperature(check, axes, temperature);
+      const auto changes = runLive(check, axes, temperature);
       ASSERT_FALSE(changes.empty()) << what;
       const LiveEffect& e = changes.front();
       EXPECT_EQ(e.kind, LiveEffectKind::TemperatureBias) << what << ": " << e.evidence;
@@ -326,7 +315,7 @@ TEST(LiveCheck, ATemperatureCouplingThatIsNotTheBoardsIsNamedAndAKnownOneIsNot) 
     LiveCheckSettings known = liveSettings();
     known.temperature_coefficient_dps_per_c[axis] = k;
     LiveCheck check(known);
-    for (const LiveEffect& c : runLiveWithTemperature(check, axes, temperature))
+    for (const LiveEffect& c : runLive(check, axes, temperature))
       ADD_FAILURE() << what << ", coupling known: " << liveEffectName(c.kind) << " at " << c.t << " s: " << c.evidence;
   }
 }
