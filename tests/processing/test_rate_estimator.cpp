@@ -568,7 +568,9 @@ TEST(RateEstimator, WhatOneRunLearnedStartsTheNext) {
           "%s restart at %.1f C, axis %zu: bias error %.4f deg/s (RMS over the last 10 min before: %.4f; "
           "stated 1 sigma %.4f; from the model: %.4f)\n",
           warm ? "warm" : "cold", s.temperature_c, a, after, before, stated, from_scratch);
-      if (warm) EXPECT_LE(after, 2.0 * before) << "axis " << a;
+      if (warm) {
+        EXPECT_LE(after, 2.0 * before) << "axis " << a;
+      }
       EXPECT_LE(after, 3.0 * stated) << "axis " << a;
       EXPECT_GE(from_scratch, 5.0 * after) << "axis " << a;
     }
