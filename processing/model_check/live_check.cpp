@@ -81,6 +81,20 @@ double meanOf(const std::vector<double>& y, std::size_t from, std::size_t to) {
   return sum / static_cast<double>(to - from);
 }
 
+// The residual sum of squares of one step fitted to y[first, n) at each boundary c (the mean
+// before it and the mean after it); infinity where no step fits.
+std::vector<double> oneStepRss(const std::vector<double>& y, std::size_t first) {
+  const std::size_t n = y.size();
+  std::vector<double> rss(n, std::numeric_limits<double>::infinity());
+  for (std::size_t c = first + 1; c < n; ++c) {
+    const double a = meanOf(y, first, c), b = meanOf(y, c, n);
+    double sum = 0.0;
+    for (std::size_t j = first; j < n; ++j) sum += (y[j] - (j < c ? a : b)) * (y[j] - (j < c ? a : b));
+    rss[c] = sum;
+  }
+  return rss;
+}
+
 // Two-sided P(|T| > |t|) for Student's t with `dof` degrees of freedom.
 double twoSidedT(double t, double dof) { return 2.0 * studentTUpperTail(std::fabs(t), dof); }
 
@@ -463,14 +477,21 @@ double LiveCheck::knownCoupling(std::size_t axis) const { return settings_.tempe
 // The window's middle boundaries: blocks_/2 .. blocks_/2 + blocks_ − 1 of its 2·blocks_, so
 // that successive windows (one interval apart) judge each boundary once, each with half an
 // interval of data or more on both sides.
+std::vector<std::pair<std::size_t, double>> LiveCheck::middleDifferences(const std::vector<double>& y,
+                                                                         std::size_t first, std::size_t s) const {
+  std::vector<std::pair<std::size_t, double>> out;
+  const std::size_t lo = blocks_ / 2;
+  for (std::size_t c = lo; c < lo + blocks_; ++c)
+    if (c >= first + s && c + s <= y.size()) out.emplace_back(c, meanOf(y, c, c + s) - meanOf(y, c - s, c));
+  return out;
+}
+
 void LiveCheck::addToPool(std::size_t axis, const std::vector<double>& y, std::size_t first) {
-  const std::size_t m = blocks_, lo = m / 2;
+  const std::size_t m = blocks_;
   for (std::size_t i = 0; i < scales_.size(); ++i) {
     const std::size_t s = scales_[i];
     double sum = 0.0, count = 0.0;
-    for (std::size_t c = lo; c < lo + m; ++c) {
-      if (c < first + s || c + s > y.size()) continue;
-      const double d = meanOf(y, c, c + s) - meanOf(y, c - s, c);
+    for (const auto& [c, d] : middleDifferences(y, first, s)) {
       sum += 0.5 * d * d;
       count += 1.0;
     }
@@ -486,7 +507,6 @@ void LiveCheck::addToPool(std::size_t axis, const std::vector<double>& y, std::s
 
 std::optional<LiveEffect> LiveCheck::findStep(std::size_t axis, const std::vector<double>& y, std::size_t first,
                                               double window_t0) const {
-  const std::size_t m = blocks_, lo = m / 2;
   const AllanPool& p = pool_[axis];
   const double block_s = static_cast<double>(block_) / settings_.rate_hz;
   struct Best {
@@ -495,12 +515,9 @@ std::optional<LiveEffect> LiveCheck::findStep(std::size_t axis, const std::vecto
   } best;
   std::size_t tests = 0;
   for (std::size_t i = 0; i + 1 < scales_.size(); ++i) {  // the last scale (a whole interval) is the coupling's
-    const std::size_t s = scales_[i];
-    if (!(p.dof[i] >= 1.0) || !(p.sum_half_d2[i] > 0.0)) continue;
-    const double sd = std::sqrt(2.0 * p.sum_half_d2[i] / p.terms[i]);  // of a difference: √2·σA
-    for (std::size_t c = lo; c < lo + m; ++c) {
-      if (c < first + s || c + s > y.size()) continue;
-      const double d = meanOf(y, c, c + s) - meanOf(y, c - s, c);
+    if (!p.ready(i)) continue;
+    const double sd = p.differenceSd(i);
+    for (const auto& [c, d] : middleDifferences(y, first, scales_[i])) {
       const double pv = twoSidedT(d / sd, p.dof[i]);
       ++tests;
       if (pv < best.p) best = {pv, d, d / sd, sd, c, i};
@@ -514,13 +531,8 @@ std::optional<LiveEffect> LiveCheck::findStep(std::size_t axis, const std::vecto
   // block on each side.
   const double block_var = p.sum_half_d2[0] / p.terms[0];
   const std::size_t n = y.size();
-  std::vector<double> cost(n, std::numeric_limits<double>::infinity());
-  for (std::size_t c = first + 1; c < n; ++c) {
-    const double a = meanOf(y, first, c), b = meanOf(y, c, n);
-    double rss = 0.0;
-    for (std::size_t j = first; j < n; ++j) rss += (y[j] - (j < c ? a : b)) * (y[j] - (j < c ? a : b));
-    cost[c] = rss / block_var;
-  }
+  std::vector<double> cost = oneStepRss(y, first);
+  for (double& c : cost) c /= block_var;
   const auto at_best = std::min_element(cost.begin(), cost.end());
   const auto c_best = static_cast<std::size_t>(at_best - cost.begin());
   std::size_t c_lo = c_best, c_hi = c_best;
@@ -536,7 +548,7 @@ std::optional<LiveEffect> LiveCheck::findStep(std::size_t axis, const std::vecto
   while (i > 0 && (before_end < first + scales_[i] || after_start + scales_[i] > n)) --i;
   const std::size_t s = scales_[i];
   const bool fits = before_end >= first + s && after_start + s <= n;
-  const double sd = fits ? std::sqrt(2.0 * p.sum_half_d2[i] / p.terms[i]) : best.sd;
+  const double sd = fits ? p.differenceSd(i) : best.sd;
   const double size = fits ? meanOf(y, after_start, after_start + s) - meanOf(y, before_end - s, before_end) : best.d;
   const auto at = [&](std::size_t c) { return window_t0 + static_cast<double>(c) * block_s; };
   LiveEffect e;
@@ -564,9 +576,9 @@ std::optional<LiveEffect> LiveCheck::findCoupling(std::size_t axis, const std::v
   if (!(std::fabs(dt) >= kLiveMinTemperatureChangeC)) return std::nullopt;
   const AllanPool& p = pool_[axis];
   const std::size_t last = scales_.size() - 1;
-  if (!(p.dof[last] >= 1.0) || !(p.sum_half_d2[last] > 0.0)) return std::nullopt;
+  if (!p.ready(last)) return std::nullopt;
   const double k0 = knownCoupling(axis);
-  const double sd = std::sqrt(2.0 * p.sum_half_d2[last] / p.terms[last]);
+  const double sd = p.differenceSd(last);
   const double dy = meanOf(y, m, n) - meanOf(y, 0, m) - k0 * dt;
   const double pv = twoSidedT(dy / sd, p.dof[last]);
   if (!(pv < alpha_)) return std::nullopt;
@@ -586,13 +598,8 @@ std::optional<LiveEffect> LiveCheck::findCoupling(std::size_t axis, const std::v
     const double e = r[j] - r_mean - slope * (temp[j] - t_mean);
     rss_t += e * e;
   }
-  double rss_step = std::numeric_limits<double>::infinity();
-  for (std::size_t c = 1; c < n; ++c) {
-    const double a = meanOf(r, 0, c), b = meanOf(r, c, n);
-    double rss = 0.0;
-    for (std::size_t j = 0; j < n; ++j) rss += (r[j] - (j < c ? a : b)) * (r[j] - (j < c ? a : b));
-    rss_step = std::min(rss_step, rss);
-  }
+  const std::vector<double> step_rss = oneStepRss(r, 0);
+  const double rss_step = *std::min_element(step_rss.begin(), step_rss.end());
   if (!(rss_t < rss_step)) return std::nullopt;
   LiveEffect e;
   e.kind = LiveEffectKind::TemperatureBias;
@@ -619,7 +626,7 @@ bool LiveCheck::couplingStillShows(const LiveEffect& e, const std::vector<double
   const AllanPool& p = pool_[e.axis];
   const std::size_t last = scales_.size() - 1;
   if (!(p.sum_half_d2[last] > 0.0)) return true;
-  const double sd = std::sqrt(2.0 * p.sum_half_d2[last] / p.terms[last]);
+  const double sd = p.differenceSd(last);
   const double dt = meanOf(temp, m, n) - meanOf(temp, 0, m);
   const double k0 = knownCoupling(e.axis);
   // Only a window where the named coupling would stand out (3 × the noise) can show it gone.

@@ -27,10 +27,12 @@
 // once when an interval no longer shows it ("gone").
 // Pure: no clock, no I/O; the caller supplies data time.
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace gyrod::processing {
@@ -182,7 +184,15 @@ class LiveCheck {
   // of freedom they are worth.
   struct AllanPool {
     std::vector<double> sum_half_d2, terms, dof;
+    // Whether scale i has a variance to judge by (a degree of freedom or more).
+    bool ready(std::size_t i) const { return dof[i] >= 1.0 && sum_half_d2[i] > 0.0; }
+    // The standard deviation of one difference at scale i: √2·σA.
+    double differenceSd(std::size_t i) const { return std::sqrt(2.0 * sum_half_d2[i] / terms[i]); }
   };
+  // The differences (after − before, s blocks each side) at the window's middle boundaries c
+  // whose s blocks before start at `first` or later: (c, d) pairs.
+  std::vector<std::pair<std::size_t, double>> middleDifferences(const std::vector<double>& y, std::size_t first,
+                                                                std::size_t s) const;
   // Block means of a window `y` (2 intervals, corrected for the known coupling): adds its
   // differences at the window's middle boundaries to the pool; `first` the earliest block
   // that may be used (after a step named in the window).
