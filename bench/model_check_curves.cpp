@@ -6,17 +6,22 @@
 // Not a unit test (minutes); scripts/model-check-curves.sh runs it and draws the PNGs of
 // docs/model-check.md; ctest runs its --quick mode (scripts/check-model-check-curves.sh).
 //
-//   model_check_curves [--quick] [--trials N] [--durations S,S] [--effects a,b] [--replicas R]
-//                      [--calibration M] [--clean C] [--data DIR]
+//   model_check_curves [--quick] [--trials N] [--first-trial J] [--durations S,S] [--effects a,b]
+//                      [--replicas R] [--calibration M] [--scan-calibration K] [--clean C]
+//                      [--data DIR] [--explain]
 //
 // Records: one axis at 50 Hz of fixed base noise (Q 2 µrad, N 0.5 °/√h, B 10 °/h,
 // K 3 °/h^1.5, quantised at 131 LSB per °/s) with a temperature channel (warm-up + room
 // cycle + noise). Trial j of a duration has its own noise, step time, frequency, phase and
 // Gauss–Markov realisation; only the size changes along a curve (common random numbers).
 // Output: per curve, lines "size trials blind lo hi optimal lo hi" (Wilson 95 % intervals),
-// then a "summary" line; false discoveries on clean records; --data DIR writes each curve as
-// DIR/<effect>-<duration>.dat for gnuplot.
+// with "bound lo hi" after them where the blind bound is measured (steps: the check's scan
+// with the noise known, calibrated on K clean records; temperature: the known-form statistic
+// at the check's rate), then a "summary" line; false discoveries on clean records; --data DIR
+// writes each curve as DIR/<effect>-<duration>.dat for gnuplot; --explain prints, per step
+// trial and size, the check's scan statistic beside the known-noise scans'.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -28,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "processing/base/distributions.hpp"
 #include "processing/base/noise_terms.hpp"
 #include "processing/base/portable_random.hpp"
 #include "processing/model_check/detail.hpp"
@@ -166,6 +172,7 @@ struct Oracle {
   std::vector<double> base_power;  // expected Hann periodogram of the clean record
   std::vector<double> gm_shape;    // of the curve's T
   double threshold = 0.0;
+  double clean_rms = 0.0;  // of the statistic on the clean records that set the threshold
   std::size_t block = 50;  // 1 s blocks
 };
 
@@ -230,7 +237,93 @@ Oracle calibrate(const Records& rec, const Curve& c, std::size_t records, std::u
   std::vector<double> values;
   for (std::size_t j = half; j < records; ++j) values.push_back(oracleStatistic(o, c, shapes[j], clean[j]));
   o.threshold = calibratedThreshold(values, kFalseAlarm);
+  double ss = 0.0;
+  for (double v : values) ss += v * v;
+  o.clean_rms = std::sqrt(ss / static_cast<double>(values.size()));
   return o;
+}
+
+// ---- the blind bound, measured: the check's own statistics with the noise known -----------
+// Steps: the check's scan (steps.cpp), the largest |D_W(t)| / sd_W over dyadic widths W and
+// every boundary t of 1 s block means (D_W(t) the mean of the W blocks from t less the mean of
+// the W before), with sd_W known from clean records of the generator's model instead of fitted
+// to the record. Two reaches: ScanReach::Check, the check's widths (2 blocks up to 1/16 of the
+// record, inside the τ range of its Allan fit) with its line removed; ScanReach::All, every width
+// from 1 block to 1/4 of the record with no line removed, what knowing the noise at widths a
+// record of this length cannot measure would give. Threshold: the empirical (1 − α) quantile
+// at the check's rate for its step scan, on further clean records.
+enum class ScanReach { Check, All };
+struct KnownNoiseScan {
+  ScanReach reach = ScanReach::Check;
+  std::vector<std::size_t> widths;
+  std::vector<double> sd;
+  double threshold = 0.0;
+};
+
+// Per width: the largest |D_W(t)| over t, and the sum of squares and the count of D_W(t).
+struct ScanMoments {
+  std::vector<double> max_abs, sum_sq;
+  std::vector<std::size_t> count;
+};
+
+ScanMoments scanMoments(const KnownNoiseScan& k, const std::vector<double>& x) {
+  std::vector<double> y = model_check_detail::blockMeans(x, static_cast<std::size_t>(kRate));
+  if (k.reach == ScanReach::Check) model_check_detail::removeLineInPlace(y);
+  std::vector<double> prefix(y.size() + 1, 0.0);
+  for (std::size_t i = 0; i < y.size(); ++i) prefix[i + 1] = prefix[i] + y[i];
+  ScanMoments m{std::vector<double>(k.widths.size(), 0.0), std::vector<double>(k.widths.size(), 0.0),
+                std::vector<std::size_t>(k.widths.size(), 0)};
+  for (std::size_t j = 0; j < k.widths.size(); ++j) {
+    const std::size_t w = k.widths[j];
+    for (std::size_t t = w; t + w <= y.size(); ++t) {
+      const double d = (prefix[t + w] - 2.0 * prefix[t] + prefix[t - w]) / static_cast<double>(w);
+      m.max_abs[j] = std::max(m.max_abs[j], std::fabs(d));
+      m.sum_sq[j] += d * d;
+      ++m.count[j];
+    }
+  }
+  return m;
+}
+
+double knownNoiseScanStatistic(const KnownNoiseScan& k, const std::vector<double>& x) {
+  const ScanMoments m = scanMoments(k, x);
+  double z = 0.0;
+  for (std::size_t j = 0; j < k.widths.size(); ++j)
+    if (k.sd[j] > 0.0) z = std::max(z, m.max_abs[j] / k.sd[j]);
+  return z;
+}
+
+// The check's per-statistic false-alarm rates: its step scan at 10 × the default 1e-4
+// (steps.cpp, kStepAlphaFactor), the temperature slope two-sided at the default.
+constexpr double kCheckStepRate = 1e-3;
+constexpr double kCheckTemperatureRate = 1e-4;
+
+// sd_W from the first tenth of `records` clean records (pooled over positions), the threshold
+// from the rest.
+KnownNoiseScan calibrateKnownNoiseScan(const Records& rec, ScanReach reach, std::size_t records,
+                                       std::uint64_t seed_base) {
+  KnownNoiseScan k;
+  k.reach = reach;
+  const std::size_t blocks = rec.n / static_cast<std::size_t>(kRate);
+  const std::size_t first = reach == ScanReach::Check ? 2 : 1, share = reach == ScanReach::Check ? 16 : 4;
+  for (std::size_t w = first; share * w <= blocks; w *= 2) k.widths.push_back(w);
+  k.sd.assign(k.widths.size(), 1.0);
+  const Curve none{Kind::Step, "", "", 0.0, {}};
+  auto clean = [&](std::size_t j) { return withEffect(rec, drawTrial(rec, seed_base + j, 0.0), none, 0.0); };
+  const std::size_t for_sd = std::max<std::size_t>(records / 10, 20);
+  std::vector<double> sum_sq(k.widths.size(), 0.0), count(k.widths.size(), 0.0);
+  for (std::size_t j = 0; j < for_sd; ++j) {
+    const ScanMoments m = scanMoments(k, clean(j));
+    for (std::size_t s = 0; s < k.widths.size(); ++s) {
+      sum_sq[s] += m.sum_sq[s];
+      count[s] += static_cast<double>(m.count[s]);
+    }
+  }
+  for (std::size_t s = 0; s < k.widths.size(); ++s) k.sd[s] = std::sqrt(sum_sq[s] / count[s]);
+  std::vector<double> values;
+  for (std::size_t j = 0; j < records; ++j) values.push_back(knownNoiseScanStatistic(k, clean(for_sd + j)));
+  k.threshold = calibratedThreshold(values, kCheckStepRate);
+  return k;
 }
 
 // ---- tallies -------------------------------------------------------------------------
@@ -281,11 +374,14 @@ bool blindNames(const AxisModelCheck& r, Kind k) {
 
 struct Options {
   std::size_t trials = 16, calibration = 300, clean = 40, replicas = 40;
+  std::size_t scan_calibration = 4000;
+  std::size_t first_trial = 0;  // clean records that set the known-noise scan's threshold (0: no scan)
   std::vector<double> durations = {600.0, 3600.0};
   std::vector<std::string> effects = {"bias_steps", "sinusoid", "temperature_bias", "gauss_markov_short",
                                       "gauss_markov_long"};
   std::string data_dir;
   bool quick = false;
+  bool explain = false;  // per step trial: the check's scan statistic beside the known-noise scans'
 };
 
 std::vector<Curve> curvesFor(double duration, const Options& opt) {
@@ -302,8 +398,7 @@ std::vector<Curve> curvesFor(double duration, const Options& opt) {
   std::vector<Curve> all = {
       {Kind::Step, "bias_steps", "step / ADEV floor", 0.0, grid(2.0, std::sqrt(2.0))},
       {Kind::Sinusoid, "sinusoid", "amplitude / white sd", 0.0, grid(0.01 * sin_scale, std::sqrt(2.0))},
-      {Kind::Temperature, "temperature_bias", "k x temperature range / ADEV floor", 0.0,
-       grid(std::sqrt(2.0), std::sqrt(2.0))},
+      {Kind::Temperature, "temperature_bias", "k x temperature range / ADEV floor", 0.0, grid(2.0, std::sqrt(2.0))},
       {Kind::GaussMarkov, "gauss_markov_short", "GM ADEV peak / base (T = duration/300)", 1.0 / 300.0,
        grid(0.5, std::sqrt(2.0))},
       {Kind::GaussMarkov, "gauss_markov_long", "GM ADEV peak / base (T = duration/60)", 1.0 / 60.0,
@@ -315,6 +410,34 @@ std::vector<Curve> curvesFor(double duration, const Options& opt) {
   return out;
 }
 
+// --explain: one line per step or temperature trial and size, where the check loses against
+// the blind bound: its statistic (the step scan's largest z, or the temperature slope less its
+// null median) and threshold, whether that came from a further look, the effects it named, the
+// bound's statistic and threshold, and the base fit's B and K (the generator's: 10 °/h,
+// 3 °/h^1.5).
+void explainTrial(const AxisModelCheck& r, const Curve& c, std::size_t trial, double size, double bound_value,
+                  double bound_threshold, const std::vector<KnownNoiseScan>& scans, const std::vector<double>& x) {
+  const std::string prefix = c.kind == Kind::Step ? "step_scan_max_z" : "temperature_slope_dps_per_c";
+  double value = NAN, threshold = NAN;
+  std::string look = "first";
+  for (const CheckStatistic& st : r.statistics)
+    if (st.name.rfind(prefix, 0) == 0) {
+      value = c.kind == Kind::Step ? st.value : std::fabs(st.value - st.null_median);
+      threshold = c.kind == Kind::Step ? st.threshold : st.threshold - st.null_median;  // two-sided: |v − median|
+      if (st.name.find("second look") != std::string::npos) look = "further";
+    }
+  std::printf("explain trial %zu size %.3g check %.4g / %.4g %s look, named:", trial, size, value, threshold,
+              look.c_str());
+  for (const DetectedEffect& e : r.effects) std::printf(" %s", std::string(modelEffectName(e.effect)).c_str());
+  if (r.effects.empty()) std::printf(" none");
+  if (c.kind == Kind::Temperature) std::printf("; bound %.3f / %.3f", bound_value, bound_threshold);
+  for (const KnownNoiseScan& k : scans)
+    std::printf("; known-noise-%s %.2f / %.2f", k.reach == ScanReach::Check ? "check" : "all",
+                knownNoiseScanStatistic(k, x), k.threshold);
+  std::printf("; base B %.3g K %.3g\n", r.base_fit.value.bias_instability_deg_per_h,
+              r.base_fit.value.rrw_deg_per_h_sqrt_h);
+}
+
 ModelCheckOptions checkOptions(const Options& opt, std::uint64_t seed) {
   ModelCheckOptions o;
   o.replicas = opt.replicas;
@@ -322,26 +445,38 @@ ModelCheckOptions checkOptions(const Options& opt, std::uint64_t seed) {
   return o;
 }
 
-void runCurve(const Records& rec, const Curve& c, const Options& opt, double& check_seconds, std::size_t& checks) {
+// The blind bound's detections of a trial: steps, the two known-noise scans (check's reach,
+// all widths); temperature, the known-form statistic at the check's two-sided rate.
+struct Bounds {
+  std::vector<KnownNoiseScan> scans;
+  double temperature_threshold = NAN;
+  bool measured() const { return !scans.empty() || !std::isnan(temperature_threshold); }
+};
+
+Bounds calibrateBounds(const Records& rec, const Curve& c, const Oracle& oracle, const Options& opt) {
+  Bounds b;
   const auto dur = static_cast<std::uint64_t>(rec.duration);
-  const Oracle oracle = calibrate(rec, c, opt.calibration, 1000000 + dur * 1000);
-  std::vector<std::size_t> blind(c.sizes.size(), 0), optimal(c.sizes.size(), 0);
-  for (std::size_t j = 0; j < opt.trials; ++j) {
-    const std::uint64_t seed = 7000000 + dur * 1000 + j;
-    const TrialShape s = drawTrial(rec, seed, c.gm_fraction * rec.duration);
-    for (std::size_t i = 0; i < c.sizes.size(); ++i) {
-      const std::vector<double> x = withEffect(rec, s, c, c.sizes[i]);
-      optimal[i] += oracleStatistic(oracle, c, s, x) > oracle.threshold ? 1 : 0;
-      const auto t0 = std::chrono::steady_clock::now();
-      const AxisModelCheck r = checkAxisModel({x, kRate, s.temp, rec.t, {}}, checkOptions(opt, seed));
-      check_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      ++checks;
-      blind[i] += blindNames(r, c.kind) ? 1 : 0;
-    }
+  if (c.kind == Kind::Step && opt.scan_calibration > 0) {
+    b.scans.push_back(calibrateKnownNoiseScan(rec, ScanReach::Check, opt.scan_calibration, 3000000 + dur * 1000));
+    b.scans.push_back(calibrateKnownNoiseScan(rec, ScanReach::All, opt.scan_calibration, 4000000 + dur * 1000));
   }
-  std::printf("# curve %s duration %.0f s: size = %s; %zu trials per size; optimal threshold %.4g\n", c.name.c_str(),
+  if (c.kind == Kind::Temperature)
+    b.temperature_threshold = oracle.clean_rms * normalQuantile(1.0 - 0.5 * kCheckTemperatureRate);
+  return b;
+}
+
+void printCurveTable(const Curve& c, const Records& rec, const Options& opt, const Oracle& oracle, const Bounds& bounds,
+                     const std::vector<std::array<std::size_t, 4>>& hits) {
+  const auto dur = static_cast<std::uint64_t>(rec.duration);
+  const bool with_bound = bounds.measured();
+  std::printf("# curve %s duration %.0f s: size = %s; %zu trials per size; optimal threshold %.4g", c.name.c_str(),
               rec.duration, c.size_what.c_str(), opt.trials, oracle.threshold);
-  std::printf("#   size  trials  blind    lo     hi   optimal  lo     hi\n");
+  for (const KnownNoiseScan& k : bounds.scans)
+    std::printf("; known-noise scan (%s) threshold %.3f", k.reach == ScanReach::Check ? "check's widths" : "all widths",
+                k.threshold);
+  if (!std::isnan(bounds.temperature_threshold)) std::printf("; bound threshold %.4g", bounds.temperature_threshold);
+  std::printf("\n#   size  trials  blind    lo     hi   optimal  lo     hi%s\n",
+              with_bound ? "   bound   lo     hi" : "");
   std::FILE* dat = nullptr;
   if (!opt.data_dir.empty()) {
     const std::string path = opt.data_dir + "/" + c.name + "-" + std::to_string(dur) + ".dat";
@@ -350,16 +485,26 @@ void runCurve(const Records& rec, const Curve& c, const Options& opt, double& ch
       std::fprintf(stderr, "cannot write %s\n", path.c_str());
       std::exit(1);
     }
-    std::fprintf(dat, "# %s, %.0f s: size blind lo hi optimal lo hi\n", c.size_what.c_str(), rec.duration);
+    std::fprintf(dat, "# %s, %.0f s: size blind lo hi optimal lo hi%s\n", c.size_what.c_str(), rec.duration,
+                 with_bound ? " bound lo hi" : "");
   }
-  std::vector<double> pb, po;
+  std::vector<double> pb, po, pbound, pall;
   for (std::size_t i = 0; i < c.sizes.size(); ++i) {
-    const Wilson b = wilson(blind[i], opt.trials), o = wilson(optimal[i], opt.trials);
+    const Wilson b = wilson(hits[i][0], opt.trials), o = wilson(hits[i][1], opt.trials);
+    const Wilson d = wilson(hits[i][2], opt.trials), a = wilson(hits[i][3], opt.trials);
     pb.push_back(b.p);
     po.push_back(o.p);
-    std::printf("%8.4g %6zu %6.3f %6.3f %6.3f %6.3f %6.3f %6.3f\n", c.sizes[i], opt.trials, b.p, b.lo, b.hi, o.p, o.lo,
+    pbound.push_back(d.p);
+    pall.push_back(a.p);
+    std::printf("%8.4g %6zu %6.3f %6.3f %6.3f %6.3f %6.3f %6.3f", c.sizes[i], opt.trials, b.p, b.lo, b.hi, o.p, o.lo,
                 o.hi);
-    if (dat) std::fprintf(dat, "%g %g %g %g %g %g %g\n", c.sizes[i], b.p, b.lo, b.hi, o.p, o.lo, o.hi);
+    if (with_bound) std::printf(" %6.3f %6.3f %6.3f", d.p, d.lo, d.hi);
+    std::printf("\n");
+    if (dat) {
+      std::fprintf(dat, "%g %g %g %g %g %g %g", c.sizes[i], b.p, b.lo, b.hi, o.p, o.lo, o.hi);
+      if (with_bound) std::fprintf(dat, " %g %g %g", d.p, d.lo, d.hi);
+      std::fprintf(dat, "\n");
+    }
   }
   if (dat) std::fclose(dat);
   const double b50 = size50(c.sizes, pb), o50 = size50(c.sizes, po);
@@ -368,14 +513,51 @@ void runCurve(const Records& rec, const Curve& c, const Options& opt, double& ch
   if (!std::isnan(b50))
     for (std::size_t i = 0; i < c.sizes.size(); ++i)
       if (c.sizes[i] >= 2.0 * std::fabs(b50)) {
-        above_k += blind[i];
+        above_k += hits[i][0];
         above_n += opt.trials;
       }
   const Wilson above = wilson(above_k, above_n);
-  const double ratio = (std::isnan(b50) || std::isnan(o50)) ? NAN : std::fabs(b50) / std::fabs(o50);
-  std::printf("summary %s %.0f blind50 %s optimal50 %s ratio %.3g above2x %zu/%zu (%.3f, %.3f..%.3f)\n\n",
-              c.name.c_str(), rec.duration, formatSize(b50).c_str(), formatSize(o50).c_str(), ratio, above_k, above_n,
+  auto ratio = [](double x, double y) { return (std::isnan(x) || std::isnan(y)) ? NAN : std::fabs(x) / std::fabs(y); };
+  std::printf("summary %s %.0f blind50 %s optimal50 %s ratio %.3g above2x %zu/%zu (%.3f, %.3f..%.3f)", c.name.c_str(),
+              rec.duration, formatSize(b50).c_str(), formatSize(o50).c_str(), ratio(b50, o50), above_k, above_n,
               above.p, above.lo, above.hi);
+  if (with_bound) {
+    const double d50 = size50(c.sizes, pbound);
+    std::printf(" bound50 %s check/bound %.3g", formatSize(d50).c_str(), ratio(b50, d50));
+  }
+  if (bounds.scans.size() > 1) {
+    const double a50 = size50(c.sizes, pall);
+    std::printf(" bound_all_widths50 %s check/bound_all_widths %.3g", formatSize(a50).c_str(), ratio(b50, a50));
+  }
+  std::printf("\n\n");
+}
+
+void runCurve(const Records& rec, const Curve& c, const Options& opt, double& check_seconds, std::size_t& checks) {
+  const auto dur = static_cast<std::uint64_t>(rec.duration);
+  const Oracle oracle = calibrate(rec, c, opt.calibration, 1000000 + dur * 1000);
+  const Bounds bounds = calibrateBounds(rec, c, oracle, opt);
+  // Per size: the check, the known-form detector, the bound (check's widths), the bound (all widths).
+  std::vector<std::array<std::size_t, 4>> hits(c.sizes.size(), {0, 0, 0, 0});
+  for (std::size_t j = opt.first_trial; j < opt.first_trial + opt.trials; ++j) {
+    const std::uint64_t seed = 7000000 + dur * 1000 + j;
+    const TrialShape s = drawTrial(rec, seed, c.gm_fraction * rec.duration);
+    for (std::size_t i = 0; i < c.sizes.size(); ++i) {
+      const std::vector<double> x = withEffect(rec, s, c, c.sizes[i]);
+      const double known = oracleStatistic(oracle, c, s, x);
+      hits[i][1] += known > oracle.threshold ? 1 : 0;
+      hits[i][2] += known > bounds.temperature_threshold ? 1 : 0;  // false when NaN
+      for (std::size_t k = 0; k < bounds.scans.size(); ++k)
+        hits[i][2 + k] += knownNoiseScanStatistic(bounds.scans[k], x) > bounds.scans[k].threshold ? 1 : 0;
+      const auto t0 = std::chrono::steady_clock::now();
+      const AxisModelCheck r = checkAxisModel({x, kRate, s.temp, rec.t, {}}, checkOptions(opt, seed));
+      check_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      ++checks;
+      hits[i][0] += blindNames(r, c.kind) ? 1 : 0;
+      if (opt.explain && bounds.measured())
+        explainTrial(r, c, j, c.sizes[i], known, bounds.temperature_threshold, bounds.scans, x);
+    }
+  }
+  printCurveTable(c, rec, opt, oracle, bounds, hits);
 }
 
 void runClean(const Records& rec, const Options& opt, double& check_seconds, std::size_t& checks) {
@@ -445,11 +627,18 @@ Options parseOptions(int argc, char** argv) {
       opt.effects = splitList(next());
     } else if (a == "--data") {
       opt.data_dir = next();
+    } else if (a == "--explain") {
+      opt.explain = true;
+    } else if (a == "--first-trial") {
+      opt.first_trial = std::strtoull(next().c_str(), nullptr, 10);
+    } else if (a == "--scan-calibration") {
+      opt.scan_calibration = std::strtoull(next().c_str(), nullptr, 10);
     } else {
       std::fprintf(stderr, "unknown option %s\n", a.c_str());
       std::exit(2);
     }
   }
+  if (opt.quick) opt.scan_calibration = std::min<std::size_t>(opt.scan_calibration, 200);
   if (opt.trials == 0 || opt.calibration < 4) {
     std::fprintf(stderr, "--trials must be > 0 and --calibration ≥ 4\n");
     std::exit(2);

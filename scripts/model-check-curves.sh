@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Detection curves of the model check against the detectors that know each effect's form
-# (bench/model_check_curves.cpp): prints the tables and draws docs/img/model-check-*.png with
+# Detection curves of the model check against the detectors that know each effect's form and,
+# where it is measured, the blind bound (bench/model_check_curves.cpp): prints the tables and
+# draws docs/img/model-check-*.png with
 # gnuplot. Not a unit test (tens of minutes on a loaded 2-core machine; ctest runs the
 # program's --quick mode instead, scripts/check-model-check-curves.sh).
 #
@@ -43,9 +44,17 @@ for dat in "$data"/*-600.dat; do
   what=$(head -1 "$dat" | sed -e 's/^# //' -e 's/, 600 s:.*//')
   plot="'$dat' u 1:2:3:4 w yerrorlines lw 2 lc rgb '#d62728' t 'model check, 10 min', \
         '$dat' u 1:5:6:7 w yerrorlines lw 2 dt 2 lc rgb '#1f77b4' t 'known form, 10 min'"
+  # The blind bound, where the table measures it (columns 8-10).
+  bound() { awk '!/^#/ { exit !(NF >= 10) }' "$1"; }
+  if bound "$dat"; then
+    plot="$plot, '$dat' u 1:8:9:10 w yerrorlines lw 2 dt 4 lc rgb '#2ca02c' t 'blind bound, 10 min'"
+  fi
   if [ -f "$long" ]; then
     plot="$plot, '$long' u 1:2:3:4 w yerrorlines lw 2 lc rgb '#ff7f0e' t 'model check, 1 h', \
           '$long' u 1:5:6:7 w yerrorlines lw 2 dt 2 lc rgb '#17becf' t 'known form, 1 h'"
+    if bound "$long"; then
+      plot="$plot, '$long' u 1:8:9:10 w yerrorlines lw 2 dt 4 lc rgb '#9467bd' t 'blind bound, 1 h'"
+    fi
   fi
   gnuplot <<GP
 set terminal pngcairo size 720,440 font ",10" noenhanced
