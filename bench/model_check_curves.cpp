@@ -39,6 +39,7 @@
 #include "processing/model_check/detail.hpp"
 #include "processing/model_check/known_form_detectors.hpp"
 #include "processing/model_check/model_check.hpp"
+#include "processing/model_check/pipeline.hpp"
 #include "processing/simulation/noise_simulator.hpp"
 
 using namespace gyrod;
@@ -172,9 +173,31 @@ struct Oracle {
   std::vector<double> base_power;  // expected Hann periodogram of the clean record
   std::vector<double> gm_shape;    // of the curve's T
   double threshold = 0.0;
-  double clean_rms = 0.0;  // of the statistic on the clean records that set the threshold
-  std::size_t block = 50;  // 1 s blocks
+  double clean_rms = 0.0;             // of the statistic on the clean records that set the threshold
+  std::size_t block = 50;             // 1 s blocks
+  std::size_t k_lo = 0, k_hi = 0;     // the periodogram bins the check searches for a sinusoid
+  double spectrum_scan_median = NAN;  // of knownSpectrumScanStatistic on those clean records
 };
+
+// The sinusoid's blind bound: the check's peak statistic with the background known, the
+// largest ratio of the record's Hann periodogram (line removed) to the clean records' mean
+// periodogram over the bins the check searches.
+double knownSpectrumScanStatistic(const Oracle& o, const std::vector<double>& x) {
+  std::vector<double> y = x;
+  model_check_detail::removeLineInPlace(y);
+  const auto p = model_check_detail::hannPeriodogram(y);
+  double best = 0.0;
+  for (std::size_t k = o.k_lo; k <= o.k_hi && k < p.power.size(); ++k)
+    if (o.base_power[k] > 0.0) best = std::max(best, p.power[k] / o.base_power[k]);
+  return best;
+}
+
+// The (1 − α) quantile of the largest of n independent Exp(1) variables (a periodogram's bins
+// over their mean, in Gaussian noise), n fitted to the median: (1 − e^−m)^n = 1/2.
+double exponentialMaximaQuantile(double median, double alpha) {
+  const double n = std::log(0.5) / std::log1p(-std::exp(-median));
+  return -std::log(-std::expm1(std::log1p(-alpha) / n));
+}
 
 double oracleStatistic(const Oracle& o, const Curve& c, const TrialShape& s, const std::vector<double>& x) {
   switch (c.kind) {
@@ -221,18 +244,28 @@ Oracle calibrate(const Records& rec, const Curve& c, std::size_t records, std::u
     for (std::size_t w = 0; w < sum2.size(); ++w)
       o.step_sd.push_back(count[w] > 4 ? std::sqrt(sum2[w] / static_cast<double>(count[w])) : 0.0);
   }
-  if (c.kind == Kind::GaussMarkov) {
+  if (c.kind == Kind::GaussMarkov || c.kind == Kind::Sinusoid) {
     for (std::size_t j = 0; j < half; ++j) {
       std::vector<double> y = clean[j];
       model_check_detail::removeLineInPlace(y);
       const auto p = model_check_detail::hannPeriodogram(y);
       if (o.base_power.empty()) {
         o.base_power.assign(p.power.size(), 0.0);
-        o.gm_shape = gaussMarkovSpectralShape(c.gm_fraction * rec.duration, kRate, p.nfft);
+        if (c.kind == Kind::GaussMarkov)
+          o.gm_shape = gaussMarkovSpectralShape(c.gm_fraction * rec.duration, kRate, p.nfft);
       }
       for (std::size_t k = 0; k < p.power.size(); ++k) o.base_power[k] += p.power[k] / static_cast<double>(half);
     }
     o.base_power[0] = 0.0;  // the mean, removed
+    const model_check_detail::SearchedBins bins = model_check_detail::searchedBins(rec.n);
+    o.k_lo = bins.k_lo;
+    o.k_hi = bins.k_hi;
+  }
+  if (c.kind == Kind::Sinusoid) {
+    std::vector<double> scans;
+    for (std::size_t j = half; j < records; ++j) scans.push_back(knownSpectrumScanStatistic(o, clean[j]));
+    std::sort(scans.begin(), scans.end());
+    o.spectrum_scan_median = model_check_detail::sortedQuantile(scans, 0.5);
   }
   std::vector<double> values;
   for (std::size_t j = half; j < records; ++j) values.push_back(oracleStatistic(o, c, shapes[j], clean[j]));
@@ -297,6 +330,7 @@ double knownNoiseScanStatistic(const KnownNoiseScan& k, const std::vector<double
 // (steps.cpp, kStepAlphaFactor), the temperature slope two-sided at the default.
 constexpr double kCheckStepRate = 1e-3;
 constexpr double kCheckTemperatureRate = 1e-4;
+constexpr double kCheckSinusoidRate = 1e-4;
 
 // sd_W from the first tenth of `records` clean records (pooled over positions), the threshold
 // from the rest.
@@ -445,12 +479,13 @@ ModelCheckOptions checkOptions(const Options& opt, std::uint64_t seed) {
   return o;
 }
 
-// The blind bound's detections of a trial: steps, the two known-noise scans (check's reach,
-// all widths); temperature, the known-form statistic at the check's two-sided rate.
+// The blind bound's detectors: steps, the two known-noise scans (check's widths, all widths);
+// temperature, the known-form statistic at the check's two-sided rate; sinusoid, the
+// known-background peak scan at the check's rate. `threshold` is the latter two's.
 struct Bounds {
   std::vector<KnownNoiseScan> scans;
-  double temperature_threshold = NAN;
-  bool measured() const { return !scans.empty() || !std::isnan(temperature_threshold); }
+  double threshold = NAN;
+  bool measured() const { return !scans.empty() || !std::isnan(threshold); }
 };
 
 Bounds calibrateBounds(const Records& rec, const Curve& c, const Oracle& oracle, const Options& opt) {
@@ -460,8 +495,9 @@ Bounds calibrateBounds(const Records& rec, const Curve& c, const Oracle& oracle,
     b.scans.push_back(calibrateKnownNoiseScan(rec, ScanReach::Check, opt.scan_calibration, 3000000 + dur * 1000));
     b.scans.push_back(calibrateKnownNoiseScan(rec, ScanReach::All, opt.scan_calibration, 4000000 + dur * 1000));
   }
-  if (c.kind == Kind::Temperature)
-    b.temperature_threshold = oracle.clean_rms * normalQuantile(1.0 - 0.5 * kCheckTemperatureRate);
+  if (c.kind == Kind::Temperature) b.threshold = oracle.clean_rms * normalQuantile(1.0 - 0.5 * kCheckTemperatureRate);
+  if (c.kind == Kind::Sinusoid)
+    b.threshold = exponentialMaximaQuantile(oracle.spectrum_scan_median, kCheckSinusoidRate);
   return b;
 }
 
@@ -474,7 +510,7 @@ void printCurveTable(const Curve& c, const Records& rec, const Options& opt, con
   for (const KnownNoiseScan& k : bounds.scans)
     std::printf("; known-noise scan (%s) threshold %.3f", k.reach == ScanReach::Check ? "check's widths" : "all widths",
                 k.threshold);
-  if (!std::isnan(bounds.temperature_threshold)) std::printf("; bound threshold %.4g", bounds.temperature_threshold);
+  if (!std::isnan(bounds.threshold)) std::printf("; bound threshold %.4g", bounds.threshold);
   std::printf("\n#   size  trials  blind    lo     hi   optimal  lo     hi%s\n",
               with_bound ? "   bound   lo     hi" : "");
   std::FILE* dat = nullptr;
@@ -545,7 +581,8 @@ void runCurve(const Records& rec, const Curve& c, const Options& opt, double& ch
       const std::vector<double> x = withEffect(rec, s, c, c.sizes[i]);
       const double known = oracleStatistic(oracle, c, s, x);
       hits[i][1] += known > oracle.threshold ? 1 : 0;
-      hits[i][2] += known > bounds.temperature_threshold ? 1 : 0;  // false when NaN
+      const double bound_value = c.kind == Kind::Sinusoid ? knownSpectrumScanStatistic(oracle, x) : known;
+      hits[i][2] += bound_value > bounds.threshold ? 1 : 0;  // false when NaN
       for (std::size_t k = 0; k < bounds.scans.size(); ++k)
         hits[i][2 + k] += knownNoiseScanStatistic(bounds.scans[k], x) > bounds.scans[k].threshold ? 1 : 0;
       const auto t0 = std::chrono::steady_clock::now();
@@ -553,8 +590,8 @@ void runCurve(const Records& rec, const Curve& c, const Options& opt, double& ch
       check_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       ++checks;
       hits[i][0] += blindNames(r, c.kind) ? 1 : 0;
-      if (opt.explain && bounds.measured())
-        explainTrial(r, c, j, c.sizes[i], known, bounds.temperature_threshold, bounds.scans, x);
+      if (opt.explain && (c.kind == Kind::Step || c.kind == Kind::Temperature))
+        explainTrial(r, c, j, c.sizes[i], bound_value, bounds.threshold, bounds.scans, x);
     }
   }
   printCurveTable(c, rec, opt, oracle, bounds, hits);
