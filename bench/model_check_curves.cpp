@@ -27,6 +27,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <optional>
@@ -175,6 +176,7 @@ struct Oracle {
   double threshold = 0.0;
   double clean_rms = 0.0;             // of the statistic on the clean records that set the threshold
   std::size_t block = 50;             // 1 s blocks
+  std::size_t nfft = 0;               // of the periodograms (sinusoid, Gauss–Markov)
   std::size_t k_lo = 0, k_hi = 0;     // the periodogram bins the check searches for a sinusoid
   double spectrum_scan_median = NAN;  // of knownSpectrumScanStatistic on those clean records
 };
@@ -251,6 +253,7 @@ Oracle calibrate(const Records& rec, const Curve& c, std::size_t records, std::u
       const auto p = model_check_detail::hannPeriodogram(y);
       if (o.base_power.empty()) {
         o.base_power.assign(p.power.size(), 0.0);
+        o.nfft = p.nfft;
         if (c.kind == Kind::GaussMarkov)
           o.gm_shape = gaussMarkovSpectralShape(c.gm_fraction * rec.duration, kRate, p.nfft);
       }
@@ -331,6 +334,28 @@ double knownNoiseScanStatistic(const KnownNoiseScan& k, const std::vector<double
 constexpr double kCheckStepRate = 1e-3;
 constexpr double kCheckTemperatureRate = 1e-4;
 constexpr double kCheckSinusoidRate = 1e-4;
+constexpr double kCheckGaussMarkovRate = 1e-3;  // gauss_markov.cpp: 10 × the default 1e-4
+
+// The Gauss–Markov process's blind bound: the known-form score (the base spectrum known) at
+// each correlation time of the check's grid (3 samples up to a fifteenth of the record, five
+// per decade), the largest over the grid.
+std::vector<std::vector<double>> gaussMarkovScanShapes(const Records& rec, std::size_t nfft) {
+  std::vector<std::vector<double>> shapes;
+  for (double t = 3.0 / kRate; t <= rec.duration / 15.0; t *= std::pow(10.0, 0.2))
+    shapes.push_back(gaussMarkovSpectralShape(t, kRate, nfft));
+  return shapes;
+}
+
+double gaussMarkovScanStatistic(const std::vector<double>& base_power, const std::vector<std::vector<double>>& shapes,
+                                const std::vector<double>& x) {
+  std::vector<double> y = x;
+  model_check_detail::removeLineInPlace(y);
+  const auto p = model_check_detail::hannPeriodogram(y);
+  double best = -std::numeric_limits<double>::infinity();
+  for (const std::vector<double>& shape : shapes)
+    best = std::max(best, spectralScoreStatistic(p.power, base_power, shape));
+  return best;
+}
 
 // sd_W from the first tenth of `records` clean records (pooled over positions), the threshold
 // from the rest.
@@ -481,9 +506,12 @@ ModelCheckOptions checkOptions(const Options& opt, std::uint64_t seed) {
 
 // The blind bound's detectors: steps, the two known-noise scans (check's widths, all widths);
 // temperature, the known-form statistic at the check's two-sided rate; sinusoid, the
-// known-background peak scan at the check's rate. `threshold` is the latter two's.
+// known-background peak scan at the check's rate; Gauss–Markov, the known-spectrum score
+// scanned over the check's correlation times, its threshold the empirical quantile of clean
+// records at the check's rate. `threshold` is the last three's.
 struct Bounds {
   std::vector<KnownNoiseScan> scans;
+  std::vector<std::vector<double>> gm_shapes;  // the Gauss–Markov scan's, one per correlation time
   double threshold = NAN;
   bool measured() const { return !scans.empty() || !std::isnan(threshold); }
 };
@@ -498,6 +526,16 @@ Bounds calibrateBounds(const Records& rec, const Curve& c, const Oracle& oracle,
   if (c.kind == Kind::Temperature) b.threshold = oracle.clean_rms * normalQuantile(1.0 - 0.5 * kCheckTemperatureRate);
   if (c.kind == Kind::Sinusoid)
     b.threshold = exponentialMaximaQuantile(oracle.spectrum_scan_median, kCheckSinusoidRate);
+  if (c.kind == Kind::GaussMarkov && opt.scan_calibration > 0) {
+    b.gm_shapes = gaussMarkovScanShapes(rec, oracle.nfft);
+    std::vector<double> values;
+    for (std::size_t k = 0; k < opt.scan_calibration; ++k) {
+      const TrialShape clean = drawTrial(rec, 5000000 + dur * 1000 + k, 0.0);
+      values.push_back(gaussMarkovScanStatistic(oracle.base_power, b.gm_shapes,
+                                                withEffect(rec, clean, {Kind::Step, "", "", 0.0, {}}, 0.0)));
+    }
+    b.threshold = calibratedThreshold(values, kCheckGaussMarkovRate);
+  }
   return b;
 }
 
@@ -581,7 +619,10 @@ void runCurve(const Records& rec, const Curve& c, const Options& opt, double& ch
       const std::vector<double> x = withEffect(rec, s, c, c.sizes[i]);
       const double known = oracleStatistic(oracle, c, s, x);
       hits[i][1] += known > oracle.threshold ? 1 : 0;
-      const double bound_value = c.kind == Kind::Sinusoid ? knownSpectrumScanStatistic(oracle, x) : known;
+      const double bound_value = c.kind == Kind::Sinusoid ? knownSpectrumScanStatistic(oracle, x)
+                                 : !bounds.gm_shapes.empty()
+                                     ? gaussMarkovScanStatistic(oracle.base_power, bounds.gm_shapes, x)
+                                     : known;
       hits[i][2] += bound_value > bounds.threshold ? 1 : 0;  // false when NaN
       for (std::size_t k = 0; k < bounds.scans.size(); ++k)
         hits[i][2 + k] += knownNoiseScanStatistic(bounds.scans[k], x) > bounds.scans[k].threshold ? 1 : 0;
