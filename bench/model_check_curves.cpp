@@ -15,11 +15,13 @@
 // cycle + noise). Trial j of a duration has its own noise, step time, frequency, phase and
 // Gauss–Markov realisation; only the size changes along a curve (common random numbers).
 // Output: per curve, lines "size trials blind lo hi optimal lo hi" (Wilson 95 % intervals),
-// with "bound lo hi" after them where the blind bound is measured (steps: the check's scan
-// with the noise known, calibrated on K clean records; temperature: the known-form statistic
-// at the check's rate), then a "summary" line; false discoveries on clean records; --data DIR
-// writes each curve as DIR/<effect>-<duration>.dat for gnuplot; --explain prints, per step
-// trial and size, the check's scan statistic beside the known-noise scans'.
+// then "bound lo hi", the blind bound: the check's own statistic with the noise known, at the
+// check's rate (steps: its scan, calibrated on K clean records; temperature: the known-form
+// statistic; sinusoid: its periodogram peak over the clean records' mean periodogram;
+// Gauss–Markov: the known-spectrum score scanned over its correlation times, K clean
+// records); then a "summary" line; false discoveries on clean records; --data DIR writes each
+// curve as DIR/<effect>-<duration>.dat for gnuplot; --explain prints, per step or temperature
+// trial and size, the check's statistic beside the bound's.
 #include <algorithm>
 #include <array>
 #include <chrono>
