@@ -459,7 +459,8 @@ std::vector<Curve> curvesFor(double duration, const Options& opt) {
   std::vector<Curve> all = {
       {Kind::Step, "bias_steps", "step / ADEV floor", 0.0, grid(2.0, std::sqrt(2.0))},
       {Kind::Sinusoid, "sinusoid", "amplitude / white sd", 0.0, grid(0.01 * sin_scale, std::sqrt(2.0))},
-      {Kind::Temperature, "temperature_bias", "k x temperature range / ADEV floor", 0.0, grid(2.0, std::sqrt(2.0))},
+      {Kind::Temperature, "temperature_bias", "k x temperature range / ADEV floor", 0.0,
+       grid(2.0 * std::sqrt(2.0), std::sqrt(2.0))},
       {Kind::GaussMarkov, "gauss_markov_short", "GM ADEV peak / base (T = duration/300)", 1.0 / 300.0,
        grid(0.5, std::sqrt(2.0))},
       {Kind::GaussMarkov, "gauss_markov_long", "GM ADEV peak / base (T = duration/60)", 1.0 / 60.0,
