@@ -169,6 +169,18 @@ std::vector<double> withEffect(const Records& rec, const TrialShape& s, const Cu
   return x;
 }
 
+// A trial's record with no effect.
+std::vector<double> cleanRecord(const Records& rec, const TrialShape& s) {
+  return withEffect(rec, s, {Kind::Step, "", "", 0.0, {}}, 0.0);
+}
+
+// The Hann periodogram of x with its line removed, as the check takes it.
+model_check_detail::Periodogram linelessPeriodogram(const std::vector<double>& x) {
+  std::vector<double> y = x;
+  model_check_detail::removeLineInPlace(y);
+  return model_check_detail::hannPeriodogram(y);
+}
+
 // ---- the known-form detector, calibrated on clean records ------------------------------
 
 struct Oracle {
@@ -187,9 +199,7 @@ struct Oracle {
 // largest ratio of the record's Hann periodogram (line removed) to the clean records' mean
 // periodogram over the bins the check searches.
 double knownSpectrumScanStatistic(const Oracle& o, const std::vector<double>& x) {
-  std::vector<double> y = x;
-  model_check_detail::removeLineInPlace(y);
-  const auto p = model_check_detail::hannPeriodogram(y);
+  const auto p = linelessPeriodogram(x);
   double best = 0.0;
   for (std::size_t k = o.k_lo; k <= o.k_hi && k < p.power.size(); ++k)
     if (o.base_power[k] > 0.0) best = std::max(best, p.power[k] / o.base_power[k]);
@@ -210,11 +220,7 @@ double oracleStatistic(const Oracle& o, const Curve& c, const TrialShape& s, con
           knownStepDifferences(x, static_cast<std::size_t>(std::ceil(s.step_time * kRate)), o.block), o.step_sd);
     case Kind::Sinusoid: return knownSinusoidStatistic(x, kRate, s.freq);
     case Kind::Temperature: return knownTemperatureStatistic(x, s.temp, o.block);
-    case Kind::GaussMarkov: {
-      std::vector<double> y = x;
-      model_check_detail::removeLineInPlace(y);
-      return spectralScoreStatistic(model_check_detail::hannPeriodogram(y).power, o.base_power, o.gm_shape);
-    }
+    case Kind::GaussMarkov: return spectralScoreStatistic(linelessPeriodogram(x).power, o.base_power, o.gm_shape);
   }
   return 0.0;
 }
@@ -227,7 +233,7 @@ Oracle calibrate(const Records& rec, const Curve& c, std::size_t records, std::u
   std::vector<std::vector<double>> clean;
   for (std::size_t j = 0; j < records; ++j) {
     shapes.push_back(drawTrial(rec, seed_base + j, 0.0));
-    clean.push_back(withEffect(rec, shapes.back(), {Kind::Step, "", "", 0.0, {}}, 0.0));
+    clean.push_back(cleanRecord(rec, shapes.back()));
   }
   const std::size_t half = records / 2;
   if (c.kind == Kind::Step) {
@@ -250,9 +256,7 @@ Oracle calibrate(const Records& rec, const Curve& c, std::size_t records, std::u
   }
   if (c.kind == Kind::GaussMarkov || c.kind == Kind::Sinusoid) {
     for (std::size_t j = 0; j < half; ++j) {
-      std::vector<double> y = clean[j];
-      model_check_detail::removeLineInPlace(y);
-      const auto p = model_check_detail::hannPeriodogram(y);
+      const auto p = linelessPeriodogram(clean[j]);
       if (o.base_power.empty()) {
         o.base_power.assign(p.power.size(), 0.0);
         o.nfft = p.nfft;
@@ -350,9 +354,7 @@ std::vector<std::vector<double>> gaussMarkovScanShapes(const Records& rec, std::
 
 double gaussMarkovScanStatistic(const std::vector<double>& base_power, const std::vector<std::vector<double>>& shapes,
                                 const std::vector<double>& x) {
-  std::vector<double> y = x;
-  model_check_detail::removeLineInPlace(y);
-  const auto p = model_check_detail::hannPeriodogram(y);
+  const auto p = linelessPeriodogram(x);
   double best = -std::numeric_limits<double>::infinity();
   for (const std::vector<double>& shape : shapes)
     best = std::max(best, spectralScoreStatistic(p.power, base_power, shape));
@@ -369,8 +371,7 @@ KnownNoiseScan calibrateKnownNoiseScan(const Records& rec, ScanReach reach, std:
   const std::size_t first = reach == ScanReach::Check ? 2 : 1, share = reach == ScanReach::Check ? 16 : 4;
   for (std::size_t w = first; share * w <= blocks; w *= 2) k.widths.push_back(w);
   k.sd.assign(k.widths.size(), 1.0);
-  const Curve none{Kind::Step, "", "", 0.0, {}};
-  auto clean = [&](std::size_t j) { return withEffect(rec, drawTrial(rec, seed_base + j, 0.0), none, 0.0); };
+  auto clean = [&](std::size_t j) { return cleanRecord(rec, drawTrial(rec, seed_base + j, 0.0)); };
   const std::size_t for_sd = std::max<std::size_t>(records / 10, 20);
   std::vector<double> sum_sq(k.widths.size(), 0.0), count(k.widths.size(), 0.0);
   for (std::size_t j = 0; j < for_sd; ++j) {
@@ -435,14 +436,14 @@ bool blindNames(const AxisModelCheck& r, Kind k) {
 
 struct Options {
   std::size_t trials = 16, calibration = 300, clean = 40, replicas = 40;
-  std::size_t scan_calibration = 4000;
-  std::size_t first_trial = 0;  // clean records that set the known-noise scan's threshold (0: no scan)
+  std::size_t scan_calibration = 4000;  // clean records that set the measured bounds' thresholds (0: none)
+  std::size_t first_trial = 0;
   std::vector<double> durations = {600.0, 3600.0};
   std::vector<std::string> effects = {"bias_steps", "sinusoid", "temperature_bias", "gauss_markov_short",
                                       "gauss_markov_long"};
   std::string data_dir;
   bool quick = false;
-  bool explain = false;  // per step trial: the check's scan statistic beside the known-noise scans'
+  bool explain = false;  // per step or temperature trial: the check's statistic beside the bound's
 };
 
 std::vector<Curve> curvesFor(double duration, const Options& opt) {
@@ -534,8 +535,7 @@ Bounds calibrateBounds(const Records& rec, const Curve& c, const Oracle& oracle,
     std::vector<double> values;
     for (std::size_t k = 0; k < opt.scan_calibration; ++k) {
       const TrialShape clean = drawTrial(rec, 5000000 + dur * 1000 + k, 0.0);
-      values.push_back(gaussMarkovScanStatistic(oracle.base_power, b.gm_shapes,
-                                                withEffect(rec, clean, {Kind::Step, "", "", 0.0, {}}, 0.0)));
+      values.push_back(gaussMarkovScanStatistic(oracle.base_power, b.gm_shapes, cleanRecord(rec, clean)));
     }
     b.threshold = calibratedThreshold(values, kCheckGaussMarkovRate);
   }
@@ -648,7 +648,7 @@ void runClean(const Records& rec, const Options& opt, double& check_seconds, std
   for (std::size_t j = 0; j < opt.clean; ++j) {
     const std::uint64_t seed = 9000000 + dur * 1000 + j;
     const TrialShape s = drawTrial(rec, seed, 0.0);
-    const std::vector<double> x = withEffect(rec, s, {Kind::Step, "", "", 0.0, {}}, 0.0);
+    const std::vector<double> x = cleanRecord(rec, s);
     const auto t0 = std::chrono::steady_clock::now();
     const AxisModelCheck r = checkAxisModel({x, kRate, s.temp, rec.t, {}}, checkOptions(opt, seed));
     check_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
