@@ -4,7 +4,8 @@
 // Usage: attitude_broad DIRECTORY [--set NAME=VALUE]... [TRIAL...]
 //   TRIAL: default every NAME.truth.csv.gz in DIRECTORY; --set overrides an AttitudeParameters
 //   field (tau, norm_scale, estimate_bias, rest_bias_tc, motion_bias_tc, rest_gyro, rest_accel,
-//   rest_duration, bias_limit), for exploring the parameters.
+//   rest_duration, bias_limit; the motion errors: estimate_sensitivity, estimate_lever_arm, s_init,
+//   r_init, r_rw, b_init, b_rw, c_noise), for exploring the parameters.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -43,9 +44,23 @@ bool setParameter(gyrod::processing::attitude::AttitudeParameters& p, const std:
                                                  {"rest_gyro", &p.rest_gyro_deviation_dps},
                                                  {"rest_accel", &p.rest_accel_deviation_g},
                                                  {"rest_duration", &p.rest_duration_s},
-                                                 {"bias_limit", &p.bias_limit_dps}};
+                                                 {"bias_limit", &p.bias_limit_dps},
+                                                 {"s_init", &p.motion_errors.sensitivity_initial_std},
+                                                 {"r_init", &p.motion_errors.lever_arm_initial_std_m},
+                                                 {"r_rw", &p.motion_errors.lever_arm_random_walk_m_per_sqrt_s},
+                                                 {"b_init", &p.motion_errors.bias_initial_std_rad_s},
+                                                 {"b_rw", &p.motion_errors.bias_random_walk_rad_s_per_sqrt_s},
+                                                 {"c_noise", &p.motion_errors.correction_noise_density}};
   if (key == "estimate_bias") {
     p.estimate_bias = v != 0.0;
+    return true;
+  }
+  if (key == "estimate_sensitivity") {
+    p.estimate_sensitivity = v != 0.0;
+    return true;
+  }
+  if (key == "estimate_lever_arm") {
+    p.estimate_lever_arm = v != 0.0;
     return true;
   }
   const auto it = fields.find(key);

@@ -50,6 +50,8 @@ AttitudeEstimator::AttitudeEstimator(const AttitudeParameters& params) : p_(para
   lp_a2_ = (1.0 - std::sqrt(2.0) * c + c * c) / d;
   const double arw = p_.gyro_angle_random_walk_dps_per_sqrt_hz * kDegToRad;
   bias_variance_rest_ = arw * arw / (2.0 * p_.rest_bias_time_constant_s);
+  motion_errors_ = MotionErrorEstimator(p_.motion_errors, {lp_b0_, lp_b1_, lp_b2_, lp_a1_, lp_a2_}, p_.rate_hz,
+                                        p_.estimate_sensitivity, p_.estimate_lever_arm);
   reset();
 }
 
@@ -61,10 +63,12 @@ void AttitudeEstimator::reset() {
   lp_s2_ = {};
   started_ = false;
   bias_rad_s_ = {};
+  motion_errors_.reset();
   rest_rate_mean_ = {};
   rest_accel_mean_ = {};
   rest_time_s_ = 0.0;
   rest_ = false;
+  bias_known_ = false;
   const double b0 = p_.estimate_bias ? p_.initial_bias_std_dps * kDegToRad : 0.0;
   bias_variance_ = b0 * b0;
   heading_arw_variance_ = 0.0;
@@ -94,9 +98,10 @@ void AttitudeEstimator::updateRest(const Vector3& rate_dps, const Vector3& accel
                      accel_dev2 < p_.rest_accel_deviation_g * p_.rest_accel_deviation_g;
   rest_time_s_ = quiet ? rest_time_s_ + dt_ : 0.0;
   rest_ = rest_time_s_ >= p_.rest_duration_s;
+  if (rest_) bias_known_ = true;
 }
 
-void AttitudeEstimator::correctInclination(const Vector3& accel_g, double weight) {
+Vector3 AttitudeEstimator::correctInclination(const Vector3& accel_g, double weight) {
   const Vector3 a_inertial = rotate(q_gyro_, accel_g);
   if (!started_) {
     // The first sample sets roll and pitch from the accel and heading 0 (Z-Y-X Euler):
@@ -109,7 +114,7 @@ void AttitudeEstimator::correctInclination(const Vector3& accel_g, double weight
     const double roll = std::atan2(accel_g[1], accel_g[2]);
     const double pitch = std::atan2(-accel_g[0], std::sqrt(accel_g[1] * accel_g[1] + accel_g[2] * accel_g[2]));
     q_correction_ = multiply(fromRotationVector({0.0, pitch, 0.0}), fromRotationVector({roll, 0.0, 0.0}));
-    return;
+    return {};
   }
   for (int i = 0; i < 3; ++i) {
     const double x = a_inertial[i];
@@ -120,20 +125,23 @@ void AttitudeEstimator::correctInclination(const Vector3& accel_g, double weight
   }
   Vector3 v = rotate(q_correction_, accel_lowpass_);
   const double n = norm(v);
-  if (!(n > 0.0)) return;
+  if (!(n > 0.0)) return {};
   for (double& c : v) c /= n;
   // The rotation by acos(v_z) about v × z = (v_y, −v_x, 0), which turns v to +z.
   const double w = std::sqrt(0.5 * (1.0 + v[2]));
-  if (w < 1e-6) return;  // upside down: the axis is undefined; the next sample decides
+  if (w < 1e-6) return {};  // upside down: the axis is undefined; the next sample decides
   const Quaternion step{w, 0.5 * v[1] / w, -0.5 * v[0] / w, 0.0};
   q_correction_ = normalized(multiply(step, q_correction_));
+  // c = 2·(x, y, 0) of the step (small angle), world frame.
+  const Vector3 c{2.0 * step[1], 2.0 * step[2], 0.0};
   if (p_.estimate_bias && !rest_) {
-    // c = 2·(x, y, 0) of the step (small angle) in the world frame, into the sensor frame.
+    // c into the sensor frame.
     const Quaternion q = multiply(q_correction_, q_gyro_);
-    const Vector3 c_sensor = rotateInverse(q, {2.0 * step[1], 2.0 * step[2], 0.0});
+    const Vector3 c_sensor = rotateInverse(q, c);
     const double gain = weight / p_.motion_bias_time_constant_s;
     for (int i = 0; i < 3; ++i) bias_rad_s_[i] -= gain * c_sensor[i];
   }
+  return c;
 }
 
 AttitudeSample AttitudeEstimator::update(const Vector3& rate_dps, const Vector3& accel_g) {
@@ -150,14 +158,28 @@ AttitudeSample AttitudeEstimator::update(const Vector3& rate_dps, const Vector3&
       for (double& c : bias_rad_s_) c *= limit / b;
   }
 
-  Vector3 r;
-  for (int i = 0; i < 3; ++i) r[i] = (rate_dps[i] * kDegToRad - bias_rad_s_[i]) * dt_;
+  Vector3 r, rate_rad_s;
+  for (int i = 0; i < 3; ++i) rate_rad_s[i] = rate_dps[i] * kDegToRad;
+  const Vector3& s_hat = motion_errors_.sensitivityError();
+  for (int i = 0; i < 3; ++i) r[i] = (rate_rad_s[i] * (1.0 - s_hat[i]) - bias_rad_s_[i]) * dt_;
   if (started_) q_gyro_ = normalized(multiply(q_gyro_, fromRotationVector(r)));
+  // The sensitivity and lever arm are learned from the corrections that follow the first sample,
+  // once the bias is known (a rate already corrected, or a first rest): an unknown bias turns
+  // the quasi-inertial frame as a sensitivity error would, and would be learned as one.
+  const bool learn =
+      (p_.estimate_sensitivity || p_.estimate_lever_arm) && started_ && (bias_known_ || !p_.estimate_bias);
+  Vector3 accel = accel_g;
+  if (learn) {  // K·r̂ off the accel: what is left is gravity and the centre's own acceleration
+    const Vector3 lever = motion_errors_.propagate(q_gyro_, rate_rad_s, bias_rad_s_);
+    for (int i = 0; i < 3; ++i) accel[i] -= lever[i];
+  }
 
   if (accel_ok) {
-    const double deviation = (norm(accel_g) - 1.0) / p_.accel_norm_scale_g;
-    correctInclination(accel_g, 1.0 / (1.0 + deviation * deviation));
+    const double deviation = (norm(accel) - 1.0) / p_.accel_norm_scale_g;
+    const double weight = 1.0 / (1.0 + deviation * deviation);
+    const Vector3 c = correctInclination(accel, weight);
     started_ = true;
+    if (learn) motion_errors_.update(q_correction_, c[0], c[1], weight);
   }
 
   // The 1σ bookkeeping.
@@ -191,6 +213,8 @@ AttitudeSample AttitudeEstimator::output() const {
   s.inclination_std_deg = std::sqrt(incl_var) * kRadToDeg;
   s.heading_std_deg = std::sqrt(heading_arw_variance_ + heading_bias_drift_ * heading_bias_drift_) * kRadToDeg;
   for (int i = 0; i < 3; ++i) s.bias_dps[i] = bias_rad_s_[i] * kRadToDeg;
+  s.gyro_sensitivity_error = motion_errors_.sensitivityError();
+  s.lever_arm_m = motion_errors_.leverArm();
   s.rest = rest_;
   return s;
 }

@@ -33,6 +33,12 @@
 //   disturbed says little about the bias. |b̂| is held below bias_limit_dps.
 // With estimate_bias unset (a rate already bias-corrected, e.g. gyrod's `rate` stream), b̂ = 0.
 //
+// Motion errors (processing/attitude/motion_errors.hpp), when estimate_sensitivity /
+// estimate_lever_arm are set: each gyro axis's sensitivity error ŝ, applied as
+// ω̂ = ω − b̂ − ŝ⊙ω, and the accel's lever arm r̂ from the centre of rotation, whose
+// acceleration K·r̂ (centripetal and tangential) is taken off the accel before the low-pass;
+// both learned by a Kalman filter from the same inclination corrections.
+//
 // Uncertainty (1σ, radians internally, degrees in AttitudeSample):
 //   inclination σ² = N_a²/(2τ) + N_g²·τ/2 + (σ_b·τ)²: the steady state of the first-order
 //     complementary filter, accel white noise N_a [g/√Hz ≈ rad/√Hz] through the low-pass,
@@ -44,6 +50,7 @@
 // update() allocates nothing and is O(1).
 #include <cstddef>
 
+#include "processing/attitude/motion_errors.hpp"
 #include "processing/attitude/quaternion.hpp"
 
 namespace gyrod::processing::attitude {
@@ -59,6 +66,9 @@ struct AttitudeParameters {
   double rest_accel_deviation_g = 0.05;       // rest: |a − ā| stays below
   double rest_duration_s = 1.5;               // for at least this long
   double bias_limit_dps = 5.0;
+  bool estimate_sensitivity = true;  // the gyro's sensitivity error, learned in motion
+  bool estimate_lever_arm = true;    // the accel's offset from the centre of rotation
+  MotionErrorParameters motion_errors{};
   // Noise terms for the 1σ (defaults: an MPU6050's datasheet figures).
   double gyro_angle_random_walk_dps_per_sqrt_hz = 0.005;  // N_g
   double gyro_rate_random_walk_dps_per_sqrt_s = 1e-4;     // K_g
@@ -72,6 +82,8 @@ struct AttitudeSample {
   double inclination_std_deg = 0.0;  // 1σ of the inclination (roll/pitch) error
   double heading_std_deg = 0.0;      // 1σ of the heading change since the first sample
   Vector3 bias_dps{};                // b̂, sensor frame
+  Vector3 gyro_sensitivity_error{};  // ŝ per sensor axis (0.01: reads 1 % high)
+  Vector3 lever_arm_m{};             // r̂, the accel's offset from the centre of rotation
   bool rest = false;
 };
 
@@ -85,10 +97,12 @@ class AttitudeEstimator {
   AttitudeSample update(const Vector3& rate_dps, const Vector3& accel_g);
   void reset();
   const AttitudeParameters& parameters() const { return p_; }
+  const MotionErrorEstimator& motionErrors() const { return motion_errors_; }
 
  private:
   void updateRest(const Vector3& rate_dps, const Vector3& accel_g);
-  void correctInclination(const Vector3& accel_g, double weight);
+  // Returns the correction's rotation vector (world frame, z = 0); zero when none was made.
+  Vector3 correctInclination(const Vector3& accel_g, double weight);
   AttitudeSample output() const;
 
   AttitudeParameters p_;
@@ -105,9 +119,11 @@ class AttitudeEstimator {
   Vector3 accel_lowpass_{};  // ā_I, the filter's output
   bool started_ = false;
   Vector3 bias_rad_s_{};
+  MotionErrorEstimator motion_errors_;
   Vector3 rest_rate_mean_{}, rest_accel_mean_{};
   double rest_time_s_ = 0.0;
   bool rest_ = false;
+  bool bias_known_ = false;            // a rest has been seen
   double bias_variance_ = 0.0;         // σ_b², (rad/s)²
   double heading_arw_variance_ = 0.0;  // N_g²·t
   double heading_bias_drift_ = 0.0;    // ∫σ_b dt

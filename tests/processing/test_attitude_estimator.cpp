@@ -54,6 +54,15 @@ SimulationModel attitudeSensor(double temperature_coefficient_dps_per_c = 0.0) {
 struct SimulatedAttitudeRun {
   std::vector<Quaternion> truth, estimate;
   std::vector<AttitudeSample> samples;
+  Vector3 sensitivity_error{}, lever_arm_m{};  // the estimator's at the end
+};
+
+// What a board adds beyond the simulator's chip: each gyro axis reading (1 + s)·ω of the true
+// rate ω, and the accel sitting r from the centre the board turns about (reading K·r more,
+// K = [ω]×² + [α]×, α the true rate's difference over a sample).
+struct BoardErrors {
+  Vector3 sensitivity_error{};
+  Vector3 lever_arm_m{};
 };
 
 // The estimator on the simulator's raw gyro and accel; the truth is the attitude the
@@ -61,23 +70,65 @@ struct SimulatedAttitudeRun {
 // The simulator's rate_k turns the board from t_k to t_k+1, after accel_k was taken; a chip's
 // gyro sample is the rate up to its time, so the estimator gets rate_k−1 with accel_k.
 SimulatedAttitudeRun runOnSimulator(const SimulationModel& model, const MotionProfile& motion, double duration_s,
-                                    std::uint64_t seed) {
+                                    std::uint64_t seed, AttitudeParameters p = {}, const BoardErrors& board = {}) {
   NoiseSimulator sim(model, duration_s, seed, motion);
-  AttitudeParameters p;
   p.rate_hz = model.rate_hz;
   AttitudeEstimator estimator(p);
   AttitudeIntegrator truth;
   SimulatedAttitudeRun run;
-  Vector3 previous_rate_dps{};
+  Vector3 previous_rate_dps{}, previous_true_rad_s{};
   for (std::uint64_t i = 0; i < sim.sampleCount(); ++i) {
-    const SimulatedSample s = sim.next();
+    SimulatedSample s = sim.next();
+    Vector3 w{}, alpha{};
+    for (std::size_t a = 0; a < 3; ++a) {
+      s.rate_dps[a] += board.sensitivity_error[a] * s.true_rate_dps[a];
+      w[a] = s.true_rate_dps[a] / kAttitudeRadToDeg;
+      alpha[a] = (w[a] - previous_true_rad_s[a]) * model.rate_hz;
+    }
+    previous_true_rad_s = w;
+    const Vector3& r = board.lever_arm_m;
+    const Vector3 w_cross_r{w[1] * r[2] - w[2] * r[1], w[2] * r[0] - w[0] * r[2], w[0] * r[1] - w[1] * r[0]};
+    const Vector3 centripetal{w[1] * w_cross_r[2] - w[2] * w_cross_r[1], w[2] * w_cross_r[0] - w[0] * w_cross_r[2],
+                              w[0] * w_cross_r[1] - w[1] * w_cross_r[0]};
+    const Vector3 tangential{alpha[1] * r[2] - alpha[2] * r[1], alpha[2] * r[0] - alpha[0] * r[2],
+                             alpha[0] * r[1] - alpha[1] * r[0]};
+    for (std::size_t a = 0; a < 3; ++a) s.accel_g[a] += (centripetal[a] + tangential[a]) / 9.80665;
     run.truth.push_back(truth.quaternion());
     truth.step(s.true_rate_dps, 1.0 / model.rate_hz);
     run.samples.push_back(estimator.update(previous_rate_dps, s.accel_g));
     previous_rate_dps = s.rate_dps;
     run.estimate.push_back(run.samples.back().q);
   }
+  run.sensitivity_error = estimator.motionErrors().sensitivityError();
+  run.lever_arm_m = estimator.motionErrors().leverArm();
   return run;
+}
+
+struct AttitudeScore {
+  double inclination_rmse_deg = 0.0;
+  double largest_heading_change_error_deg = 0.0;  // against the true heading change since `from`
+};
+
+AttitudeScore scoreFrom(const SimulatedAttitudeRun& run, std::size_t from) {
+  const double heading_at_start = signedHeadingAngle(multiply(run.estimate[from], conjugate(run.truth[from])));
+  double sum_incl2 = 0.0, largest = 0.0;
+  for (std::size_t i = from; i < run.truth.size(); ++i) {
+    const Quaternion e = multiply(run.estimate[i], conjugate(run.truth[i]));
+    sum_incl2 += inclinationAngle(e) * inclinationAngle(e);
+    largest = std::max(largest, std::fabs(wrapAngle(signedHeadingAngle(e) - heading_at_start)));
+  }
+  return {std::sqrt(sum_incl2 / static_cast<double>(run.truth.size() - from)) * kAttitudeRadToDeg,
+          largest * kAttitudeRadToDeg};
+}
+
+// 10 s still, then body rates on every axis at once (90, 80 and 120 °/s times `speed`, at
+// incommensurate frequencies times `speed`): the board tumbles, so every axis spends time
+// horizontal while it turns.
+MotionProfile tumbling(double duration_s, double speed = 1.0) {
+  const MotionProfile moving = MotionProfile::sum({MotionProfile::sine(0, 0.23 * speed, 90.0 * speed),
+                                                   MotionProfile::sine(1, 0.31 * speed, 80.0 * speed),
+                                                   MotionProfile::sine(2, 0.17 * speed, 120.0 * speed)});
+  return MotionProfile::sequence({{MotionProfile{}, 10.0}, {moving, duration_s - 10.0}});
 }
 
 }  // namespace
@@ -152,16 +203,9 @@ TEST(AttitudeEstimator, FollowsTheSimulatorsTrueAttitudeThroughAMotionProfile) {
   const SimulationModel model = attitudeSensor();
   const SimulatedAttitudeRun run = runOnSimulator(model, motion, 190.0, 7);
   const auto from = static_cast<std::size_t>(10.0 * model.rate_hz);
-  const double heading_at_start = signedHeadingAngle(multiply(run.estimate[from], conjugate(run.truth[from])));
-  double sum_incl2 = 0.0, largest_heading_change_error = 0.0;
-  for (std::size_t i = from; i < run.truth.size(); ++i) {
-    const Quaternion e = multiply(run.estimate[i], conjugate(run.truth[i]));
-    sum_incl2 += inclinationAngle(e) * inclinationAngle(e);
-    largest_heading_change_error =
-        std::max(largest_heading_change_error, std::fabs(wrapAngle(signedHeadingAngle(e) - heading_at_start)));
-  }
-  const double incl_rmse_deg = std::sqrt(sum_incl2 / static_cast<double>(run.truth.size() - from)) * kAttitudeRadToDeg;
-  const double heading_deg = largest_heading_change_error * kAttitudeRadToDeg;
+  const AttitudeScore score = scoreFrom(run, from);
+  const double incl_rmse_deg = score.inclination_rmse_deg;
+  const double heading_deg = score.largest_heading_change_error_deg;
   std::printf(
       "simulated motion: inclination RMSE %.3f deg (stated 1 sigma %.3f), largest heading change error %.3f"
       " deg (stated 1 sigma at the end %.3f)\n",
@@ -224,4 +268,51 @@ TEST(AttitudeEstimator, BroadTrialsWithinTheirBounds) {
     EXPECT_LE(e.heading_rmse_deg, b.heading_deg) << b.name;
     EXPECT_GE(without.heading_rmse_deg, 3.0 * e.heading_rmse_deg) << b.name;
   }
+}
+
+// A gyro whose axes read 2 % high, 1.5 % low and 2.5 % high (the MPU6050's datasheet allows
+// ±3 %), tumbled for 4 min: the estimator learns each axis's error from the gravity
+// correction, and the heading follows the true one where the uncorrected gyro's does not.
+TEST(AttitudeEstimator, LearnsEachGyroAxissSensitivityErrorWhileTheBoardTumbles) {
+  const SimulationModel model = attitudeSensor();
+  const BoardErrors board{{0.02, -0.015, 0.025}, {}};
+  const SimulatedAttitudeRun run = runOnSimulator(model, tumbling(250.0), 250.0, 23, {}, board);
+  AttitudeParameters fixed;
+  fixed.estimate_sensitivity = false;
+  const SimulatedAttitudeRun without = runOnSimulator(model, tumbling(250.0), 250.0, 23, fixed, board);
+  const auto from = static_cast<std::size_t>(60.0 * model.rate_hz);  // after the first 50 s of motion
+  const AttitudeScore learned = scoreFrom(run, from), not_learned = scoreFrom(without, from);
+  std::printf(
+      "sensitivity error %.2f %.2f %.2f %% learned as %.2f %.2f %.2f %%; from 60 s: inclination RMSE %.3f deg "
+      "(%.3f without), heading change error %.2f deg (%.2f without)\n",
+      100 * board.sensitivity_error[0], 100 * board.sensitivity_error[1], 100 * board.sensitivity_error[2],
+      100 * run.sensitivity_error[0], 100 * run.sensitivity_error[1], 100 * run.sensitivity_error[2],
+      learned.inclination_rmse_deg, not_learned.inclination_rmse_deg, learned.largest_heading_change_error_deg,
+      not_learned.largest_heading_change_error_deg);
+  for (std::size_t a = 0; a < 3; ++a)
+    EXPECT_NEAR(run.sensitivity_error[a], board.sensitivity_error[a], 0.003) << "axis " << a;
+  EXPECT_LE(learned.largest_heading_change_error_deg, 0.25 * not_learned.largest_heading_change_error_deg);
+  EXPECT_LE(learned.inclination_rmse_deg, 0.5 * not_learned.inclination_rmse_deg);
+}
+
+// The accel 15 cm out along x and 5 cm below the centre of a board tumbling at up to 200 °/s:
+// the centripetal and tangential accelerations, which tilt the gravity estimate, are learned
+// as a lever arm and taken off.
+TEST(AttitudeEstimator, LearnsTheAccelerometersLeverArmAndTakesItsAccelerationOff) {
+  const SimulationModel model = attitudeSensor();
+  const BoardErrors board{{}, {0.15, 0.0, -0.05}};
+  const SimulatedAttitudeRun run = runOnSimulator(model, tumbling(250.0, 1.6), 250.0, 29, {}, board);
+  AttitudeParameters fixed;
+  fixed.estimate_lever_arm = false;
+  const SimulatedAttitudeRun without = runOnSimulator(model, tumbling(250.0, 1.6), 250.0, 29, fixed, board);
+  const auto from = static_cast<std::size_t>(60.0 * model.rate_hz);
+  const AttitudeScore learned = scoreFrom(run, from), not_learned = scoreFrom(without, from);
+  std::printf(
+      "lever arm %.3f %.3f %.3f m learned as %.3f %.3f %.3f m; from 60 s: inclination RMSE %.3f deg (%.3f without), "
+      "heading change error %.2f deg (%.2f without)\n",
+      board.lever_arm_m[0], board.lever_arm_m[1], board.lever_arm_m[2], run.lever_arm_m[0], run.lever_arm_m[1],
+      run.lever_arm_m[2], learned.inclination_rmse_deg, not_learned.inclination_rmse_deg,
+      learned.largest_heading_change_error_deg, not_learned.largest_heading_change_error_deg);
+  for (std::size_t a = 0; a < 3; ++a) EXPECT_NEAR(run.lever_arm_m[a], board.lever_arm_m[a], 0.02) << "axis " << a;
+  EXPECT_LE(learned.inclination_rmse_deg, 0.6 * not_learned.inclination_rmse_deg);
 }

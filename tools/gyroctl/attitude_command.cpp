@@ -121,6 +121,7 @@ int runAttitude(const AttitudeOptions& opt) {
   for (const auto& c : columns) out += "," + c.first;
   out += ",qw,qx,qy,qz,roll,pitch,heading,inclination_std,heading_std\n";
   std::size_t rest_samples = 0;
+  AttitudeSample last;
   for (std::size_t i = 0; i < n; ++i) {
     const double t = rec.t.empty() ? static_cast<double>(i) * dt : rec.t[i];
     Vector3 rate{(*gyro[0])[i], (*gyro[1])[i], (*gyro[2])[i]};
@@ -130,6 +131,7 @@ int runAttitude(const AttitudeOptions& opt) {
       rate = rate_estimator->update(t, rate, rec.temp.empty() ? fixed_temperature_c : rec.temp[i]).rate_dps;
     }
     const AttitudeSample s = estimator.update(rate, a);
+    last = s;
     if (s.rest) ++rest_samples;
     appendAttitudeNumber(out, t);
     for (const auto& c : columns) {
@@ -150,6 +152,15 @@ int runAttitude(const AttitudeOptions& opt) {
   else
     std::fprintf(stderr, "attitude from the raw gyro, its bias learned from the record (%zu of %zu samples at rest)\n",
                  rest_samples, n);
+  const Vector3& sens = last.gyro_sensitivity_error;
+  const Vector3& lever = last.lever_arm_m;
+  if (!rate_estimator && rest_samples == 0)
+    std::fprintf(stderr, "learned in motion: nothing (no rest in the record, so the gyro bias is not known)\n");
+  else
+    std::fprintf(stderr,
+                 "learned in motion: gyro sensitivity error x %+.2f %%, y %+.2f %%, z %+.2f %%; accel lever arm "
+                 "%+.3f, %+.3f, %+.3f m\n",
+                 100.0 * sens[0], 100.0 * sens[1], 100.0 * sens[2], lever[0], lever[1], lever[2]);
   std::fprintf(stderr, "wrote %zu samples to %s\n", n, opt.output.c_str());
   return kExitOk;
 }

@@ -1,0 +1,173 @@
+#include "processing/attitude/motion_errors.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace gyrod::processing::attitude {
+namespace {
+
+using Matrix3 = std::array<Vector3, 3>;
+constexpr double kStandardGravity = 9.80665;  // m/s² per g
+
+Matrix3 rotationMatrix(const Quaternion& q) {
+  const double w = q[0], x = q[1], y = q[2], z = q[3];
+  return {{{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
+           {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
+           {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}}};
+}
+
+// K = [ω]×² + [α]×: the acceleration of a point r from the centre of rotation is K·r.
+Matrix3 leverArmMatrix(const Vector3& w, const Vector3& a) {
+  const double xx = w[0] * w[0], yy = w[1] * w[1], zz = w[2] * w[2];
+  return {{{-(yy + zz), w[0] * w[1] - a[2], w[0] * w[2] + a[1]},
+           {w[0] * w[1] + a[2], -(xx + zz), w[1] * w[2] - a[0]},
+           {w[0] * w[2] - a[1], w[1] * w[2] + a[0], -(xx + yy)}}};
+}
+
+void requirePositive(double value, const char* name) {
+  if (!(value > 0.0) || !std::isfinite(value))
+    throw std::invalid_argument(std::string("attitude: motion errors ") + name + " must be a positive number, not " +
+                                std::to_string(value));
+}
+
+}  // namespace
+
+MotionErrorEstimator::MotionErrorEstimator(const MotionErrorParameters& params, const LowpassCoefficients& lowpass,
+                                           double rate_hz, bool estimate_sensitivity, bool estimate_lever_arm)
+    : p_(params),
+      lp_(lowpass),
+      dt_(1.0 / rate_hz),
+      estimate_sensitivity_(estimate_sensitivity),
+      estimate_lever_arm_(estimate_lever_arm) {
+  requirePositive(p_.sensitivity_initial_std, "sensitivity_initial_std");
+  requirePositive(p_.sensitivity_limit, "sensitivity_limit");
+  requirePositive(p_.lever_arm_initial_std_m, "lever_arm_initial_std_m");
+  requirePositive(p_.lever_arm_limit_m, "lever_arm_limit_m");
+  requirePositive(p_.bias_initial_std_rad_s, "bias_initial_std_rad_s");
+  requirePositive(p_.correction_noise_density, "correction_noise_density");
+  for (const auto& [value, name] : {std::pair{p_.lever_arm_random_walk_m_per_sqrt_s, "lever_arm_random_walk"},
+                                    std::pair{p_.bias_random_walk_rad_s_per_sqrt_s, "bias_random_walk"}})
+    if (!(value >= 0.0) || !std::isfinite(value))
+      throw std::invalid_argument(std::string("attitude: motion errors ") + name + " must be finite and >= 0, not " +
+                                  std::to_string(value));
+  // White at the sample rate with this density: the information a second does not depend on
+  // the rate.
+  measurement_variance_ = p_.correction_noise_density * p_.correction_noise_density * rate_hz;
+  for (int i = 0; i < 3; ++i) {
+    process_variance_[3 + i] = p_.bias_random_walk_rad_s_per_sqrt_s * p_.bias_random_walk_rad_s_per_sqrt_s * dt_;
+    if (estimate_lever_arm_)
+      process_variance_[6 + i] = p_.lever_arm_random_walk_m_per_sqrt_s * p_.lever_arm_random_walk_m_per_sqrt_s * dt_;
+  }
+  reset();
+}
+
+void MotionErrorEstimator::reset() {
+  s1_ = {};
+  s2_ = {};
+  out_ = {};
+  previous_lever_out_ = {};
+  previous_rate_ = {};
+  primed_ = false;
+  theta_ = {};
+  cov_ = {};
+  for (int i = 0; i < 3; ++i) {
+    if (estimate_sensitivity_) cov_[i][i] = p_.sensitivity_initial_std * p_.sensitivity_initial_std;
+    cov_[3 + i][3 + i] = p_.bias_initial_std_rad_s * p_.bias_initial_std_rad_s;
+    if (estimate_lever_arm_) cov_[6 + i][6 + i] = p_.lever_arm_initial_std_m * p_.lever_arm_initial_std_m;
+  }
+  sensitivity_ = {};
+  lever_arm_ = {};
+}
+
+Vector3 MotionErrorEstimator::propagate(const Quaternion& q_gyro, const Vector3& rate, const Vector3& bias) {
+  const Matrix3 r = rotationMatrix(q_gyro);
+  Vector3 angular_acceleration{};
+  if (primed_)
+    for (int i = 0; i < 3; ++i) angular_acceleration[i] = (rate[i] - previous_rate_[i]) / dt_;
+  previous_rate_ = rate;
+  const Matrix3 k = leverArmMatrix(rate, angular_acceleration);
+  Vector3 lever_accel_g{};  // K·r̂ / g, sensor frame
+  for (int i = 0; i < 3; ++i)
+    lever_accel_g[i] = (k[i][0] * lever_arm_[0] + k[i][1] * lever_arm_[1] + k[i][2] * lever_arm_[2]) / kStandardGravity;
+
+  std::array<double, kChannels> x{};
+  for (int i = 0; i < 3; ++i) {
+    double applied_rate = 0.0, applied_accel = 0.0;
+    for (int j = 0; j < 3; ++j) {
+      x[3 * i + j] = r[i][j] * rate[j];
+      x[9 + 3 * i + j] = r[i][j];
+      applied_rate += r[i][j] * (sensitivity_[j] * rate[j] + bias[j]);
+      double rk = 0.0;
+      for (int m = 0; m < 3; ++m) rk += r[i][m] * k[m][j];
+      x[kLeverChannels + 3 * i + j] = rk / kStandardGravity;
+      applied_accel += r[i][j] * lever_accel_g[j];
+    }
+    x[18 + i] = applied_rate;
+    x[kLeverChannels + 9 + i] = applied_accel;
+  }
+  for (int c = kLeverChannels; c < kChannels; ++c) previous_lever_out_[c - kLeverChannels] = out_[c];
+  if (!primed_) {  // the steady state of a constant input, as the gravity low-pass starts
+    for (int c = 0; c < kChannels; ++c) {
+      s2_[c] = (lp_.b2 - lp_.a2) * x[c];
+      s1_[c] = (lp_.b1 - lp_.a1) * x[c] + s2_[c];
+      out_[c] = x[c];
+    }
+    for (int c = kLeverChannels; c < kChannels; ++c) previous_lever_out_[c - kLeverChannels] = out_[c];
+    primed_ = true;
+    return lever_accel_g;
+  }
+  for (int c = 0; c < kChannels; ++c) {
+    const double y = lp_.b0 * x[c] + s1_[c];
+    s1_[c] = lp_.b1 * x[c] - lp_.a1 * y + s2_[c];
+    s2_[c] = lp_.b2 * x[c] - lp_.a2 * y;
+    out_[c] = y;
+  }
+  for (int i = 0; i < kStates; ++i) cov_[i][i] += process_variance_[i];
+  return lever_accel_g;
+}
+
+void MotionErrorEstimator::update(const Quaternion& q_correction, double cx, double cy, double weight) {
+  if (!primed_ || !(weight > 0.0)) return;
+  const Matrix3 rc = rotationMatrix(q_correction);
+  const double measured[2] = {cx / dt_, cy / dt_};
+  const double variance = measurement_variance_ / weight;
+  // J picks, for the correction's world x, the disturbance's y, and for its y, minus its x.
+  const int other_row[2] = {1, 0};
+  const double sign[2] = {1.0, -1.0};
+  for (int row = 0; row < 2; ++row) {
+    std::array<double, kStates> h{};
+    double known = 0.0;
+    const int lever_row = other_row[row];
+    for (int j = 0; j < 3; ++j) {
+      for (int i = 0; i < 3; ++i) {
+        h[j] -= rc[row][i] * out_[3 * i + j];
+        h[3 + j] -= rc[row][i] * out_[9 + 3 * i + j];
+        const double d_lever = out_[kLeverChannels + 3 * i + j] - previous_lever_out_[3 * i + j];
+        h[6 + j] += sign[row] * rc[lever_row][i] * d_lever / dt_;
+      }
+      const double d_applied = out_[kLeverChannels + 9 + j] - previous_lever_out_[9 + j];
+      known += rc[row][j] * out_[18 + j] - sign[row] * rc[lever_row][j] * d_applied / dt_;
+    }
+    std::array<double, kStates> ph{};
+    double hph = 0.0, predicted = 0.0;
+    for (int a = 0; a < kStates; ++a) {
+      for (int b = 0; b < kStates; ++b) ph[a] += cov_[a][b] * h[b];
+      hph += h[a] * ph[a];
+      predicted += h[a] * theta_[a];
+    }
+    const double innovation = measured[row] - known - predicted;
+    const double s = hph + variance;
+    for (int a = 0; a < kStates; ++a) theta_[a] += ph[a] / s * innovation;
+    for (int a = 0; a < kStates; ++a)
+      for (int b = 0; b < kStates; ++b) cov_[a][b] -= ph[a] * ph[b] / s;
+  }
+  for (int i = 0; i < 3; ++i) {
+    sensitivity_[i] = std::clamp(theta_[i], -p_.sensitivity_limit, p_.sensitivity_limit);
+    lever_arm_[i] = std::clamp(theta_[6 + i], -p_.lever_arm_limit_m, p_.lever_arm_limit_m);
+  }
+}
+
+}  // namespace gyrod::processing::attitude
