@@ -163,6 +163,15 @@ recording::SampleValues recordedSample(const RateSample& r, std::int64_t wall_ns
   v.rate_dps = r.rate_dps;
   v.bias_dps = r.bias_dps;
   v.still = r.still ? static_cast<std::int8_t>(*r.still) : std::int8_t{-1};
+  v.attitude = {r.quat[0],
+                r.quat[1],
+                r.quat[2],
+                r.quat[3],
+                r.roll_pitch_heading_deg[0],
+                r.roll_pitch_heading_deg[1],
+                r.roll_pitch_heading_deg[2],
+                r.inclination_std_deg,
+                r.heading_std_deg};
   return v;
 }
 
@@ -297,6 +306,31 @@ PipelineSettings Gyrod::pipelineSettings(const GyrodConfig& c, const LoadedRateM
   return s;
 }
 
+// The recording, its header comments saying what each column is and how to recompute it.
+void Gyrod::startRecorder(const std::string& started_from) {
+  // Sized for the samples per second it really receives: the accelerated mock's included.
+  RecorderOptions options = recorderOptions(config_.record, recordedSamplesPerSecond(config_));
+  options.header_comments.push_back("gyrod " + std::string(GYROD_RELEASE) + " recording of " + device_.description);
+  options.header_comments.push_back(
+      "gx,gy,gz: raw rates as read from the chip (bias not removed); t: CLOCK_MONOTONIC s of the data-ready edge; "
+      "time: the same edge in UTC epoch s; GAP lines mark lost samples");
+  const driver::Mpu6050Config& chip = device_.driver_config;  // the chain the model check puts in its base model
+  options.header_comments.push_back(recording::acquisitionHeaderComment(
+      chip.dlpf_cfg, chip.fs_sel, chip.sample_rate_hz, driver::sampleRateDivider(chip)));
+  options.header_comments.push_back(
+      "gx_rate..still: the RATE stream's rate, bias and still as published (docs/recording-format.md)");
+  if (rate_model_.params)  // the recording holds what the rate stream was fed, at full precision
+    options.header_comments.push_back("recompute them: gyroctl filter FILE --model " + config_.filter.model +
+                                      " --rate " + formats::shortest(config_.device.rate_hz) +
+                                      "; the orientation (qw..heading_std): gyroctl attitude FILE --model " +
+                                      config_.filter.model + " --rate " + formats::shortest(config_.device.rate_hz));
+  appendCalibrationStateHeader(options.header_comments, started_from);
+  options.columns.time = true;
+  options.columns.rate = true;
+  options.columns.attitude = true;  // when the first sample has an orientation (a model and accel)
+  recorder_ = std::make_unique<Recorder>(options);
+}
+
 Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
     : config_(config),
       config_file_(std::move(config_file)),
@@ -346,26 +380,7 @@ Gyrod::Gyrod(const GyrodConfig& config, std::string config_file)
       std::make_unique<UnixSocketServer>(client_loop_, openListeningSocket(socket_options), *this, server_options);
   client_loop_.addFd(stop_clients_fd_.get(), EPOLLIN, [this](std::uint32_t) { client_loop_.stop(); });
 
-  if (config_.record.enabled()) {
-    // Sized for the samples per second it really receives: the accelerated mock's included.
-    RecorderOptions options = recorderOptions(config_.record, recordedSamplesPerSecond(config_));
-    options.header_comments.push_back("gyrod " + std::string(GYROD_RELEASE) + " recording of " + device_.description);
-    options.header_comments.push_back(
-        "gx,gy,gz: raw rates as read from the chip (bias not removed); t: CLOCK_MONOTONIC s of the data-ready edge; "
-        "time: the same edge in UTC epoch s; GAP lines mark lost samples");
-    const driver::Mpu6050Config& chip = device_.driver_config;  // the chain the model check puts in its base model
-    options.header_comments.push_back(recording::acquisitionHeaderComment(
-        chip.dlpf_cfg, chip.fs_sel, chip.sample_rate_hz, driver::sampleRateDivider(chip)));
-    options.header_comments.push_back(
-        "gx_rate..still: the RATE stream's rate, bias and still as published (docs/recording-format.md)");
-    if (rate_model_.params)  // the recording holds what the rate stream was fed, at full precision
-      options.header_comments.push_back("recompute them: gyroctl filter FILE --model " + config_.filter.model +
-                                        " --rate " + formats::shortest(config_.device.rate_hz));
-    appendCalibrationStateHeader(options.header_comments, started_from);
-    options.columns.time = true;
-    options.columns.rate = true;
-    recorder_ = std::make_unique<Recorder>(options);
-  }
+  if (config_.record.enabled()) startRecorder(started_from);
 
   if (config_.mqtt.enabled()) startMqtt();
 
@@ -612,6 +627,13 @@ void Gyrod::publish(const driver::GyroSample& s, const ProcessedSample& out) {
   r.still = out.still;
   r.time_s = s.wall_ns != 0 ? static_cast<double>(s.wall_ns) * 1e-9 : kNaN;
   r.accel_g = s.accel_g;
+  if (out.attitude) {
+    const processing::attitude::AttitudeSample& a = *out.attitude;
+    r.quat = a.q;
+    r.roll_pitch_heading_deg = {a.roll_deg, a.pitch_deg, a.heading_deg};
+    r.inclination_std_deg = a.inclination_std_deg;
+    r.heading_std_deg = a.heading_std_deg;
+  }
   LineForClients line;
   line.rate = r;
   queueForClients(line);

@@ -93,6 +93,7 @@ class Gyrod final : public driver::SampleSink, public ServerContent {
   static PipelineSettings pipelineSettings(const GyrodConfig& config, const LoadedRateModel& rate_model);
   std::string rateModelDescription() const;
   std::string startCalibrationKeeper();
+  void startRecorder(const std::string& started_from);
   void startLiveCheck();
   // The live check's change as an EFFECT line for the delivery thread (sample thread).
   void queueEffect(const processing::LiveEffect& e);

@@ -16,6 +16,7 @@
 #include <ctime>
 #include <filesystem>
 #include <new>
+#include <tuple>
 
 #include "formats/recording_format.hpp"
 
@@ -24,9 +25,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Header and a first line (RecordingLine, 512 bytes) fit in one page of any size (≥ 4096): written in one write().
+// Header and a first line (a RecordingLine) fit in one page of any size (≥ 4096): written in one write().
 // A calibration state the rate stream started from takes about 1.2 KiB of it.
-constexpr std::size_t kMaxHeaderBytes = 4096 - 512;
+constexpr std::size_t kMaxHeaderBytes = 4096 - std::tuple_size_v<decltype(recording::RecordingLine::bytes)>;
 
 std::int64_t steadyNowNs() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
@@ -88,6 +89,7 @@ Recorder::Recorder(RecorderOptions options) : options_(std::move(options)), ring
   if (!(options_.rotate_after_s >= 0.0)) throw std::invalid_argument("Recorder: rotate_after_s must be ≥ 0");
   recording::SampleColumns all_columns = options_.columns;
   all_columns.accel = true;
+  all_columns.attitude = true;
   std::size_t header_bytes = recording::columnsLine(all_columns).size() + 128;
   for (const auto& c : options_.header_comments) {
     if (c.find('\n') != std::string::npos) throw std::invalid_argument("Recorder: a header comment contains a newline");
@@ -116,6 +118,7 @@ Recorder::Recorder(RecorderOptions options) : options_(std::move(options)), ring
   }
   columns_ = options_.columns;
   columns_.accel = false;
+  columns_.attitude = false;
   in_error_ = false;
   writer_ = std::thread([this] { writerLoop(); });
 }
@@ -275,9 +278,10 @@ void Recorder::flushOnce(bool final_flush) {
                  true);
       continue;
     }
-    if (!columns_known_) {  // the first sample: does the device give accel?
+    if (!columns_known_) {  // the first sample: does the device give accel, the stream an orientation?
       const auto& a = r.sample.accel_g;
       columns_.accel = std::isfinite(a[0]) && std::isfinite(a[1]) && std::isfinite(a[2]);
+      columns_.attitude = options_.columns.attitude && std::isfinite(r.sample.attitude[0]);
       columns_known_ = true;
     }
     appendLine(recording::formatSampleLine(line, columns_, r.sample), true);

@@ -74,8 +74,9 @@ struct RecorderOptions {
   bool fsync_each_flush = false;
   std::size_t keep = 0;                      // files of this base name to keep (oldest deleted); 0 = all
   std::vector<std::string> header_comments;  // written as "# ..." lines after the column line of each file
-  // The `time` and rate-stream columns (formats/recording_format.hpp); `accel` is ignored:
-  // ax,ay,az are there when the first sample has accel.
+  // The `time`, rate-stream and attitude columns (formats/recording_format.hpp); `accel` is
+  // ignored: ax,ay,az are there when the first sample has accel; the attitude columns, when
+  // `attitude` is set and the first sample has an orientation.
   recording::SampleColumns columns;
 };
 
@@ -178,7 +179,7 @@ class Recorder {
   std::uint64_t next_index_ = 0;
   std::int64_t file_opened_unix_s_ = 0;  // for the header's "opened" comment
   std::string previous_file_;            // for the header's "continues" comment
-  // The file's columns: `accel` from the first sample; until then none is written.
+  // The file's columns: `accel` and `attitude` from the first sample; until then none is written.
   recording::SampleColumns columns_;
   bool columns_known_ = false;
   std::uint64_t drops_reported_ = 0;         // dropped records announced (or in lines on their way to a file)

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "formats/calibration.hpp"
+
 namespace gyrod::daemon {
 namespace {
 
@@ -49,7 +51,10 @@ SamplePipeline::SamplePipeline(const PipelineSettings& settings)
       allan_mean_(makeAllanArray(settings)),
       allan_kalman_(makeAllanArray(settings)) {
   if (settings_.bias_origin != BiasOrigin::Estimate) bias_ = settings_.bias_dps;
-  if (settings_.rate_model) rate_.emplace(*settings_.rate_model);  // validates them
+  if (settings_.rate_model) {
+    rate_.emplace(*settings_.rate_model);  // validates them
+    attitude_.emplace(recording::rateStreamAttitudeParameters(*settings_.rate_model));
+  }
   for (auto& p : params_) {
     p.mean_window = settings_.mean_window;
     p.mean_threshold_dps = settings_.mean_threshold_dps;
@@ -290,6 +295,10 @@ ProcessedSample SamplePipeline::process(std::uint64_t seq, double t_s, const Vec
     out.rate_bias = r.bias_dps;
     out.still = r.still;
     out.has_rate = true;
+    // The orientation from the rate stream and the accel, as `gyroctl attitude --model` computes
+    // it from a recording; published only when the device gives the accel.
+    const processing::attitude::AttitudeSample a = attitude_->update(r.rate_dps, accel_g);
+    if (std::isfinite(accel_g[0]) && std::isfinite(accel_g[1]) && std::isfinite(accel_g[2])) out.attitude = a;
   }
   advance(out, false);
   return out;
@@ -343,6 +352,12 @@ void SamplePipeline::reloadRateModel(const std::optional<processing::RateEstimat
   if (p) fresh.emplace(*p);  // throws before anything changes
   settings_.rate_model = p;
   rate_ = std::move(fresh);
+  // The orientation goes on through a new model (its parameters differ only in the 1σ terms):
+  // a reload must not turn the heading back to 0.
+  if (!p)
+    attitude_.reset();
+  else if (!attitude_)
+    attitude_.emplace(recording::rateStreamAttitudeParameters(*p));
 }
 
 bool SamplePipeline::startRateFrom(const processing::LearnedResidual& learned, double elapsed_s) {

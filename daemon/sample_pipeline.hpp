@@ -25,6 +25,8 @@
 //    from the recording, so that the two agree bit for bit;
 //  - without one: raw − the bias above (the start-up estimate, the config's or the model's
 //    constant), from the end of the still period; no temperature term, no still detection.
+// With a sensor model, the orientation (processing/attitude) from the rate stream and the
+// accel, sample by sample, as `gyroctl attitude --model` computes it from a recording.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -36,6 +38,7 @@
 
 #include "processing/allan/noise_fit.hpp"
 #include "processing/allan/rolling_allan.hpp"
+#include "processing/attitude/attitude_estimator.hpp"
 #include "processing/motion/rate_estimator.hpp"
 #include "processing/motion/still_period_check.hpp"
 #include "processing/paper/filter_chain.hpp"
@@ -108,7 +111,9 @@ struct ProcessedSample {
   Vec3 rate_bias{};           // b̂ subtracted from raw for rate
   bool has_rate = false;      // false while a constant bias is still being estimated
   std::optional<bool> still;  // the still detector's verdict (sensor model only)
-  bool held = false;          // off-loop still window: released later by finishStillWindow
+  // The orientation from `rate` and the accel (sensor model and accel only; docs/attitude.md).
+  std::optional<processing::attitude::AttitudeSample> attitude;
+  bool held = false;  // off-loop still window: released later by finishStillWindow
 };
 
 // A full still window and what its evaluation needs, handed off the loop.
@@ -252,8 +257,9 @@ class SamplePipeline {
   std::array<std::vector<double>, kAxes> still_;  // reserved once
   StillPeriodReport still_period_;
   std::array<processing::FilterChainParameters, kAxes> params_{};
-  std::vector<processing::AxisFilterChain> chains_;  // kAxes, built at start and on reload
-  std::optional<processing::RateEstimator> rate_;    // with a sensor model
+  std::vector<processing::AxisFilterChain> chains_;                  // kAxes, built at start and on reload
+  std::optional<processing::RateEstimator> rate_;                    // with a sensor model
+  std::optional<processing::attitude::AttitudeEstimator> attitude_;  // on rate_'s stream
   std::array<processing::RollingOverlappingAllan, kAxes> allan_raw_, allan_mean_, allan_kalman_;
   std::array<std::optional<processing::NoiseTermFit>, kAxes> noise_terms_;
   std::array<std::array<std::vector<int>, kStreams>, kAxes> noise_alpha_;  // of the last refit, per τ

@@ -1,5 +1,6 @@
 #include "formats/calibration.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace gyrod::recording {
@@ -77,6 +78,25 @@ AxisCalibrationFit calibrateAxis(std::span<const double> secs, std::span<const d
     out.corrected[i] -= model;
   }
   return out;
+}
+
+}  // namespace gyrod::recording
+
+namespace gyrod::recording {
+
+processing::attitude::AttitudeParameters rateStreamAttitudeParameters(const processing::RateEstimatorParameters& rate) {
+  processing::attitude::AttitudeParameters params;
+  params.rate_hz = rate.rate_hz;
+  // The largest axis's angle random walk (°/√h → °/s/√Hz: /60) and bias 1σ.
+  double arw = 0.0, bias_std = 0.0;
+  for (const auto& axis : rate.axes) {
+    arw = std::max(arw, axis.terms.arw_deg_per_sqrt_h / 60.0);
+    bias_std = std::max(bias_std, axis.bias_std_dps);
+  }
+  params.estimate_bias = false;
+  params.gyro_angle_random_walk_dps_per_sqrt_hz = arw;
+  params.initial_bias_std_dps = bias_std;
+  return params;
 }
 
 }  // namespace gyrod::recording

@@ -8,6 +8,7 @@
 
 #include "formats/model_toml.hpp"
 #include "formats/recording_csv.hpp"
+#include "processing/attitude/attitude_estimator.hpp"
 #include "processing/motion/rate_estimator.hpp"
 #include "processing/motion/temperature_bias_fit.hpp"
 
@@ -17,6 +18,11 @@ namespace gyrod::recording {
 // none: no temperature term, bias_std 0), and [filter] (or its defaults); rate_hz the model's.
 // Throws std::invalid_argument as validateRateEstimatorParameters does.
 processing::RateEstimatorParameters rateEstimatorParameters(const SensorModel& model);
+
+// The attitude estimator on the rate stream of `rate`'s model (gyrod's RATE orientation and
+// `gyroctl attitude --model`, which must agree bit for bit): no bias of its own (the stream's
+// is used), and for the 1σ the largest axis's angle random walk and bias 1σ.
+processing::attitude::AttitudeParameters rateStreamAttitudeParameters(const processing::RateEstimatorParameters& rate);
 
 // Seconds from the first sample for each sample: from t when present, else i/rate.
 std::vector<double> secondsFromStart(const Recording& rec, double rate_hz);

@@ -47,7 +47,8 @@ std::vector<double>* streamColumn(Recording& rec, std::size_t index) {
   if (index == 0) return &rec.time;
   if (index <= 3) return &rec.rate[index - 1];
   if (index <= 6) return &rec.bias[index - 4];
-  return &rec.still;
+  if (index == 7) return &rec.still;
+  return &rec.attitude[index - 8];
 }
 
 [[noreturn]] void fail(const std::string& path, std::size_t line, const std::string& cause) {

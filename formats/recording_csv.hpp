@@ -49,6 +49,9 @@ struct Recording {
   // (1 still, 0 moving), NaN where the field is empty; each empty when its column is absent.
   std::array<std::vector<double>, 3> rate, bias;
   std::vector<double> still;
+  // gyrod's recordings: the orientation RATE published, in kAttitudeColumns' order (qw, qx, qy,
+  // qz, roll, pitch, heading, their 1σ), NaN where empty; each empty when its column is absent.
+  std::array<std::vector<double>, 9> attitude;
   std::vector<std::size_t> line_numbers;  // file line of each sample (empty without ReadOptions::line_numbers)
   // The same lines, compactly: a run starts wherever a sample's line does not follow the
   // previous sample's (after the header, a comment, an empty line).

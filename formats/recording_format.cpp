@@ -123,6 +123,8 @@ std::string columnsLine(const SampleColumns& columns) {
     for (const auto name : kBiasColumns) add(name);
     add(kStillColumn);
   }
+  if (columns.attitude)
+    for (const auto name : kAttitudeColumns) add(name);
   return line + "\n";
 }
 
@@ -153,6 +155,8 @@ std::string_view formatSampleLine(RecordingLine& line, const SampleColumns& colu
     w.character(',');
     if (v.still >= 0) w.character(v.still ? '1' : '0');
   }
+  if (columns.attitude)
+    for (double x : v.attitude) optional(x);
   return w.finish();
 }
 

@@ -2,7 +2,8 @@
 // The lines of a recording file as gyrod writes them and readRecordingCsv reads them back
 // (docs/recording-format.md is the reference):
 //
-//   t,gx,gy,gz,temp,time,ax,ay,az,gx_rate,gy_rate,gz_rate,gx_bias,gy_bias,gz_bias,still
+//   t,gx,gy,gz,temp,time,ax,ay,az,gx_rate,gy_rate,gz_rate,gx_bias,gy_bias,gz_bias,still,
+//   qw,qx,qy,qz,roll,pitch,heading,inclination_std,heading_std
 //                                                            the columns, always the FIRST line
 //   # gyrod recording, opened 2025-01-01T12:00:00Z          then comments
 //   # continues gyro-20250101T115000Z-000003.csv            (a file after a rotation)
@@ -16,7 +17,8 @@
 // t,gx,gy,gz,temp (s, °/s, °/s, °/s, °C) come first and are in every file; the others are
 // there when the writer has them (SampleColumns): the wall clock `time` (UTC epoch s, 6
 // decimals), the accelerometer ax,ay,az [g], and the rate stream's rate and bias per axis
-// [°/s] and still (1/0). Values are in their shortest round-trip form, except `time`; a value
+// [°/s] and still (1/0), and the orientation RATE published (quaternion, Z-Y-X angles [°] and
+// their 1σ [°], docs/attitude.md). Values are in their shortest round-trip form, except `time`; a value
 // the sample does not have (a rate during the start-up estimation) is an empty field.
 // The column line comes first because numpy's genfromtxt(names=True) takes the first line
 // for the names, even a comment; pandas' read_csv(comment='#') and genfromtxt(comments='#')
@@ -41,14 +43,18 @@ inline constexpr std::string_view kTimeColumn = "time";  // wall clock, UTC epoc
 inline constexpr std::array<std::string_view, 3> kRateColumns = {"gx_rate", "gy_rate", "gz_rate"};  // °/s
 inline constexpr std::array<std::string_view, 3> kBiasColumns = {"gx_bias", "gy_bias", "gz_bias"};  // °/s
 inline constexpr std::string_view kStillColumn = "still";  // 1 still, 0 moving, empty: no detector
+// The orientation, as `gyroctl attitude` names its output columns.
+inline constexpr std::array<std::string_view, 9> kAttitudeColumns = {
+    "qw", "qx", "qy", "qz", "roll", "pitch", "heading", "inclination_std", "heading_std"};
 // Decimals of the `time` column: µs, as RATE's "time" (docs/protocol.md).
 inline constexpr int kTimeDecimals = 6;
 
 // Which optional columns a file has (after t,gx,gy,gz,temp, in the order of the fields).
 struct SampleColumns {
-  bool time = false;   // time
-  bool accel = false;  // ax,ay,az (kAccelColumns)
-  bool rate = false;   // gx_rate..gz_rate, gx_bias..gz_bias, still
+  bool time = false;      // time
+  bool accel = false;     // ax,ay,az (kAccelColumns)
+  bool rate = false;      // gx_rate..gz_rate, gx_bias..gz_bias, still
+  bool attitude = false;  // kAttitudeColumns
   bool operator==(const SampleColumns&) const = default;
 };
 // The column line, '\n' included.
@@ -64,6 +70,9 @@ struct SampleValues {
   std::array<double, 3> rate_dps{kNoValue, kNoValue, kNoValue};
   std::array<double, 3> bias_dps{kNoValue, kNoValue, kNoValue};
   std::int8_t still = -1;  // 1 still, 0 moving, -1 no verdict (empty field)
+  // In kAttitudeColumns' order: qw, qx, qy, qz, roll, pitch, heading, their 1σ.
+  std::array<double, 9> attitude{kNoValue, kNoValue, kNoValue, kNoValue, kNoValue,
+                                 kNoValue, kNoValue, kNoValue, kNoValue};
   static constexpr double kNoValue = std::numeric_limits<double>::quiet_NaN();
 };
 
@@ -77,12 +86,12 @@ std::tm utcCalendarTime(std::int64_t unix_seconds);
 std::string recordingHeaderComments(std::int64_t opened_unix_seconds, std::string_view previous_file,
                                     const std::vector<std::string>& comments);
 
-// One formatted line, '\n' included. 512 bytes hold the longest: "# NONFINITE " (12), 14
-// doubles of at most 24 characters (336), `time` (at most 24: 17 digits, the point, 6
-// decimals), `still` (1), 15 commas and the newline: 389; or a GAP line with its
+// One formatted line, '\n' included. 768 bytes hold the longest: "# NONFINITE " (12), 23
+// doubles of at most 24 characters (552), `time` (at most 24: 17 digits, the point, 6
+// decimals), `still` (1), 24 commas and the newline: 614; or a GAP line with its
 // 23-character reason (about 110).
 struct RecordingLine {
-  std::array<char, 512> bytes{};
+  std::array<char, 768> bytes{};
   std::size_t size = 0;
   std::string_view view() const { return {bytes.data(), size}; }
 };

@@ -17,8 +17,9 @@ namespace gyrod::recording::slice_detail {
 constexpr std::array<std::string_view, 11> kKnownColumns = {"t",  "gx", "gy", "gz", "temp", "wx",
                                                             "wy", "wz", "ax", "ay", "az"};
 // gyrod's columns a sample may leave empty (recording_format.hpp): read as NaN then.
-constexpr std::array<std::string_view, 8> kStreamColumns = {"time",    "gx_rate", "gy_rate", "gz_rate",
-                                                            "gx_bias", "gy_bias", "gz_bias", "still"};
+constexpr std::array<std::string_view, 17> kStreamColumns = {
+    "time", "gx_rate", "gy_rate", "gz_rate", "gx_bias", "gy_bias", "gz_bias",         "still",      "qw",
+    "qx",   "qy",      "qz",      "roll",    "pitch",   "heading", "inclination_std", "heading_std"};
 
 inline bool isSkippable(std::string_view line) { return line.empty() || line.front() == '#'; }
 

@@ -86,6 +86,17 @@ RateSample rateOf(const json& j) {
   r.still = optionalFlag(j, "RATE", "still");
   r.time_s = realOr(j, "RATE", "time", kNaN);
   r.accel_g = triple(j, "accel");  // "accel_ms2" is the same values × standard gravity
+  if (const json* q = field(j, "RATE", "quat", &json::is_array, "[w, x, y, z]")) {
+    if (q->size() != 4) malformed("RATE", "\"quat\" must have 4 elements");
+    for (std::size_t i = 0; i < 4; ++i) {
+      if (!(*q)[i].is_number()) malformed("RATE", "\"quat\" must hold numbers");
+      r.quat[i] = (*q)[i].get<double>();
+    }
+  }
+  r.roll_pitch_heading_deg = {realOr(j, "RATE", "roll", kNaN), realOr(j, "RATE", "pitch", kNaN),
+                              realOr(j, "RATE", "heading", kNaN)};
+  r.inclination_std_deg = realOr(j, "RATE", "inclination_std", kNaN);
+  r.heading_std_deg = realOr(j, "RATE", "heading_std", kNaN);
   return r;
 }
 

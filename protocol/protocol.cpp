@@ -64,6 +64,12 @@ class FixedWriter {
     number(v[2]);
     text("]");
   }
+  // key then v, when v is finite.
+  void real(std::string_view key, double v) noexcept {
+    if (!std::isfinite(v)) return;
+    text(key);
+    number(v);
+  }
   std::size_t size() const noexcept { return static_cast<std::size_t>(p_ - begin_); }
 
  private:
@@ -117,6 +123,21 @@ std::size_t formatRateLine(const RateSample& s, std::span<char, kMaxRateLineByte
   const auto& a = s.accel_g;
   w.triple(R"(,"accel_ms2":[)",
            {a[0] * units::kStandardGravity, a[1] * units::kStandardGravity, a[2] * units::kStandardGravity});
+  const auto& q = s.quat;
+  if (std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2]) && std::isfinite(q[3])) {
+    w.text(R"(,"quat":[)");
+    w.number(q[0]);
+    w.text(",");
+    w.triple("", {q[1], q[2], q[3]});
+  }
+  const auto& e = s.roll_pitch_heading_deg;
+  if (std::isfinite(e[0]) && std::isfinite(e[1]) && std::isfinite(e[2])) {
+    w.real(R"(,"roll":)", e[0]);
+    w.real(R"(,"pitch":)", e[1]);
+    w.real(R"(,"heading":)", e[2]);
+  }
+  w.real(R"(,"inclination_std":)", s.inclination_std_deg);
+  w.real(R"(,"heading_std":)", s.heading_std_deg);
   w.text("}");
   const std::size_t n = w.size();
   out[n] = '\n';

@@ -23,7 +23,7 @@
 namespace gyrod::protocol {
 
 inline constexpr int kProtocolMajor = 1;  // incompatible changes
-inline constexpr int kProtocolMinor = 8;  // compatible additions (new classes, new fields)
+inline constexpr int kProtocolMinor = 9;  // compatible additions (new classes, new fields)
 
 // A client line longer than this (not counting the '\n' and an optional '\r') is refused
 // with an ERROR and the client is disconnected.
@@ -52,6 +52,12 @@ struct RateSample {
   // Appended by issue 12 (protocol 1.3).
   double time_s = kUnset;                                 // wall clock, UTC epoch seconds
   std::array<double, 3> accel_g{kUnset, kUnset, kUnset};  // [g]
+  // Appended by issue 32 (protocol 1.9): the orientation from `rate` and `accel`
+  // (processing/attitude, docs/attitude.md). Unset unless the server fills them.
+  std::array<double, 4> quat{kUnset, kUnset, kUnset, kUnset};            // q_ws: w, x, y, z (Hamilton)
+  std::array<double, 3> roll_pitch_heading_deg{kUnset, kUnset, kUnset};  // Z-Y-X Euler angles [°]
+  double inclination_std_deg = kUnset;                                   // 1σ of roll and pitch [°]
+  double heading_std_deg = kUnset;                                       // 1σ of the heading change [°]
 };
 
 // Samples that will never come: seq, seq+1, ..., seq+count−1.
@@ -75,10 +81,10 @@ inline constexpr std::string_view kMqttAllanTopic = "allan";      // retained: t
 inline constexpr std::string_view kMqttModelTopic = "model";      // retained: the calibration in use
 inline constexpr std::string_view kMqttEffectTopic = "effect";    // each EFFECT line, QoS 1, not retained
 
-// Longest possible RATE line: 23 doubles of ≤ 24 characters in shortest round-trip form
-// (552), "time" (≤ 24: fixed with 6 decimals below 1e15, else shortest), a 20-digit seq,
-// the keys and punctuation (about 220) and the newline, rounded up.
-inline constexpr std::size_t kMaxRateLineBytes = 1024;
+// Longest possible RATE line: 32 doubles of ≤ 24 characters in shortest round-trip form
+// (768), "time" (≤ 24: fixed with 6 decimals below 1e15, else shortest), a 20-digit seq,
+// the keys and punctuation (about 320) and the newline, rounded up.
+inline constexpr std::size_t kMaxRateLineBytes = 1280;
 // "time" is written with this many decimals: µs resolution (docs/protocol.md).
 inline constexpr int kRateTimeDecimals = 6;
 inline constexpr std::size_t kMaxGapLineBytes = 160;

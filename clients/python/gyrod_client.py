@@ -36,7 +36,10 @@ class ProtocolError(Exception):
 class Rate:
     """One RATE line: angular rates in deg/s per axis [x, y, z]; `t` is the sample's data-ready
     edge on CLOCK_MONOTONIC (s, for intervals), `time` the same instant in UTC epoch seconds
-    (us resolution, for lining up with other machines); `accel` in g, `accel_ms2` in m/s^2."""
+    (us resolution, for lining up with other machines); `accel` in g, `accel_ms2` in m/s^2;
+    `quat` the orientation [w, x, y, z] (sensor -> world, z up), `roll`, `pitch`, `heading` its
+    Z-Y-X angles in degrees and `inclination_std`, `heading_std` their 1 sigma (with a sensor
+    model and the accelerometer; docs/attitude.md)."""
 
     seq: int
     t: float
@@ -50,6 +53,12 @@ class Rate:
     time: Optional[float] = None
     accel: Vector = None
     accel_ms2: Vector = None
+    quat: Vector = None
+    roll: Optional[float] = None
+    pitch: Optional[float] = None
+    heading: Optional[float] = None
+    inclination_std: Optional[float] = None
+    heading_std: Optional[float] = None
     # Every field of the line, including those added by later protocol minor versions.
     fields: dict = field(default_factory=dict, repr=False)
 
@@ -64,7 +73,7 @@ class Gap:
     fields: dict = field(default_factory=dict, repr=False)
 
 
-_REAL_FIELDS = ("t", "temp", "time")
+_REAL_FIELDS = ("t", "temp", "time", "roll", "pitch", "heading", "inclination_std", "heading_std")
 _VECTOR_FIELDS = ("raw", "mean", "kalman", "rate", "bias", "accel", "accel_ms2")
 
 
@@ -87,6 +96,10 @@ def _known(cls, obj: dict) -> dict:
                 if not isinstance(known[k], list) or len(known[k]) != 3:
                     raise ProtocolError("RATE %s is not [x, y, z]: %.80r" % (k, known[k]))
                 known[k] = [_as_real(x) for x in known[k]]
+        if "quat" in known:
+            if not isinstance(known["quat"], list) or len(known["quat"]) != 4:
+                raise ProtocolError("RATE quat is not [w, x, y, z]: %.80r" % (known["quat"],))
+            known["quat"] = [_as_real(x) for x in known["quat"]]
     return known
 
 

@@ -234,7 +234,7 @@ TEST_F(GyroctlTest, StatusHumanAndJson) {
 
   const CommandResult h = run({"status", "--socket", socketPath()});
   ASSERT_EQ(h.exit_status, 0) << h.err;
-  EXPECT_NE(h.out.find(std::string("gyrod ") + GYROD_RELEASE + " (protocol 1.8)"), std::string::npos) << h.out;
+  EXPECT_NE(h.out.find(std::string("gyrod ") + GYROD_RELEASE + " (protocol 1.9)"), std::string::npos) << h.out;
   EXPECT_NE(h.out.find("device_state:    streaming\n"), std::string::npos) << h.out;
   EXPECT_NE(h.out.find("device:          /dev/i2c-1@0x68\n"), std::string::npos) << h.out;
   EXPECT_NE(h.out.find("samples:         1234\n"), std::string::npos) << h.out;

@@ -37,7 +37,7 @@ TEST_F(ServerTest, VersionOnConnect) {
   TestClient c(socketPath());
   const json v = c.readObject(loop_);
   EXPECT_EQ(v, json::parse(std::string(R"({"class":"VERSION","release":")") + GYROD_RELEASE +
-                           R"(","proto_major":1,"proto_minor":8})"));
+                           R"(","proto_major":1,"proto_minor":9})"));
   EXPECT_EQ(server_->clientCount(), 1u);
 }
 

@@ -179,31 +179,34 @@ SampleValues fullSample(double t) {
   v.rate_dps = {0.1 + 0.2, -0.0, 30};
   v.bias_dps = {-3.34, 1.09, -0.5};
   v.still = 1;
+  v.attitude = {0.5, -0.5, 0.5, -0.5, 0.1 + 0.2, -0.0, 179.5, 0.25, 12};
   return v;
 }
 
-constexpr SampleColumns kAllColumns{true, true, true};
+constexpr SampleColumns kAllColumns{true, true, true, true};
 
 }  // namespace
 
 TEST(RecordingFormat, GyrodsColumnsAreWrittenByteForByte) {
   EXPECT_EQ(columnsLine({}), kColumnsLine);
   EXPECT_EQ(columnsLine(kAllColumns),
-            "t,gx,gy,gz,temp,time,ax,ay,az,gx_rate,gy_rate,gz_rate,gx_bias,gy_bias,gz_bias,still\n");
+            "t,gx,gy,gz,temp,time,ax,ay,az,gx_rate,gy_rate,gz_rate,gx_bias,gy_bias,gz_bias,still,"
+            "qw,qx,qy,qz,roll,pitch,heading,inclination_std,heading_std\n");
   EXPECT_EQ(columnsLine({true, false, true}),
             "t,gx,gy,gz,temp,time,gx_rate,gy_rate,gz_rate,gx_bias,gy_bias,gz_bias,still\n");
   RecordingLine line;
   EXPECT_EQ(formatSampleLine(line, kAllColumns, fullSample(0.02)),
             "0.02,0.125,-0.3333333333333333,2,25.5,1795000000.123457,0.01,-0.02,0.3333333333333333,"
-            "0.30000000000000004,-0,30,-3.34,1.09,-0.5,1\n");
+            "0.30000000000000004,-0,30,-3.34,1.09,-0.5,1,0.5,-0.5,0.5,-0.5,0.30000000000000004,-0,179.5,0.25,12\n");
   // What a sample does not have is an empty field (the start-up estimation, no detector, no accel).
   SampleValues partial = fullSample(0.04);
   partial.wall_ns = 0;
   partial.accel_g[1] = std::nan("");
   partial.rate_dps = partial.bias_dps = {std::nan(""), std::nan(""), std::nan("")};
   partial.still = -1;
+  partial.attitude.fill(std::nan(""));
   EXPECT_EQ(formatSampleLine(line, kAllColumns, partial),
-            "0.04,0.125,-0.3333333333333333,2,25.5,,0.01,,0.3333333333333333,,,,,,,\n");
+            "0.04,0.125,-0.3333333333333333,2,25.5,,0.01,,0.3333333333333333,,,,,,,,,,,,,,,,\n");
   partial.still = 0;
   EXPECT_EQ(formatSampleLine(line, {false, false, true}, partial), "0.04,0.125,-0.3333333333333333,2,25.5,,,,,,,0\n");
   // The five columns decide a NONFINITE comment, as before.
@@ -221,6 +224,7 @@ TEST(RecordingFormat, TheLongestGyrodLineFits) {
   v.wall_ns = std::numeric_limits<std::int64_t>::max();
   v.accel_g = v.rate_dps = v.bias_dps = {big, big, big};
   v.still = 1;
+  v.attitude.fill(big);
   const auto sample = formatSampleLine(line, kAllColumns, v);
   EXPECT_EQ(sample.rfind("# NONFINITE ", 0), 0u);
   EXPECT_EQ(sample.back(), '\n');
@@ -229,7 +233,7 @@ TEST(RecordingFormat, TheLongestGyrodLineFits) {
 
 TEST(RecordingFormat, GyrodsColumnsReadBackWithEmptyFieldsAsNaN) {
   // Without ax,ay,az: reading them is the accelerometer import's part (kAccelColumns).
-  constexpr SampleColumns columns{true, false, true};
+  constexpr SampleColumns columns{true, false, true, true};
   RecordingLine line;
   std::string text = columnsLine(columns);
   text += recordingHeaderComments(1735732800, "", {"device mock"});
@@ -252,6 +256,12 @@ TEST(RecordingFormat, GyrodsColumnsReadBackWithEmptyFieldsAsNaN) {
   EXPECT_EQ(rec.bias[2], (std::vector<double>{-0.5, -0.5}));
   EXPECT_EQ(rec.still[0], 1.0);
   EXPECT_TRUE(std::isnan(rec.still[1]));
+  const SampleValues full = fullSample(0.02);
+  for (std::size_t k = 0; k < full.attitude.size(); ++k) {
+    ASSERT_EQ(rec.attitude[k].size(), 2u);
+    EXPECT_EQ(rec.attitude[k][0], full.attitude[k]) << kAttitudeColumns[k];
+  }
+  EXPECT_TRUE(std::signbit(rec.attitude[5][0]));
   ASSERT_EQ(rec.lost.size(), 1u);
   EXPECT_EQ(rec.lost[0].before_sample, 1u);
   // Only gyrod's optional columns may be empty; "nan" is refused there as anywhere.
@@ -264,7 +274,8 @@ TEST(RecordingFormat, GyrodsColumnsReadBackWithEmptyFieldsAsNaN) {
   // An old recording (five columns) has none of them.
   const TempFile old("t,gx,gy,gz,temp\n0,1,2,3,25\n");
   const Recording five = readRecordingCsv(old.path());
-  EXPECT_TRUE(five.time.empty() && five.rate[0].empty() && five.bias[2].empty() && five.still.empty());
+  EXPECT_TRUE(five.time.empty() && five.rate[0].empty() && five.bias[2].empty() && five.still.empty() &&
+              five.attitude[0].empty());
 }
 
 // docs/recording-format.md's column table names the columns columnsLine writes, in order.

@@ -10,7 +10,9 @@
 #include <array>
 #include <cmath>
 #include <csignal>
+#include <cstdio>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -139,6 +141,55 @@ std::vector<OfflineRate> offlineRate(const std::string& rec_path, const std::fil
   return out;
 }
 
+// `gyroctl attitude --model`'s last nine columns per row: qw, qx, qy, qz, roll, pitch, heading,
+// inclination_std, heading_std.
+using AttitudeRow = std::array<double, 9>;
+std::vector<AttitudeRow> offlineAttitude(const std::string& rec_path, const std::filesystem::path& model,
+                                         const ScratchDir& d) {
+  const auto out_path = d.path() / "attitude.csv";
+  const auto r = runGyroctl(
+      "attitude " + rec_path + " -o " + out_path.string() + " --model " + model.string() + " --rate 50", d.path());
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  std::ifstream f(out_path);
+  std::string line;
+  std::getline(f, line);
+  EXPECT_NE(line.find(",qw,qx,qy,qz,roll,pitch,heading,inclination_std,heading_std"), std::string::npos) << line;
+  std::vector<AttitudeRow> out;
+  while (std::getline(f, line)) {
+    std::stringstream ls(line);
+    std::string field;
+    std::vector<double> v;
+    while (std::getline(ls, field, ',')) v.push_back(std::stod(field));
+    AttitudeRow row{};
+    std::copy(v.end() - 9, v.end(), row.begin());
+    out.push_back(row);
+  }
+  return out;
+}
+
+// RATE's orientation fields in the order of AttitudeRow.
+AttitudeRow attitudeOf(const json& r) {
+  return {r["quat"][0].get<double>(),    r["quat"][1].get<double>(),
+          r["quat"][2].get<double>(),    r["quat"][3].get<double>(),
+          r["roll"].get<double>(),       r["pitch"].get<double>(),
+          r["heading"].get<double>(),    r["inclination_std"].get<double>(),
+          r["heading_std"].get<double>()};
+}
+
+// With the accel, every RATE line carries the orientation and it is `gyroctl attitude --model`'s
+// on the recording, bit for bit, row by row; without it no line does.
+void expectTheAttitudeIsTheOfflineOne(const std::vector<json>& rates, const std::vector<AttitudeRow>& offline,
+                                      const std::function<std::size_t(std::uint64_t)>& rowOf, bool accel) {
+  for (const json& r : rates) {
+    ASSERT_EQ(r.contains("quat"), accel) << r.dump();
+    if (!accel) continue;
+    const std::size_t i = rowOf(r["seq"].get<std::uint64_t>());
+    ASSERT_LT(i, offline.size());
+    const AttitudeRow live = attitudeOf(r);
+    for (std::size_t k = 0; k < live.size(); ++k) ASSERT_EQ(live[k], offline[i][k]) << "row " << i << " field " << k;
+  }
+}
+
 void expectRateFollowsTheMotionAndIsTheOfflineRateStream(bool accel) {
   ScratchDir d;
   const auto model = d.write("sensor.toml", sensorModel());
@@ -180,6 +231,32 @@ void expectRateFollowsTheMotionAndIsTheOfflineRateStream(bool accel) {
     }
     ASSERT_TRUE(r.contains("rate") && r.contains("bias") && r.contains("still")) << r.dump();
     ASSERT_EQ(r["still"].get<bool>(), offline[seq].still) << "seq " << seq;
+  }
+  if (accel) {
+    const auto attitude = offlineAttitude(rec_path, model, d);
+    ASSERT_EQ(attitude.size(), offline.size());
+    expectTheAttitudeIsTheOfflineOne(
+        rates, attitude, [](std::uint64_t seq) { return seq; }, accel);
+    // The board turns about z, which points up: the heading follows the rate stream's integral
+    // about z (the 0.5°), and roll and pitch stay put.
+    double heading_change = 0.0, rate_integral = 0.0, largest_tilt = 0.0;
+    for (std::size_t i = 1; i < attitude.size(); ++i) {
+      if (offline[i].t <= motionStartS(accel) + 1.0) continue;
+      double step = attitude[i][6] - attitude[i - 1][6];
+      step -= 360.0 * std::round(step / 360.0);  // unwrapped across ±180°
+      heading_change += step;
+      rate_integral += offline[i].rate[2] / 50.0;
+      largest_tilt = std::max({largest_tilt, std::fabs(attitude[i][4]), std::fabs(attitude[i][5])});
+    }
+    std::printf(
+        "turn about z: heading change %.4f deg, the rate stream's integral %.4f deg; roll and pitch within %.3f deg\n",
+        heading_change, rate_integral, largest_tilt);
+    EXPECT_GT(heading_change, 100.0);
+    EXPECT_NEAR(heading_change, rate_integral, 0.5);
+    EXPECT_LT(largest_tilt, 1.0);
+  } else {
+    expectTheAttitudeIsTheOfflineOne(
+        rates, {}, [](std::uint64_t seq) { return seq; }, accel);
   }
 
   // The figures over every sample of the recording (the stream equals it bit for bit, above):
@@ -317,8 +394,8 @@ void expectTheOfflineRateStreamMatchesAcrossGaps(bool accel) {
     const auto line = watcher.readLine(20s);
     ASSERT_TRUE(line.has_value()) << readWholeFile(d.path() / "log.txt");
     json j = json::parse(*line);
-    if (j["class"] == "RATE") rates.push_back(std::move(j));
     if (j["class"] == "GAP") gaps.emplace_back(j["seq"].get<std::uint64_t>(), j["count"].get<std::uint64_t>());
+    if (j["class"] == "RATE") rates.push_back(std::move(j));
   }
   gyrod.signal(SIGTERM);
   ASSERT_EQ(gyrod.waitExit(2000ms), std::optional<int>(0)) << readWholeFile(d.path() / "log.txt");
@@ -362,6 +439,16 @@ void expectTheOfflineRateStreamMatchesAcrossGaps(bool accel) {
   ASSERT_EQ(static_cast<std::size_t>(gap_lines), gaps.size());
   // The recording carries the accel exactly when the device gave it (what the offline still detector used).
   for (const auto& column : recorded.accel_g) EXPECT_EQ(column.size(), accel ? recorded.size() : 0u);
+  // And the orientation as RATE published it; `gyroctl attitude --model` recomputes it across the gaps.
+  for (const auto& column : recorded.attitude) ASSERT_EQ(column.size(), accel ? recorded.size() : 0u);
+  if (accel) {
+    for (const json& r : rates) {
+      const std::size_t i = rowOf(r["seq"].get<std::uint64_t>());
+      const AttitudeRow live = attitudeOf(r);
+      for (std::size_t k = 0; k < live.size(); ++k) ASSERT_EQ(recorded.attitude[k][i], live[k]) << "row " << i;
+    }
+    expectTheAttitudeIsTheOfflineOne(rates, offlineAttitude(rec_path, model, d), rowOf, accel);
+  }
 }
 
 }  // namespace

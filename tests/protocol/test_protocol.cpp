@@ -163,7 +163,7 @@ TEST(ProtocolGap, FormatsAndRejectsMalformedGaps) {
 TEST(ProtocolReplies, VersionAndWatch) {
   const std::string v = versionLine("1.2.3");
   ASSERT_EQ(v.back(), '\n');
-  EXPECT_EQ(json::parse(v), json::parse(R"({"class":"VERSION","release":"1.2.3","proto_major":1,"proto_minor":8})"));
+  EXPECT_EQ(json::parse(v), json::parse(R"({"class":"VERSION","release":"1.2.3","proto_major":1,"proto_minor":9})"));
   EXPECT_EQ(json::parse(watchLine(false, 5)), json::parse(R"({"class":"WATCH","enable":false,"decimate":5})"));
 }
 
@@ -380,4 +380,47 @@ TEST(ProtocolRate, UnsetRateBiasAndStillAreOmitted) {
   EXPECT_FALSE(j.contains("rate"));
   EXPECT_FALSE(j.contains("bias"));
   EXPECT_FALSE(j.contains("still"));
+}
+
+TEST(ProtocolRate, TheAttitudeComesLastRoundTripsAndTheLongestLineFits) {
+  RateSample s;
+  s.seq = std::numeric_limits<std::uint64_t>::max();
+  const double longest = -2.2250738585072014e-308;  // 24 characters in shortest form
+  s.t_s = s.temp_c = longest;
+  s.raw_dps = s.mean_dps = s.kalman_dps = s.rate_dps = s.bias_dps = s.accel_g = {longest, longest, longest};
+  s.still = false;
+  s.time_s = 1e300;  // past 1e15: the shortest form
+  s.quat = {longest, longest, longest, longest};
+  s.roll_pitch_heading_deg = {longest, longest, longest};
+  s.inclination_std_deg = s.heading_std_deg = longest;
+  std::array<char, kMaxRateLineBytes> buf;
+  const std::size_t n = formatRateLine(s, buf);
+  EXPECT_LT(n, kMaxRateLineBytes);
+  const std::string line(buf.data(), n);
+  EXPECT_EQ(line.back(), '\n');
+  EXPECT_LT(line.find("\"accel_ms2\""), line.find("\"quat\"")) << line;
+  EXPECT_LT(line.find("\"quat\""), line.find("\"roll\"")) << line;
+  EXPECT_LT(line.find("\"heading\""), line.find("\"inclination_std\"")) << line;
+  const json j = parseLine(buf.data(), n);
+  for (std::size_t i = 0; i < 4; ++i) EXPECT_TRUE(sameDouble(j["quat"][i].get<double>(), longest));
+  EXPECT_TRUE(sameDouble(j["heading_std"].get<double>(), longest));
+
+  // Ordinary values come back from parseServerLine bit for bit; an unset quaternion is omitted
+  // with its angles' fields left as they are.
+  s.quat = {0.9238795325112867, 0.0, -0.3826834323650898, 1e-17};
+  s.roll_pitch_heading_deg = {-0.0, -45.00000000000001, 179.99999999999997};
+  s.inclination_std_deg = 0.123;
+  s.heading_std_deg = 4.56;
+  const std::string ordinary(buf.data(), formatRateLine(s, buf) - 1);
+  const auto back = std::get<RateSample>(parseServerLine(ordinary));
+  for (std::size_t i = 0; i < 4; ++i) EXPECT_EQ(back.quat[i], s.quat[i]) << ordinary;
+  for (std::size_t i = 0; i < 3; ++i)
+    EXPECT_EQ(std::signbit(back.roll_pitch_heading_deg[i]), std::signbit(s.roll_pitch_heading_deg[i]));
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(back.roll_pitch_heading_deg[i], s.roll_pitch_heading_deg[i]);
+  EXPECT_EQ(back.inclination_std_deg, 0.123);
+  EXPECT_EQ(back.heading_std_deg, 4.56);
+  s.quat[2] = std::numeric_limits<double>::quiet_NaN();
+  const json without = parseLine(buf.data(), formatRateLine(s, buf));
+  EXPECT_FALSE(without.contains("quat"));
+  EXPECT_TRUE(without.contains("roll"));
 }

@@ -159,6 +159,10 @@ TEST(ProtocolDoc, RateFieldsAreTheOnesSent) {
   s.still = true;
   s.time_s = 1.8e9;
   s.accel_g = {0.0, 0.0, 1.0};
+  s.quat = {1.0, 0.0, 0.0, 0.0};
+  s.roll_pitch_heading_deg = {1.0, 2.0, 3.0};
+  s.inclination_std_deg = 0.1;
+  s.heading_std_deg = 0.2;
   std::array<char, protocol::kMaxRateLineBytes> buf;
   const std::size_t n = protocol::formatRateLine(s, buf);
   std::set<std::string> sent;

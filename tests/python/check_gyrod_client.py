@@ -32,13 +32,20 @@ def check_parse_tolerates_unknown_fields():
     check(r.time == 1795000000.123456 and r.accel == [0.0, 0.0, 1.0] and r.accel_ms2 == [0.0, 0.0, 9.80665],
           "time, accel and accel_ms2: %r" % r)
     check(r.kalman is None and r.fields["future_field"] == {"a": 1}, "an unknown RATE field is kept in .fields")
+    oriented = gyrod_client.parse_line(
+        '{"class":"RATE","seq":8,"t":1.52,"quat":[1,0,0.0,-0.0],"roll":0,"pitch":-1.5,"heading":179.9,'
+        '"inclination_std":0.2,"heading_std":3}')
+    check(oriented.quat == [1.0, 0.0, 0.0, -0.0] and all(isinstance(x, float) for x in oriented.quat)
+          and oriented.roll == 0.0 and isinstance(oriented.roll, float) and oriented.heading == 179.9
+          and oriented.heading_std == 3.0, "the orientation: %r" % oriented)
     g = gyrod_client.parse_line('{"class":"GAP","seq":9,"count":2,"reason":"some_new_reason","extra":1}')
     check(isinstance(g, gyrod_client.Gap) and g.count == 2 and g.reason == "some_new_reason", "parse a GAP line")
     check(gyrod_client.parse_line('{"class":"NEWCLASS","x":1}') == {"class": "NEWCLASS", "x": 1},
           "an unknown class is returned as a dict")
     for bad in ('[1,2]', '{"seq":1}', '{"class":"RATE","t":1.0}', '{"class":"RATE","seq":1,"t":1,"raw":[1,2]}',
                 '{"class":"RATE","seq":1,"t":"now"}', '{"class":"RATE","seq":1,"t":1,"time":"today"}',
-                '{"class":"RATE","seq":1,"t":1,"accel":[0,1]}'):
+                '{"class":"RATE","seq":1,"t":1,"accel":[0,1]}', '{"class":"RATE","seq":1,"t":1,"quat":[1,0,0]}',
+                '{"class":"RATE","seq":1,"t":1,"heading":"north"}'):
         try:
             gyrod_client.parse_line(bad)
             check(False, "refuse %s" % bad)

@@ -100,16 +100,7 @@ int runAttitude(const AttitudeOptions& opt) {
       std::fprintf(stderr, "%s has no temp column: the rate stream takes the model's reference temperature, %g C\n",
                    opt.file.c_str(), fixed_temperature_c);
     }
-    // The 1σ from the model: the largest axis's angle random walk (°/√h → °/s/√Hz: /60) and
-    // bias 1σ; the bias itself is the rate estimator's.
-    double arw = 0.0, bias_std = 0.0;
-    for (const auto& axis : p.axes) {
-      arw = std::max(arw, axis.terms.arw_deg_per_sqrt_h / 60.0);
-      bias_std = std::max(bias_std, axis.bias_std_dps);
-    }
-    params.estimate_bias = false;
-    params.gyro_angle_random_walk_dps_per_sqrt_hz = arw;
-    params.initial_bias_std_dps = bias_std;
+    params = recording::rateStreamAttitudeParameters(p);
     rate_estimator.emplace(p);
   }
   AttitudeEstimator estimator(params);

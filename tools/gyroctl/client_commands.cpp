@@ -70,10 +70,19 @@ std::string timeLegend(const protocol::RateSample& r) {
 // Two layouts. Once a RATE line carries `rate` the stream to read comes first, then raw and
 // the paper's kalman, then the still detector, with a new header where the switch happens;
 // until then (an older gyrod, or gyrod still estimating its start-up bias) raw and kalman.
-void printRateHeader(bool with_rate, const protocol::RateSample& first) {
-  if (with_rate) {
-    std::printf("%10s %12s  %10s %10s %10s  %10s %10s %10s  %10s %10s %10s %6s  [deg/s]\n", "seq", "t [s]", "rate x",
+// Lines that carry the orientation add roll, pitch and heading [deg] at the end.
+struct WatchLayout {
+  bool rate = false;
+  bool attitude = false;
+  bool operator==(const WatchLayout&) const = default;
+};
+
+void printRateHeader(WatchLayout layout, const protocol::RateSample& first) {
+  if (layout.rate) {
+    std::printf("%10s %12s  %10s %10s %10s  %10s %10s %10s  %10s %10s %10s %6s  [deg/s]", "seq", "t [s]", "rate x",
                 "rate y", "rate z", "raw x", "raw y", "raw z", "kalman x", "kalman y", "kalman z", "still");
+    if (layout.attitude) std::printf("  %9s %9s %9s  [deg]", "roll", "pitch", "heading");
+    std::printf("\n");
   } else {
     std::printf("%10s %12s  %10s %10s %10s  %10s %10s %10s  [deg/s]\n", "seq", "t [s]", "raw x", "raw y", "raw z",
                 "kalman x", "kalman y", "kalman z");
@@ -91,7 +100,8 @@ void printAxisTriple(const std::array<double, 3>& v) {
   }
 }
 
-void printRate(const protocol::RateSample& r, bool with_rate) {
+void printRate(const protocol::RateSample& r, WatchLayout layout) {
+  const bool with_rate = layout.rate;
   std::printf("%10llu ", static_cast<unsigned long long>(r.seq));
   if (std::isfinite(r.t_s))
     std::printf("%12.3f ", r.t_s);
@@ -105,6 +115,15 @@ void printRate(const protocol::RateSample& r, bool with_rate) {
   std::printf(" ");
   printAxisTriple(r.kalman_dps);
   if (with_rate) std::printf(" %6s", r.still ? (*r.still ? "yes" : "no") : "-");
+  if (with_rate && layout.attitude) {
+    std::printf("         ");
+    for (const double x : r.roll_pitch_heading_deg) {
+      if (std::isfinite(x))
+        std::printf(" %9.3f", x);
+      else
+        std::printf(" %9s", "-");
+    }
+  }
   std::printf("\n");
 }
 
@@ -142,7 +161,7 @@ int runWatch(const WatchOptions& opt) {
   if (opt.common.json) std::printf("%s\n", conn.versionLine().c_str());
   conn.sendLine(protocol::requestLine(protocol::WatchRequest{true, opt.decimate}));
   std::uint64_t rates = 0;
-  std::optional<bool> with_rate;  // the layout; none before the first RATE line
+  std::optional<WatchLayout> layout;  // none before the first RATE line
   while (!opt.count || rates < *opt.count) {
     const std::string line = conn.readLine(std::nullopt);
     const protocol::ServerMessage message = parseServerLine(line);
@@ -153,11 +172,15 @@ int runWatch(const WatchOptions& opt) {
       std::printf("%s\n", line.c_str());
     } else if (rate) {
       const bool carries_rate = std::isfinite(rate->rate_dps[0]) || rate->still.has_value();
-      if (!with_rate || (carries_rate && !*with_rate)) {
-        with_rate = carries_rate;
-        printRateHeader(*with_rate, *rate);
+      const bool carries_attitude = carries_rate && std::isfinite(rate->roll_pitch_heading_deg[0]);
+      // A layout grows (rate, then the orientation) and does not shrink back.
+      const WatchLayout seen{carries_rate || (layout && layout->rate),
+                             carries_attitude || (layout && layout->attitude)};
+      if (!layout || !(seen == *layout)) {
+        layout = seen;
+        printRateHeader(*layout, *rate);
       }
-      printRate(*rate, *with_rate);
+      printRate(*rate, *layout);
     } else if (const auto* gap = std::get_if<protocol::GapNotice>(&message)) {
       printGap(*gap);
     } else if (const auto* other = std::get_if<protocol::OtherClass>(&message); other && other->name == "EFFECT") {
@@ -606,7 +629,7 @@ void addClientCommands(CLI::App& app, CommandRunner& run) {
         "watch",
         "Show gyrod's live samples: seq, t (CLOCK_MONOTONIC s of the data-ready edge; the header maps it to UTC), "
         "then per axis rate (the stream to read while the board moves), raw and the paper's Kalman, and the still "
-        "detector (RATE lines)");
+        "detector, and with a sensor model and the accelerometer roll, pitch and heading (RATE lines)");
     addCommonOptions(sub, opt->common);
     sub->add_flag("--json", opt->common.json, "print gyrod's lines unchanged (one JSON object per line)");
     sub->add_option("--decimate", opt->decimate, "receive every N-th sample")
