@@ -193,6 +193,38 @@ TEST_F(GyroctlTest, WatchShowsRateFirstThenRawAndKalmanAndStillWhenGyrodSendsRat
   }
 }
 
+TEST_F(GyroctlTest, WatchAddsRollPitchAndHeadingWhenGyrodSendsTheOrientation) {
+  const auto oriented = [](std::uint64_t k) {
+    protocol::RateSample s = syntheticSample(k);
+    s.rate_dps = {0.5, -1.25, 30.0};
+    s.bias_dps = {0.01, 0.02, 0.03};
+    s.still = false;
+    s.quat = {0.9238795325112867, 0.0, 0.0, 0.3826834323650898};
+    s.roll_pitch_heading_deg = {1.5, -2.25, 45.0 + static_cast<double>(k)};
+    s.inclination_std_deg = 0.1;
+    s.heading_std_deg = 0.2;
+    return s;
+  };
+  startServer();
+  auto next = std::make_shared<std::uint64_t>(0);
+  loop_.addPeriodicTimer(200us, [this, next, oriented](std::uint64_t) {
+    if (server_->watcherCount() == 0) return;
+    server_->publishRate(oriented((*next)++));
+  });
+  const CommandResult r = run({"watch", "--socket", socketPath(), "--count", "2"});
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const auto lines = splitLines(r.out);
+  ASSERT_EQ(lines.size(), 4u) << r.out;  // header, t legend, row, row
+  EXPECT_LT(lines[0].find("still"), lines[0].find("roll")) << lines[0];
+  EXPECT_LT(lines[0].find("pitch"), lines[0].find("heading")) << lines[0];
+  for (std::size_t i = 0; i < 2; ++i) {
+    const protocol::RateSample s = oriented(i);
+    const auto w = words(lines[2 + i]);
+    ASSERT_EQ(w.size(), 15u) << lines[2 + i];
+    for (std::size_t a = 0; a < 3; ++a) EXPECT_EQ(w[12 + a], fixed(s.roll_pitch_heading_deg[a], 3)) << lines[2 + i];
+  }
+}
+
 TEST_F(GyroctlTest, WatchHeaderSaysWhatTIsAndMapsItToUtc) {
   const auto withTime = [](std::uint64_t k) {
     protocol::RateSample s = syntheticSample(k);
