@@ -88,6 +88,7 @@ MqttSettings mqttSettings(const GyrodConfig& c, const std::string& device) {
   s.queue_lines = clientQueueLines(recordedSamplesPerSecond(c));
   s.home_assistant = c.mqtt.home_assistant;
   s.home_assistant_prefix = c.mqtt.home_assistant_prefix;
+  s.orientation = !c.filter.model.empty() && c.device.accel;
   return s;
 }
 
@@ -315,8 +316,8 @@ void Gyrod::startRecorder(const std::string& started_from) {
       "gx,gy,gz: raw rates as read from the chip (bias not removed); t: CLOCK_MONOTONIC s of the data-ready edge; "
       "time: the same edge in UTC epoch s; GAP lines mark lost samples");
   const driver::Mpu6050Config& chip = device_.driver_config;  // the chain the model check puts in its base model
-  options.header_comments.push_back(recording::acquisitionHeaderComment(
-      chip.dlpf_cfg, chip.fs_sel, chip.sample_rate_hz, driver::sampleRateDivider(chip)));
+  options.header_comments.push_back(recording::acquisitionHeaderComment(chip.dlpf_cfg, chip.fs_sel, chip.sample_rate_hz,
+                                                                        driver::sampleRateDivider(chip)));
   options.header_comments.push_back(
       "gx_rate..still: the RATE stream's rate, bias and still as published (docs/recording-format.md)");
   if (rate_model_.params)  // the recording holds what the rate stream was fed, at full precision

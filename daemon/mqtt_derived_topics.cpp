@@ -33,6 +33,11 @@ void MqttDerivedTopics::take(const protocol::RateSample& sample) {
   last_seq_ = sample.seq;
   temp_c_ = sample.temp_c;
   still_ = sample.still;
+  const auto& e = sample.roll_pitch_heading_deg;
+  if (std::isfinite(e[0]) && std::isfinite(e[1]) && std::isfinite(e[2]))
+    orientation_ = std::array<double, 4>{e[0], e[1], e[2], sample.heading_std_deg};
+  else
+    orientation_.reset();
 }
 
 void MqttDerivedTopics::addSummary(std::vector<MqttMessage>& out) {
@@ -41,6 +46,12 @@ void MqttDerivedTopics::addSummary(std::vector<MqttMessage>& out) {
   Json j = {{"seq", last_seq_}, {"samples", count_}, {"temp", temp_c_}};
   j[sum_is_rate_ ? "rate" : "raw"] = {sum_[0] / n, sum_[1] / n, sum_[2] / n};
   if (still_) j["still"] = *still_;
+  if (orientation_) {
+    j["roll"] = (*orientation_)[0];
+    j["pitch"] = (*orientation_)[1];
+    j["heading"] = (*orientation_)[2];
+    if (std::isfinite((*orientation_)[3])) j["heading_std"] = (*orientation_)[3];
+  }
   out.push_back({summary_topic_, j.dump(), 0, false});
   count_ = 0;
 }
@@ -86,6 +97,9 @@ void MqttDerivedTopics::addHomeAssistantConfigs(std::vector<MqttMessage>& out) c
            "°/s");
   }
   config("temperature", "temperature", summary_topic_, "{{ value_json.temp }}", "°C");
+  if (settings_.orientation)
+    for (const char* angle : {"roll", "pitch", "heading"})
+      config(angle, angle, summary_topic_, std::string("{{ value_json.") + angle + " }}", "°");
   config("state", "state", status_topic, "{{ value_json.state }}", nullptr);
 }
 

@@ -1,15 +1,17 @@
 #pragma once
 // What gyrod publishes on its broker beside the lines themselves (docs/protocol.md "MQTT"):
 //  - <prefix>/summary, once a second: the mean rate over the second, the newest temperature and
-//    still verdict — what a dashboard plots, without taking every sample;
+//    still verdict, and the newest orientation when RATE has one — what a dashboard plots,
+//    without taking every sample;
 //  - <prefix>/allan, retained: the ALLAN reply (rolling deviations and noise terms), at connect
 //    and after each noise refit;
 //  - <prefix>/model, retained: the calibration the rate stream uses, at connect and on change;
 //  - with home_assistant, Home Assistant's MQTT discovery (retained configs under
-//    <discovery prefix>/sensor/<node>/...): rates x, y, z and temperature from the summary, the
-//    state from the status.
+//    <discovery prefix>/sensor/<node>/...): rates x, y, z, temperature (and with the orientation
+//    roll, pitch, heading) from the summary, the state from the status.
 // Pure apart from the sources it is handed (which take gyrod's state lock): lines in, messages
 // out; the publisher's thread sends them.
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -32,6 +34,7 @@ struct MqttDerivedSettings {
   std::string device;     // the device's description, for Home Assistant's device entry
   bool home_assistant = false;
   std::string home_assistant_prefix = "homeassistant";
+  bool orientation = false;  // RATE carries the orientation (a sensor model and the accel): its sensors too
 };
 
 struct MqttMessage {
@@ -67,6 +70,9 @@ class MqttDerivedTopics {
   bool sum_is_rate_ = false;
   double temp_c_ = 0.0;
   std::optional<bool> still_;
+  // The newest roll, pitch, heading and heading 1σ [°] of the second (angles are not averaged:
+  // a heading crossing ±180° would average to nonsense); none while RATE carries none.
+  std::optional<std::array<double, 4>> orientation_;
   double next_summary_s_ = 0.0, next_model_check_s_ = 0.0;
   std::uint64_t allan_cycles_sent_ = 0;
   bool allan_pending_ = false, model_pending_ = false;  // to send once their source has them

@@ -84,7 +84,7 @@ MqttPublisher::MqttPublisher(MqttSettings settings, MqttDerivedSources sources)
       buffer_(settings_.qos == 1 ? settings_.buffer_messages : 0),
       jitter_(std::random_device{}()),
       derived_({settings_.prefix, settings_.client_id, settings_.device, settings_.home_assistant,
-                settings_.home_assistant_prefix},
+                settings_.home_assistant_prefix, settings_.orientation},
                std::move(sources)),
       wake_fd_(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)) {
   if (!wake_fd_) throw std::runtime_error("MQTT: no eventfd for the publisher's thread");

@@ -59,6 +59,7 @@ struct MqttSettings {
   std::size_t buffer_messages = 0;  // qos 1: kept while the broker is away (0: none)
   bool home_assistant = false;      // Home Assistant's discovery configs (daemon/mqtt_derived_topics.hpp)
   std::string home_assistant_prefix = "homeassistant";
+  bool orientation = false;  // RATE carries the orientation (a sensor model and the accel)
 };
 
 struct MqttStats {

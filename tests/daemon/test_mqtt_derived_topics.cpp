@@ -39,7 +39,7 @@ struct Counters {
   std::string model = R"({"rate_model":"bias"})";
 };
 
-MqttDerivedTopics derived(Counters& c, bool home_assistant) {
+MqttDerivedTopics derived(Counters& c, bool home_assistant, bool orientation = false) {
   MqttDerivedSources sources;
   sources.refit_cycles = [&c] { return c.refits; };
   sources.allan_json = [&c] {
@@ -47,7 +47,7 @@ MqttDerivedTopics derived(Counters& c, bool home_assistant) {
     return R"({"class":"ALLAN","samples":)" + std::to_string(c.refits) + "}";
   };
   sources.model_json = [&c] { return c.model; };
-  return MqttDerivedTopics({"gyrod/rig-1", "gyrod-rig.1", "mock MPU6050", home_assistant, "homeassistant"},
+  return MqttDerivedTopics({"gyrod/rig-1", "gyrod-rig.1", "mock MPU6050", home_assistant, "homeassistant", orientation},
                            std::move(sources));
 }
 
@@ -80,7 +80,27 @@ TEST(MqttDerivedTopics, TheSummaryIsTheMeanOfEachSecondOfRateThenRaw) {
   EXPECT_EQ(j["rate"], json::array({3.0, -3.0, 6.0}));
   EXPECT_EQ(j["samples"], 2);
   EXPECT_EQ(j["still"], false);                                            // seq 7's
+  EXPECT_FALSE(j.contains("heading"));                                     // no orientation sent
   EXPECT_TRUE(find(d.due(3.0, false), "gyrod/rig-1/summary") == nullptr);  // no samples that second
+}
+
+TEST(MqttDerivedTopics, TheSummaryCarriesTheNewestOrientationNotItsMean) {
+  Counters c;
+  MqttDerivedTopics d = derived(c, false, true);
+  d.due(0.0, true);
+  for (std::uint64_t i = 1; i <= 3; ++i) {
+    gyrod::protocol::RateSample s = sample(i, 1.0, true);
+    s.quat = {1.0, 0.0, 0.0, 0.0};
+    s.roll_pitch_heading_deg = {0.5 * static_cast<double>(i), -1.0, i == 3 ? -179.0 : 179.0};  // across ±180°
+    s.inclination_std_deg = 0.1;
+    s.heading_std_deg = 0.25 * static_cast<double>(i);
+    d.take(s);
+  }
+  const json j = json::parse(find(d.due(1.0, false), "gyrod/rig-1/summary")->payload);
+  EXPECT_EQ(j["roll"], 1.5);
+  EXPECT_EQ(j["pitch"], -1.0);
+  EXPECT_EQ(j["heading"], -179.0);
+  EXPECT_EQ(j["heading_std"], 0.75);
 }
 
 TEST(MqttDerivedTopics, AllanAndModelAreRetainedSentOnConnectAndOnChange) {
@@ -139,6 +159,17 @@ TEST(MqttDerivedTopics, HomeAssistantDiscoveryOnlyWhenAskedAndItsConfigsPointAtO
   EXPECT_FALSE(state.contains("availability_topic"));
   EXPECT_EQ(json::parse(find(out, "homeassistant/sensor/gyrod-rig_1/temperature/config")->payload)["device_class"],
             "temperature");
+  // Roll, pitch and heading only from a gyrod that publishes the orientation.
+  EXPECT_EQ(find(out, "homeassistant/sensor/gyrod-rig_1/heading/config"), nullptr);
+  const auto oriented = derived(c, true, true).due(0.0, true);
+  for (const char* angle : {"roll", "pitch", "heading"}) {
+    const MqttMessage* m = find(oriented, std::string("homeassistant/sensor/gyrod-rig_1/") + angle + "/config");
+    ASSERT_NE(m, nullptr) << angle;
+    const json j = json::parse(m->payload);
+    EXPECT_EQ(j["state_topic"], "gyrod/rig-1/summary");
+    EXPECT_EQ(j["value_template"], std::string("{{ value_json.") + angle + " }}");
+    EXPECT_EQ(j["unit_of_measurement"], "°");
+  }
 }
 
 TEST(MqttDerivedTopics, ASourceWithNothingYetIsAskedAgainUntilItAnswers) {
