@@ -114,7 +114,8 @@ TEST_F(ServerFixture, PublishingAllocatesNothing) {
 }
 
 // The pipeline's per-sample step, the rate stream's RateEstimator included (a sensor model
-// with a temperature term, so the residual filter and the still detector both run).
+// with a temperature term, so the residual filter and the still detector both run), and with
+// the accel the orientation on that stream (its motion errors learned while it turns).
 TEST(NoAllocation, PipelineProcessAllocatesNothingWithARateModel) {
   daemon::PipelineSettings p;
   p.bias_origin = daemon::BiasOrigin::Config;
@@ -128,17 +129,20 @@ TEST(NoAllocation, PipelineProcessAllocatesNothingWithARateModel) {
   }
   p.rate_model = model;
   daemon::SamplePipeline pipeline(p);
-  std::size_t allocations = 0, still = 0;
+  std::size_t allocations = 0, still = 0, oriented = 0;
   for (std::uint64_t k = 0; k < 6000; ++k) {
     const double noise = 0.01 * static_cast<double>(static_cast<int>(k * 7919 % 13) - 6);
     const double turning = (k / 1000) % 2 == 1 ? 30.0 : 0.0;
     CountAllocations c;
     const daemon::ProcessedSample out =
-        pipeline.process(k, static_cast<double>(k) / 50.0, {noise, -noise, turning + noise}, 25.0 + 1e-3 * k);
+        pipeline.process(k, static_cast<double>(k) / 50.0, {noise, -noise, turning + noise}, 25.0 + 1e-3 * k,
+                         {0.1 * noise, -0.1 * noise, 1.0});
     allocations += c.count();
     still += out.still.value_or(false) ? 1 : 0;
+    oriented += out.attitude ? 1 : 0;
   }
   EXPECT_EQ(allocations, 0u);
+  EXPECT_EQ(oriented, 6000u);
   EXPECT_GT(still, 0u);
   EXPECT_LT(still, 6000u);
 }
