@@ -118,6 +118,9 @@ TEST(ProtocolRate, TheLongestLineWithEveryFieldFits) {
   s.t_s = s.temp_c = longest;
   s.raw_dps = s.mean_dps = s.kalman_dps = s.rate_dps = s.bias_dps = s.accel_g = {longest, longest, longest};
   s.still = false;
+  s.quat = {longest, longest, longest, longest};
+  s.roll_pitch_heading_deg = {longest, longest, longest};
+  s.inclination_std_deg = s.heading_std_deg = longest;
   for (const double time : {-999999999999999.9, 1e300, longest}) {  // fixed notation, then shortest
     s.time_s = time;
     std::array<char, kMaxRateLineBytes> buf;
@@ -126,6 +129,8 @@ TEST(ProtocolRate, TheLongestLineWithEveryFieldFits) {
     const json j = parseLine(buf.data(), n);
     EXPECT_NEAR(j["time"].get<double>(), time, 1e-6 * std::fabs(time) + 1e-6);
     EXPECT_EQ(j["accel_ms2"].size(), 3u);
+    for (std::size_t i = 0; i < 4; ++i) EXPECT_TRUE(sameDouble(j["quat"][i].get<double>(), longest));
+    EXPECT_TRUE(sameDouble(j["heading_std"].get<double>(), longest));
   }
 }
 
@@ -382,36 +387,24 @@ TEST(ProtocolRate, UnsetRateBiasAndStillAreOmitted) {
   EXPECT_FALSE(j.contains("still"));
 }
 
-TEST(ProtocolRate, TheAttitudeComesLastRoundTripsAndTheLongestLineFits) {
+TEST(ProtocolRate, TheAttitudeComesLastAndRoundTrips) {
   RateSample s;
-  s.seq = std::numeric_limits<std::uint64_t>::max();
-  const double longest = -2.2250738585072014e-308;  // 24 characters in shortest form
-  s.t_s = s.temp_c = longest;
-  s.raw_dps = s.mean_dps = s.kalman_dps = s.rate_dps = s.bias_dps = s.accel_g = {longest, longest, longest};
+  s.seq = 12;
+  s.t_s = 1.5;
+  s.temp_c = 30.0;
+  s.raw_dps = s.rate_dps = s.bias_dps = s.accel_g = {0.5, -0.25, 1.0};
   s.still = false;
-  s.time_s = 1e300;  // past 1e15: the shortest form
-  s.quat = {longest, longest, longest, longest};
-  s.roll_pitch_heading_deg = {longest, longest, longest};
-  s.inclination_std_deg = s.heading_std_deg = longest;
   std::array<char, kMaxRateLineBytes> buf;
-  const std::size_t n = formatRateLine(s, buf);
-  EXPECT_LT(n, kMaxRateLineBytes);
-  const std::string line(buf.data(), n);
-  EXPECT_EQ(line.back(), '\n');
-  EXPECT_LT(line.find("\"accel_ms2\""), line.find("\"quat\"")) << line;
-  EXPECT_LT(line.find("\"quat\""), line.find("\"roll\"")) << line;
-  EXPECT_LT(line.find("\"heading\""), line.find("\"inclination_std\"")) << line;
-  const json j = parseLine(buf.data(), n);
-  for (std::size_t i = 0; i < 4; ++i) EXPECT_TRUE(sameDouble(j["quat"][i].get<double>(), longest));
-  EXPECT_TRUE(sameDouble(j["heading_std"].get<double>(), longest));
-
-  // Ordinary values come back from parseServerLine bit for bit; an unset quaternion is omitted
-  // with its angles' fields left as they are.
+  // After every earlier field; parseServerLine gives the values back bit for bit; an unset
+  // quaternion is omitted with its angles' fields left as they are.
   s.quat = {0.9238795325112867, 0.0, -0.3826834323650898, 1e-17};
   s.roll_pitch_heading_deg = {-0.0, -45.00000000000001, 179.99999999999997};
   s.inclination_std_deg = 0.123;
   s.heading_std_deg = 4.56;
   const std::string ordinary(buf.data(), formatRateLine(s, buf) - 1);
+  EXPECT_LT(ordinary.find("\"accel_ms2\""), ordinary.find("\"quat\"")) << ordinary;
+  EXPECT_LT(ordinary.find("\"quat\""), ordinary.find("\"roll\"")) << ordinary;
+  EXPECT_LT(ordinary.find("\"heading\""), ordinary.find("\"inclination_std\"")) << ordinary;
   const auto back = std::get<RateSample>(parseServerLine(ordinary));
   for (std::size_t i = 0; i < 4; ++i) EXPECT_EQ(back.quat[i], s.quat[i]) << ordinary;
   for (std::size_t i = 0; i < 3; ++i)
