@@ -27,7 +27,7 @@ Matrix3 leverArmMatrix(const Vector3& w, const Vector3& a) {
            {w[0] * w[2] - a[1], w[1] * w[2] + a[0], -(xx + yy)}}};
 }
 
-void requirePositive(double value, const char* name) {
+void requirePositiveMotionErrorParameter(double value, const char* name) {
   if (!(value > 0.0) || !std::isfinite(value))
     throw std::invalid_argument(std::string("attitude: motion errors ") + name + " must be a positive number, not " +
                                 std::to_string(value));
@@ -42,12 +42,12 @@ MotionErrorEstimator::MotionErrorEstimator(const MotionErrorParameters& params, 
       dt_(1.0 / rate_hz),
       estimate_sensitivity_(estimate_sensitivity),
       estimate_lever_arm_(estimate_lever_arm) {
-  requirePositive(p_.sensitivity_initial_std, "sensitivity_initial_std");
-  requirePositive(p_.sensitivity_limit, "sensitivity_limit");
-  requirePositive(p_.lever_arm_initial_std_m, "lever_arm_initial_std_m");
-  requirePositive(p_.lever_arm_limit_m, "lever_arm_limit_m");
-  requirePositive(p_.bias_initial_std_rad_s, "bias_initial_std_rad_s");
-  requirePositive(p_.correction_noise_density, "correction_noise_density");
+  requirePositiveMotionErrorParameter(p_.sensitivity_initial_std, "sensitivity_initial_std");
+  requirePositiveMotionErrorParameter(p_.sensitivity_limit, "sensitivity_limit");
+  requirePositiveMotionErrorParameter(p_.lever_arm_initial_std_m, "lever_arm_initial_std_m");
+  requirePositiveMotionErrorParameter(p_.lever_arm_limit_m, "lever_arm_limit_m");
+  requirePositiveMotionErrorParameter(p_.bias_initial_std_rad_s, "bias_initial_std_rad_s");
+  requirePositiveMotionErrorParameter(p_.correction_noise_density, "correction_noise_density");
   for (const auto& [value, name] : {std::pair{p_.lever_arm_random_walk_m_per_sqrt_s, "lever_arm_random_walk"},
                                     std::pair{p_.bias_random_walk_rad_s_per_sqrt_s, "bias_random_walk"}})
     if (!(value >= 0.0) || !std::isfinite(value))
