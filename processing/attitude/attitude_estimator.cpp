@@ -1,8 +1,8 @@
 #include "processing/attitude/attitude_estimator.hpp"
 
 #include <cmath>
-#include <stdexcept>
-#include <string>
+
+#include "processing/attitude/parameter_check.hpp"
 
 namespace gyrod::processing::attitude {
 namespace {
@@ -11,30 +11,23 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegToRad = kPi / 180.0;
 constexpr double kRestLowpassTimeConstantS = 0.5;
 
-void requirePositive(double v, const char* name) {
-  if (!(v > 0.0) || !std::isfinite(v))
-    throw std::invalid_argument(std::string("attitude: ") + name + " must be a positive number, not " +
-                                std::to_string(v));
-}
-
 double norm(const Vector3& v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
 
 }  // namespace
 
 AttitudeEstimator::AttitudeEstimator(const AttitudeParameters& params) : p_(params) {
-  requirePositive(p_.rate_hz, "rate_hz");
-  requirePositive(p_.accel_time_constant_s, "accel_time_constant_s");
-  requirePositive(p_.accel_norm_scale_g, "accel_norm_scale_g");
-  requirePositive(p_.rest_bias_time_constant_s, "rest_bias_time_constant_s");
-  requirePositive(p_.motion_bias_time_constant_s, "motion_bias_time_constant_s");
-  requirePositive(p_.rest_gyro_deviation_dps, "rest_gyro_deviation_dps");
-  requirePositive(p_.rest_accel_deviation_g, "rest_accel_deviation_g");
-  requirePositive(p_.rest_duration_s, "rest_duration_s");
-  requirePositive(p_.bias_limit_dps, "bias_limit_dps");
+  requirePositiveParameter(p_.rate_hz, "rate_hz");
+  requirePositiveParameter(p_.accel_time_constant_s, "accel_time_constant_s");
+  requirePositiveParameter(p_.accel_norm_scale_g, "accel_norm_scale_g");
+  requirePositiveParameter(p_.rest_bias_time_constant_s, "rest_bias_time_constant_s");
+  requirePositiveParameter(p_.motion_bias_time_constant_s, "motion_bias_time_constant_s");
+  requirePositiveParameter(p_.rest_gyro_deviation_dps, "rest_gyro_deviation_dps");
+  requirePositiveParameter(p_.rest_accel_deviation_g, "rest_accel_deviation_g");
+  requirePositiveParameter(p_.rest_duration_s, "rest_duration_s");
+  requirePositiveParameter(p_.bias_limit_dps, "bias_limit_dps");
   for (double v : {p_.gyro_angle_random_walk_dps_per_sqrt_hz, p_.gyro_rate_random_walk_dps_per_sqrt_s,
                    p_.accel_noise_density_g_per_sqrt_hz, p_.initial_bias_std_dps})
-    if (!(v >= 0.0) || !std::isfinite(v))
-      throw std::invalid_argument("attitude: noise terms must be finite and >= 0, not " + std::to_string(v));
+    requireNonNegativeParameter(v, "noise terms");
   dt_ = 1.0 / p_.rate_hz;
   rest_alpha_ = 1.0 - std::exp(-dt_ / kRestLowpassTimeConstantS);
   rest_bias_alpha_ = 1.0 - std::exp(-dt_ / p_.rest_bias_time_constant_s);

@@ -2,9 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
-#include <string>
-#include <utility>
+
+#include "processing/attitude/parameter_check.hpp"
 
 namespace gyrod::processing::attitude {
 namespace {
@@ -27,12 +26,6 @@ Matrix3 leverArmMatrix(const Vector3& w, const Vector3& a) {
            {w[0] * w[2] - a[1], w[1] * w[2] + a[0], -(xx + yy)}}};
 }
 
-void requirePositiveMotionErrorParameter(double value, const char* name) {
-  if (!(value > 0.0) || !std::isfinite(value))
-    throw std::invalid_argument(std::string("attitude: motion errors ") + name + " must be a positive number, not " +
-                                std::to_string(value));
-}
-
 }  // namespace
 
 MotionErrorEstimator::MotionErrorEstimator(const MotionErrorParameters& params, const LowpassCoefficients& lowpass,
@@ -42,17 +35,14 @@ MotionErrorEstimator::MotionErrorEstimator(const MotionErrorParameters& params, 
       dt_(1.0 / rate_hz),
       estimate_sensitivity_(estimate_sensitivity),
       estimate_lever_arm_(estimate_lever_arm) {
-  requirePositiveMotionErrorParameter(p_.sensitivity_initial_std, "sensitivity_initial_std");
-  requirePositiveMotionErrorParameter(p_.sensitivity_limit, "sensitivity_limit");
-  requirePositiveMotionErrorParameter(p_.lever_arm_initial_std_m, "lever_arm_initial_std_m");
-  requirePositiveMotionErrorParameter(p_.lever_arm_limit_m, "lever_arm_limit_m");
-  requirePositiveMotionErrorParameter(p_.bias_initial_std_rad_s, "bias_initial_std_rad_s");
-  requirePositiveMotionErrorParameter(p_.correction_noise_density, "correction_noise_density");
-  for (const auto& [value, name] : {std::pair{p_.lever_arm_random_walk_m_per_sqrt_s, "lever_arm_random_walk"},
-                                    std::pair{p_.bias_random_walk_rad_s_per_sqrt_s, "bias_random_walk"}})
-    if (!(value >= 0.0) || !std::isfinite(value))
-      throw std::invalid_argument(std::string("attitude: motion errors ") + name + " must be finite and >= 0, not " +
-                                  std::to_string(value));
+  requirePositiveParameter(p_.sensitivity_initial_std, "motion errors sensitivity_initial_std");
+  requirePositiveParameter(p_.sensitivity_limit, "motion errors sensitivity_limit");
+  requirePositiveParameter(p_.lever_arm_initial_std_m, "motion errors lever_arm_initial_std_m");
+  requirePositiveParameter(p_.lever_arm_limit_m, "motion errors lever_arm_limit_m");
+  requirePositiveParameter(p_.bias_initial_std_rad_s, "motion errors bias_initial_std_rad_s");
+  requirePositiveParameter(p_.correction_noise_density, "motion errors correction_noise_density");
+  requireNonNegativeParameter(p_.lever_arm_random_walk_m_per_sqrt_s, "motion errors lever_arm_random_walk");
+  requireNonNegativeParameter(p_.bias_random_walk_rad_s_per_sqrt_s, "motion errors bias_random_walk");
   // White at the sample rate with this density: the information a second does not depend on
   // the rate.
   measurement_variance_ = p_.correction_noise_density * p_.correction_noise_density * rate_hz;
