@@ -287,6 +287,11 @@ ProcessedSample SamplePipeline::process(std::uint64_t seq, double t_s, const Vec
   ++processed_;
   if (!first_t_s_) first_t_s_ = t_s;
   last_t_s_ = t_s;
+  const bool has_accel = std::isfinite(accel_g[0]) && std::isfinite(accel_g[1]) && std::isfinite(accel_g[2]);
+  if (!accel_device_) {
+    accel_device_ = has_accel;
+    if (!has_accel) attitude_.reset();  // a gyro-only device: no orientation to compute, ever
+  }
   for (std::size_t axis = 0; axis < kAxes; ++axis) allan_raw_[axis].push(raw_dps[axis]);
   if (rate_) {
     rate_->observeAccel(accel_g);  // a tilt the gyro cannot tell from bias is not still
@@ -296,9 +301,11 @@ ProcessedSample SamplePipeline::process(std::uint64_t seq, double t_s, const Vec
     out.still = r.still;
     out.has_rate = true;
     // The orientation from the rate stream and the accel, as `gyroctl attitude --model` computes
-    // it from a recording; published only when the device gives the accel.
-    const processing::attitude::AttitudeSample a = attitude_->update(r.rate_dps, accel_g);
-    if (std::isfinite(accel_g[0]) && std::isfinite(accel_g[1]) && std::isfinite(accel_g[2])) out.attitude = a;
+    // it from a recording; published only for a sample that has the accel.
+    if (attitude_) {
+      const processing::attitude::AttitudeSample a = attitude_->update(r.rate_dps, accel_g);
+      if (has_accel) out.attitude = a;
+    }
   }
   advance(out, false);
   return out;
@@ -356,7 +363,7 @@ void SamplePipeline::reloadRateModel(const std::optional<processing::RateEstimat
   // a reload must not turn the heading back to 0.
   if (!p)
     attitude_.reset();
-  else if (!attitude_)
+  else if (!attitude_ && accel_device_.value_or(true))
     attitude_.emplace(recording::rateStreamAttitudeParameters(*p));
 }
 

@@ -260,6 +260,9 @@ class SamplePipeline {
   std::vector<processing::AxisFilterChain> chains_;                  // kAxes, built at start and on reload
   std::optional<processing::RateEstimator> rate_;                    // with a sensor model
   std::optional<processing::attitude::AttitudeEstimator> attitude_;  // on rate_'s stream
+  // Whether the device gives the accel: its first sample decides (a FIFO carries the accel in
+  // every frame or in none); none before it.
+  std::optional<bool> accel_device_;
   std::array<processing::RollingOverlappingAllan, kAxes> allan_raw_, allan_mean_, allan_kalman_;
   std::array<std::optional<processing::NoiseTermFit>, kAxes> noise_terms_;
   std::array<std::array<std::vector<int>, kStreams>, kAxes> noise_alpha_;  // of the last refit, per τ
