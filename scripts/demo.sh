@@ -28,6 +28,8 @@ cat >"$work/calibrate.toml" <<'TOML'
 backend = "mock"
 [mock]
 speed = 100
+[record]
+rotate_mb = 0
 TOML
 build/bin/gyrod --config "$work/calibrate.toml" --socket "$sock" --record "$work/still/" --log-level warn &
 gyrod_pid=$!
