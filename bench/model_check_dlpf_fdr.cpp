@@ -121,9 +121,9 @@ int main(int argc, char** argv) {
         if (verbose > 1 || (verbose && !r.effects.empty())) {
           std::printf("seed %zu axis %zu:", s, a);
           for (const DetectedEffect& e : r.effects)
-            std::printf(" %s(tau %g sigma %g where %g-%g freq %g centre %g width %g)",
+            std::printf(" %s(tau %g sigma %g where %g-%g freq %g centre %g width %g; statistic %g threshold %g)",
                         std::string(modelEffectName(e.effect)).c_str(), e.tau_s, e.sigma_dps, e.where_lo, e.where_hi,
-                        e.freq_hz, e.centre_hz, e.width_hz);
+                        e.freq_hz, e.centre_hz, e.width_hz, e.evidence.statistic, e.evidence.threshold);
           const NoiseTerms& tt = g.terms[a];
           const NoiseTerms& ft = r.base_fit.value;
           std::printf("\n  truth Q %.3g N %.3g B %.3g K %.3g R %.3g | fit Q %.3g N %.3g B %.3g K %.3g R %.3g chi2 %.3g",
