@@ -1,11 +1,14 @@
 // The attitude estimator (processing/attitude/) on BROAD trials: per trial the inclination and
 // heading RMSE over the movement phases (heading: mean offset removed), their means, and the
 // cost per sample. docs/attitude.md lists the figures and the command.
-// Usage: attitude_broad DIRECTORY [--set NAME=VALUE]... [TRIAL...]
+// Usage: attitude_broad DIRECTORY [--errors] [--set NAME=VALUE]... [TRIAL...]
+//   --errors: under each trial, the motion errors learned by its end (scale errors, cross-axis
+//   terms, lever arm, accel delay).
 //   TRIAL: default every NAME.truth.csv.gz in DIRECTORY; --set overrides an AttitudeParameters
 //   field (tau, norm_scale, estimate_bias, rest_bias_tc, motion_bias_tc, rest_gyro, rest_accel,
-//   rest_duration, bias_limit; the motion errors: estimate_sensitivity, estimate_lever_arm, s_init,
-//   r_init, r_rw, b_init, b_rw, c_noise), for exploring the parameters.
+//   rest_duration, bias_limit; the motion errors: estimate_sensitivity, estimate_cross_axis,
+//   estimate_lever_arm, estimate_accel_delay, s_init, x_init, r_init, r_rw, b_init, b_rw, delay_init,
+//   c_noise), for exploring the parameters.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -46,21 +49,20 @@ bool setParameter(gyrod::processing::attitude::AttitudeParameters& p, const std:
                                                  {"rest_duration", &p.rest_duration_s},
                                                  {"bias_limit", &p.bias_limit_dps},
                                                  {"s_init", &p.motion_errors.sensitivity_initial_std},
+                                                 {"x_init", &p.motion_errors.cross_axis_initial_std},
+                                                 {"delay_init", &p.motion_errors.accel_delay_initial_std_s},
                                                  {"r_init", &p.motion_errors.lever_arm_initial_std_m},
                                                  {"r_rw", &p.motion_errors.lever_arm_random_walk_m_per_sqrt_s},
                                                  {"b_init", &p.motion_errors.bias_initial_std_rad_s},
                                                  {"b_rw", &p.motion_errors.bias_random_walk_rad_s_per_sqrt_s},
                                                  {"c_noise", &p.motion_errors.correction_noise_density}};
-  if (key == "estimate_bias") {
-    p.estimate_bias = v != 0.0;
-    return true;
-  }
-  if (key == "estimate_sensitivity") {
-    p.estimate_sensitivity = v != 0.0;
-    return true;
-  }
-  if (key == "estimate_lever_arm") {
-    p.estimate_lever_arm = v != 0.0;
+  const std::map<std::string, bool*> switches = {{"estimate_bias", &p.estimate_bias},
+                                                 {"estimate_sensitivity", &p.estimate_sensitivity},
+                                                 {"estimate_cross_axis", &p.estimate_cross_axis},
+                                                 {"estimate_lever_arm", &p.estimate_lever_arm},
+                                                 {"estimate_accel_delay", &p.estimate_accel_delay}};
+  if (const auto on = switches.find(key); on != switches.end()) {
+    *on->second = v != 0.0;
     return true;
   }
   const auto it = fields.find(key);
@@ -80,9 +82,12 @@ int main(int argc, char** argv) {
   const std::string directory = argv[1];
   processing::attitude::AttitudeParameters params;
   std::vector<std::string> names;
+  bool print_errors = false;
   for (int i = 2; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (arg == "--set" && i + 1 < argc) {
+    if (arg == "--errors") {
+      print_errors = true;
+    } else if (arg == "--set" && i + 1 < argc) {
       if (!setParameter(params, argv[++i])) {
         std::fprintf(stderr, "attitude_broad: --set %s: unknown parameter or no '='\n", argv[i]);
         return 64;
@@ -102,13 +107,24 @@ int main(int argc, char** argv) {
     for (const auto& name : names) {
       const broad::Trial trial = broad::readTrial(directory, name);
       const auto start = std::chrono::steady_clock::now();
-      const auto q = broad::estimateTrial(trial, params);
+      processing::attitude::AttitudeSample last;
+      const auto q = broad::estimateTrial(trial, params, &last);
       const auto stop = std::chrono::steady_clock::now();
       total_ns += std::chrono::duration<double, std::nano>(stop - start).count();
       total_samples += static_cast<double>(q.size());
       const broad::TrialErrors e = broad::broadErrors(q, trial);
       std::printf("%-45s %10.3f %10.3f %9.1f\n", name.c_str(), e.inclination_rmse_deg, e.heading_rmse_deg,
                   static_cast<double>(e.samples) / trial.rate_hz);
+      if (print_errors) {
+        const auto& sens = last.gyro_sensitivity_error;
+        const auto& cross = last.gyro_cross_axis;
+        const auto& r = last.lever_arm_m;
+        std::printf(
+            "  scale %+.2f %+.2f %+.2f %%, cross-axis xy %+.2f xz %+.2f yz %+.2f %%, lever arm %+.1f %+.1f %+.1f cm, "
+            "accel delay %+.2f ms\n",
+            100 * sens[0], 100 * sens[1], 100 * sens[2], 100 * cross[0], 100 * cross[1], 100 * cross[2], 100 * r[0],
+            100 * r[1], 100 * r[2], 1e3 * last.accel_delay_s);
+      }
       sum_incl += e.inclination_rmse_deg;
       sum_heading += e.heading_rmse_deg;
     }

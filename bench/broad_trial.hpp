@@ -115,13 +115,20 @@ inline TrialErrors broadErrors(const std::vector<processing::attitude::Quaternio
   return out;
 }
 
-// The estimator over the whole trial, one quaternion a sample.
-inline std::vector<processing::attitude::Quaternion> estimateTrial(const Trial& trial,
-                                                                   processing::attitude::AttitudeParameters params) {
+// The estimator over the whole trial, one quaternion a sample; `last`, when given, gets the
+// last sample's output (the motion errors learned by the end).
+inline std::vector<processing::attitude::Quaternion> estimateTrial(
+    const Trial& trial, processing::attitude::AttitudeParameters params,
+    processing::attitude::AttitudeSample* last = nullptr) {
   params.rate_hz = trial.rate_hz;
   processing::attitude::AttitudeEstimator estimator(params);
   std::vector<processing::attitude::Quaternion> q(trial.rate_dps.size());
-  for (std::size_t i = 0; i < q.size(); ++i) q[i] = estimator.update(trial.rate_dps[i], trial.accel_g[i]).q;
+  processing::attitude::AttitudeSample sample;
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    sample = estimator.update(trial.rate_dps[i], trial.accel_g[i]);
+    q[i] = sample.q;
+  }
+  if (last) *last = sample;
   return q;
 }
 

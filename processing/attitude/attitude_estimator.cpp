@@ -43,8 +43,9 @@ AttitudeEstimator::AttitudeEstimator(const AttitudeParameters& params) : p_(para
   lp_a2_ = (1.0 - std::sqrt(2.0) * c + c * c) / d;
   const double arw = p_.gyro_angle_random_walk_dps_per_sqrt_hz * kDegToRad;
   bias_variance_rest_ = arw * arw / (2.0 * p_.rest_bias_time_constant_s);
-  motion_errors_ = MotionErrorEstimator(p_.motion_errors, {lp_b0_, lp_b1_, lp_b2_, lp_a1_, lp_a2_}, p_.rate_hz,
-                                        p_.estimate_sensitivity, p_.estimate_lever_arm);
+  motion_errors_ = MotionErrorEstimator(
+      p_.motion_errors, {lp_b0_, lp_b1_, lp_b2_, lp_a1_, lp_a2_}, p_.rate_hz,
+      {p_.estimate_sensitivity, p_.estimate_cross_axis, p_.estimate_lever_arm, p_.estimate_accel_delay});
   reset();
 }
 
@@ -153,17 +154,23 @@ AttitudeSample AttitudeEstimator::update(const Vector3& rate_dps, const Vector3&
 
   Vector3 r, rate_rad_s;
   for (int i = 0; i < 3; ++i) rate_rad_s[i] = rate_dps[i] * kDegToRad;
-  const Vector3& s_hat = motion_errors_.sensitivityError();
-  for (int i = 0; i < 3; ++i) r[i] = (rate_rad_s[i] * (1.0 - s_hat[i]) - bias_rad_s_[i]) * dt_;
+  const auto& s_hat = motion_errors_.sensitivityMatrix();
+  for (int i = 0; i < 3; ++i) {
+    const double error = s_hat[i][0] * rate_rad_s[0] + s_hat[i][1] * rate_rad_s[1] + s_hat[i][2] * rate_rad_s[2];
+    r[i] = (rate_rad_s[i] - error - bias_rad_s_[i]) * dt_;
+  }
   if (started_) q_gyro_ = normalized(multiply(q_gyro_, fromRotationVector(r)));
-  // The sensitivity and lever arm are learned from the corrections that follow the first sample,
-  // once the bias is known (a rate already corrected, or a first rest): an unknown bias turns
-  // the quasi-inertial frame as a sensitivity error would, and would be learned as one.
+  // The motion errors are learned from the corrections that follow the first sample, once the
+  // bias is known (a rate already corrected, or a first rest): an unknown bias turns the
+  // quasi-inertial frame as a sensitivity error would, and would be learned as one. Until then,
+  // and while the board rests, the regression's own bias is the rest mean.
   const bool learn =
-      (p_.estimate_sensitivity || p_.estimate_lever_arm) && started_ && (bias_known_ || !p_.estimate_bias);
+      (p_.estimate_sensitivity || p_.estimate_cross_axis || p_.estimate_lever_arm || p_.estimate_accel_delay) &&
+      started_ && (bias_known_ || !p_.estimate_bias);
+  if (!learn || rest_) motion_errors_.setBias(bias_rad_s_);
   Vector3 accel = accel_g;
-  if (learn) {  // K·r̂ off the accel: what is left is gravity and the centre's own acceleration
-    const Vector3 lever = motion_errors_.propagate(q_gyro_, rate_rad_s, bias_rad_s_);
+  if (learn) {  // K·r̂ + δ̂·ω×a off the accel: what is left is gravity and the centre's own acceleration
+    const Vector3 lever = motion_errors_.propagate(q_gyro_, rate_rad_s, bias_rad_s_, accel_ok ? accel_g : Vector3{});
     for (int i = 0; i < 3; ++i) accel[i] -= lever[i];
   }
 
@@ -207,6 +214,8 @@ AttitudeSample AttitudeEstimator::output() const {
   s.heading_std_deg = std::sqrt(heading_arw_variance_ + heading_bias_drift_ * heading_bias_drift_) * kRadToDeg;
   for (int i = 0; i < 3; ++i) s.bias_dps[i] = bias_rad_s_[i] * kRadToDeg;
   s.gyro_sensitivity_error = motion_errors_.sensitivityError();
+  s.gyro_cross_axis = motion_errors_.crossAxis();
+  s.accel_delay_s = motion_errors_.accelDelay();
   s.lever_arm_m = motion_errors_.leverArm();
   s.rest = rest_;
   return s;

@@ -33,11 +33,12 @@
 //   disturbed says little about the bias. |b̂| is held below bias_limit_dps.
 // With estimate_bias unset (a rate already bias-corrected, e.g. gyrod's `rate` stream), b̂ = 0.
 //
-// Motion errors (processing/attitude/motion_errors.hpp), when estimate_sensitivity /
-// estimate_lever_arm are set: each gyro axis's sensitivity error ŝ, applied as
-// ω̂ = ω − b̂ − ŝ⊙ω, and the accel's lever arm r̂ from the centre of rotation, whose
-// acceleration K·r̂ (centripetal and tangential) is taken off the accel before the low-pass;
-// both learned by a Kalman filter from the same inclination corrections.
+// Motion errors (processing/attitude/motion_errors.hpp), when the estimate_* below are set: the
+// gyro's symmetric sensitivity matrix Ŝ (each axis's scale error and the cross-axis terms),
+// applied as ω̂ = ω − b̂ − Ŝ·ω; the accel's lever arm r̂ from the centre of rotation, whose
+// acceleration K·r̂ (centripetal and tangential) is taken off the accel before the low-pass; and
+// the accel's delay δ̂ behind the gyro, taken off as δ̂·ω×a; all learned by a Kalman filter from
+// the same inclination corrections.
 //
 // Uncertainty (1σ, radians internally, degrees in AttitudeSample):
 //   inclination σ² = N_a²/(2τ) + N_g²·τ/2 + (σ_b·τ)²: the steady state of the first-order
@@ -66,8 +67,10 @@ struct AttitudeParameters {
   double rest_accel_deviation_g = 0.05;       // rest: |a − ā| stays below
   double rest_duration_s = 1.5;               // for at least this long
   double bias_limit_dps = 5.0;
-  bool estimate_sensitivity = true;  // the gyro's sensitivity error, learned in motion
+  bool estimate_sensitivity = true;  // the gyro's sensitivity error per axis, learned in motion
+  bool estimate_cross_axis = true;   // the gyro's cross-axis sensitivity (symmetric)
   bool estimate_lever_arm = true;    // the accel's offset from the centre of rotation
+  bool estimate_accel_delay = true;  // how long the accel's sample lags the gyro's
   MotionErrorParameters motion_errors{};
   // Noise terms for the 1σ (defaults: an MPU6050's datasheet figures).
   double gyro_angle_random_walk_dps_per_sqrt_hz = 0.005;  // N_g
@@ -83,6 +86,8 @@ struct AttitudeSample {
   double heading_std_deg = 0.0;      // 1σ of the heading change since the first sample
   Vector3 bias_dps{};                // b̂, sensor frame
   Vector3 gyro_sensitivity_error{};  // ŝ per sensor axis (0.01: reads 1 % high)
+  Vector3 gyro_cross_axis{};         // Ŝ's xy, xz, yz: axis x reads xy of the rate about y, y as much of x's
+  double accel_delay_s = 0.0;        // δ̂: the accel's sample lags the gyro's by this
   Vector3 lever_arm_m{};             // r̂, the accel's offset from the centre of rotation
   bool rest = false;
 };

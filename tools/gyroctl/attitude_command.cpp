@@ -144,14 +144,17 @@ int runAttitude(const AttitudeOptions& opt) {
     std::fprintf(stderr, "attitude from the raw gyro, its bias learned from the record (%zu of %zu samples at rest)\n",
                  rest_samples, n);
   const Vector3& sens = last.gyro_sensitivity_error;
+  const Vector3& cross = last.gyro_cross_axis;
   const Vector3& lever = last.lever_arm_m;
   if (!rate_estimator && rest_samples == 0)
     std::fprintf(stderr, "learned in motion: nothing (no rest in the record, so the gyro bias is not known)\n");
   else
-    std::fprintf(stderr,
-                 "learned in motion: gyro sensitivity error x %+.2f %%, y %+.2f %%, z %+.2f %%; accel lever arm "
-                 "%+.3f, %+.3f, %+.3f m\n",
-                 100.0 * sens[0], 100.0 * sens[1], 100.0 * sens[2], lever[0], lever[1], lever[2]);
+    std::fprintf(
+        stderr,
+        "learned in motion: gyro sensitivity error x %+.2f %%, y %+.2f %%, z %+.2f %%; cross-axis xy %+.2f %%, "
+        "xz %+.2f %%, yz %+.2f %%; accel lever arm %+.3f, %+.3f, %+.3f m; accel delay %+.1f ms\n",
+        100.0 * sens[0], 100.0 * sens[1], 100.0 * sens[2], 100.0 * cross[0], 100.0 * cross[1], 100.0 * cross[2],
+        lever[0], lever[1], lever[2], 1e3 * last.accel_delay_s);
   std::fprintf(stderr, "wrote %zu samples to %s\n", n, opt.output.c_str());
   return kExitOk;
 }
