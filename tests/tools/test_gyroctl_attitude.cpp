@@ -1,6 +1,7 @@
 // gyroctl attitude: a simulated board (gyroctl simulate --accel) that rests, turns once about z
 // and rests again: with and without a model file the heading change is the true turn and roll
-// and pitch stay level; the columns and the error statuses.
+// and pitch stay level, and the motion errors it learned are named; the columns and the error
+// statuses.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -61,6 +62,10 @@ TEST(GyroctlAttitude, AOneTurnAboutZReadsAsItsTrueHeadingChangeWithAndWithoutAMo
     const auto out = d.path() / "attitude.csv";
     const auto r = runGyroctl("attitude " + rec.string() + " -o " + out.string() + with, d.path());
     ASSERT_EQ(r.exit_status, 0) << r.err;
+    // What motion taught it, named on stderr: each of the learned motion errors.
+    for (const char* term :
+         {"learned in motion: gyro sensitivity error x ", "; cross-axis xy ", "; accel lever arm ", "; accel delay "})
+      EXPECT_NE(r.err.find(term), std::string::npos) << term << " in " << r.err;
     const AttitudeCsv csv = readAttitudeCsv(readWholeFile(out));
     // The recording's columns first, then the estimator's.
     ASSERT_GE(csv.names.size(), 16u);
